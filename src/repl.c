@@ -29,10 +29,11 @@
 #define HISTORY_MAX 1000
 #define SOURCE_NAME "<stdin>"
 
-/* Word breaks for name completion: everything that cannot be part of a
-   name. File names after :load break only at blanks and quotes. Not
-   const: readline's word-break hook returns a plain char *. */
-static char name_breaks[] = " \t\n\"\\'`@$><=;|&{}()[],.+-*/^%!~#?:";
+/* Word breaks for name completion: what cannot be part of a name (a name
+   may hold a quote after its first letter: x'). File names after :load
+   break only at blanks and quotes. Not const: readline's word-break hook
+   returns a plain char *. */
+static char name_breaks[] = " \t\n\"\\`@$><=;|&{}()[],.+-*/^%!~#?:";
 static char file_breaks[] = " \t\n\"'";
 
 /* ---- signals ---- */
