@@ -1,0 +1,488 @@
+/* density.c: building and evaluating density tapes (paper Section 2). */
+#include "density.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct dt_builder {
+  dt_instr *code;
+  int ncode, capcode;
+  dt_leaf *leaves;
+  int nleaves, capleaves;
+  int depth;      /* operands currently on the (symbolic) stack */
+  int err;        /* first error seen; later calls are ignored */
+};
+
+dt_builder *dt_builder_new(void) {
+  return calloc(1, sizeof(dt_builder));
+}
+
+void dt_builder_free(dt_builder *b) {
+  if (!b) return;
+  free(b->code);
+  free(b->leaves);
+  free(b);
+}
+
+void dt_tape_free(dt_tape *t) {
+  if (!t) return;
+  free(t->code);
+  free(t->leaves);
+  free(t);
+}
+
+const char *dt_strerror(int err) {
+  switch (err) {
+  case DT_OK: return "no error";
+  case DT_EPLANE: return "plane normal must be finite and non-zero";
+  case DT_ERADIUS: return "radius must be finite and >= 0";
+  case DT_EOP: return "density operation needs two operands";
+  case DT_EUNBALANCED: return "density tape must hold exactly one tree";
+  case DT_ENOMEM: return "out of memory";
+  }
+  return "unknown density error";
+}
+
+static int push_instr(dt_builder *b, dt_instr in) {
+  if (b->ncode == b->capcode) {
+    int cap = b->capcode ? 2 * b->capcode : 16;
+    dt_instr *p = realloc(b->code, (size_t)cap * sizeof *p);
+    if (!p) return b->err = DT_ENOMEM;
+    b->code = p;
+    b->capcode = cap;
+  }
+  b->code[b->ncode++] = in;
+  return DT_OK;
+}
+
+int dt_builder_leaf(dt_builder *b, const double n[3], double d, double r) {
+  if (b->err) return b->err;
+  double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!isfinite(len) || len == 0 || !isfinite(d)) return DT_EPLANE;
+  if (!isfinite(r) || r < 0) return DT_ERADIUS;
+  if (b->nleaves == b->capleaves) {
+    int cap = b->capleaves ? 2 * b->capleaves : 16;
+    dt_leaf *p = realloc(b->leaves, (size_t)cap * sizeof *p);
+    if (!p) return b->err = DT_ENOMEM;
+    b->leaves = p;
+    b->capleaves = cap;
+  }
+  dt_leaf *lf = &b->leaves[b->nleaves];
+  for (int i = 0; i < 3; i++) lf->n[i] = n[i] / len;
+  lf->d = d / len;
+  lf->r = r;
+  lf->inv_r = r > 0 ? 1 / r : 0;
+  dt_instr in = {DT_LEAF, b->nleaves, 0};
+  if (push_instr(b, in)) return b->err;
+  b->nleaves++;
+  b->depth++;
+  return DT_OK;
+}
+
+int dt_builder_op(dt_builder *b, dt_op op) {
+  if (b->err) return b->err;
+  if (op != DT_SUM && op != DT_PRODUCT && op != DT_DIFF && op != DT_UNION)
+    return DT_EOP;
+  if (b->depth < 2) return DT_EOP;
+  dt_instr in = {(int)op, 0, 0};
+  if (push_instr(b, in)) return b->err;
+  b->depth--;
+  return DT_OK;
+}
+
+/* Interval product [a0,a1]*[b0,b1]. */
+static void imul(double a0, double a1, double b0, double b1,
+                 double *lo, double *hi) {
+  double p[4] = {a0 * b0, a0 * b1, a1 * b0, a1 * b1};
+  *lo = *hi = p[0];
+  for (int i = 1; i < 4; i++) {
+    if (p[i] < *lo) *lo = p[i];
+    if (p[i] > *hi) *hi = p[i];
+  }
+}
+
+/* The range of each op's result from its operands' ranges: x below, y on
+ * top.  Shared by the tape's M bound and (through lg.c's own copy of the
+ * rules) the per-segment bounds. */
+static void range_op(int op, double xl, double xh, double yl, double yh,
+                     double *lo, double *hi) {
+  switch (op) {
+  case DT_SUM: *lo = xl + yl; *hi = xh + yh; break;
+  case DT_DIFF: *lo = xl - yh; *hi = xh - yl; break;
+  case DT_RDIFF: *lo = yl - xh; *hi = yh - xl; break;
+  case DT_PRODUCT: imul(xl, xh, yl, yh, lo, hi); break;
+  default: { /* DT_UNION: 1 - (1-x)(1-y) */
+    double l, h;
+    imul(1 - xh, 1 - xl, 1 - yh, 1 - yl, &l, &h);
+    *lo = 1 - h;
+    *hi = 1 - l;
+  }
+  }
+}
+
+/* Sethi-Ullman reordering: emit the operand that needs more stack first,
+ * so a tree of n leaves needs at most log2(n)+1 slots.  Iterative, since
+ * builder trees may be long chains. */
+static int reorder(const dt_instr *in, int n, dt_instr *out, int *depth) {
+  /* stk needs up to 2 entries per tree level plus one: 2n + 2 ints. */
+  int *left = malloc(((size_t)n * 5 + 2) * sizeof(int));
+  if (!left) return DT_ENOMEM;
+  int *right = left + n, *need = left + 2 * n, *stk = left + 3 * n;
+  int sp = 0;
+  for (int i = 0; i < n; i++) {
+    if (in[i].op == DT_LEAF || in[i].op == DT_CONST) {
+      left[i] = right[i] = -1;
+      need[i] = 1;
+    } else {
+      right[i] = stk[--sp];
+      left[i] = stk[--sp];
+      int nl = need[left[i]], nr = need[right[i]];
+      need[i] = nl == nr ? nl + 1 : (nl > nr ? nl : nr);
+    }
+    stk[sp++] = i;
+  }
+  *depth = need[n - 1];
+  /* Explicit DFS: stk holds nodes, the sign bit of an entry marks "both
+   * children emitted". */
+  int no = 0;
+  sp = 0;
+  stk[sp++] = n - 1;
+  while (sp) {
+    int e = stk[--sp];
+    if (e < 0) {
+      int i = ~e;
+      dt_instr o = in[i];
+      if (need[right[i]] > need[left[i]] && o.op == DT_DIFF) o.op = DT_RDIFF;
+      out[no++] = o;
+      continue;
+    }
+    if (left[e] < 0) { out[no++] = in[e]; continue; }
+    int first = left[e], second = right[e];
+    if (need[second] > need[first]) { first = right[e]; second = left[e]; }
+    stk[sp++] = ~e;
+    stk[sp++] = second;
+    stk[sp++] = first;
+  }
+  free(left);
+  return DT_OK;
+}
+
+static void tape_range(dt_tape *t) {
+  double lo[DT_STACK_MAX], hi[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) { lo[sp] = 0; hi[sp] = 1; sp++; continue; }
+    if (in->op == DT_CONST) { lo[sp] = hi[sp] = in->c; sp++; continue; }
+    sp--;
+    range_op(in->op, lo[sp - 1], hi[sp - 1], lo[sp], hi[sp],
+             &lo[sp - 1], &hi[sp - 1]);
+  }
+  t->lo = lo[0];
+  t->hi = hi[0];
+}
+
+dt_tape *dt_builder_finish(dt_builder *b, int *err) {
+  int e = b->err;
+  if (!e && b->depth != 1) e = DT_EUNBALANCED;
+  dt_tape *t = NULL;
+  if (!e) {
+    t = calloc(1, sizeof *t);
+    dt_instr *code = malloc((size_t)b->ncode * sizeof *code);
+    if (!t || !code) {
+      free(code);
+      e = DT_ENOMEM;
+    } else if ((e = reorder(b->code, b->ncode, code, &t->depth)) != DT_OK) {
+      free(code);
+    } else {
+      t->code = code;
+      t->ncode = b->ncode;
+      t->leaves = b->leaves;  /* ownership moves to the tape */
+      t->nleaves = b->nleaves;
+      b->leaves = NULL;
+      for (int i = 0; i < t->nleaves; i++)
+        if (t->leaves[i].r > t->rmax) t->rmax = t->leaves[i].r;
+      if (t->depth > DT_STACK_MAX) e = DT_EOP; /* needs > 2^63 leaves */
+      else tape_range(t);
+    }
+    if (e) { dt_tape_free(t); t = NULL; }
+  }
+  if (err) *err = e;
+  dt_builder_free(b);
+  return t;
+}
+
+double dt_max(const dt_tape *t) {
+  return t->hi;
+}
+
+/* eq. (2): alpha = s/r; (1-alpha)^2 (2+alpha)/4 inside the filter. */
+double dt_halfspace(double s, double r) {
+  if (r <= 0) return s < 0 ? 1.0 : (s > 0 ? 0.0 : 0.5);
+  double a = s / r;
+  if (a >= 1) return 0;
+  if (a <= -1) return 1;
+  return (1 - a) * (1 - a) * (2 + a) * 0.25;
+}
+
+/* Signed distance of p from a leaf's plane, positive outside. */
+static double leaf_dist(const dt_leaf *lf, const double p[3]) {
+  return lf->n[0] * p[0] + lf->n[1] * p[1] + lf->n[2] * p[2] - lf->d;
+}
+
+/* Apply a binary op to stack values x (below) and y (top). */
+static double apply(int op, double x, double y) {
+  switch (op) {
+  case DT_SUM: return x + y;
+  case DT_PRODUCT: return x * y;
+  case DT_DIFF: return x - y;
+  case DT_RDIFF: return y - x;
+  default: return x + y - x * y;
+  }
+}
+
+/* Figure 4: Density. */
+double dt_density(const dt_tape *t, const double p[3]) {
+  double st[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      st[sp++] = dt_halfspace(leaf_dist(lf, p), lf->r);
+    } else if (in->op == DT_CONST) {
+      st[sp++] = in->c;
+    } else {
+      sp--;
+      st[sp - 1] = apply(in->op, st[sp - 1], st[sp]);
+    }
+  }
+  return st[0];
+}
+
+/* Value and derivative of one leaf as a function of alpha = s/r:
+ * rho = (1-a)^2(2+a)/4, drho/da = 3/4 (a^2 - 1) (Section 2.4). */
+static double leaf_va(double a, double *dda) {
+  if (a >= 1) { *dda = 0; return 0; }
+  if (a <= -1) { *dda = 0; return 1; }
+  *dda = 0.75 * (a * a - 1);
+  return (1 - a) * (1 - a) * (2 + a) * 0.25;
+}
+
+/* Derivative rules shared by the gradient and ray evaluators: combine
+ * (x, dx) below with (y, dy) on top, for k components. */
+static double apply_d(int op, double x, const double *dx, double y,
+                      const double *dy, double *out, int k) {
+  for (int j = 0; j < k; j++) {
+    switch (op) {
+    case DT_SUM: out[j] = dx[j] + dy[j]; break;
+    case DT_PRODUCT: out[j] = dx[j] * y + x * dy[j]; break;
+    case DT_DIFF: out[j] = dx[j] - dy[j]; break;
+    case DT_RDIFF: out[j] = dy[j] - dx[j]; break;
+    default: out[j] = dx[j] * (1 - y) + dy[j] * (1 - x); break;
+    }
+  }
+  return apply(op, x, y);
+}
+
+/* Section 2.4: gradient by the usual differentiation rules. */
+double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
+  double v[DT_STACK_MAX], g[DT_STACK_MAX][3];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double s = leaf_dist(lf, p), dda = 0;
+      if (lf->r > 0) v[sp] = leaf_va(s * lf->inv_r, &dda);
+      else v[sp] = dt_halfspace(s, 0);
+      for (int j = 0; j < 3; j++) g[sp][j] = dda * lf->inv_r * lf->n[j];
+      sp++;
+    } else if (in->op == DT_CONST) {
+      v[sp] = in->c;
+      g[sp][0] = g[sp][1] = g[sp][2] = 0;
+      sp++;
+    } else {
+      sp--;
+      double out[3];
+      v[sp - 1] = apply_d(in->op, v[sp - 1], g[sp - 1], v[sp], g[sp], out, 3);
+      memcpy(g[sp - 1], out, sizeof out);
+    }
+  }
+  memcpy(grad, g[0], sizeof g[0]);
+  return v[0];
+}
+
+double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
+                      double s, double *drho_ds) {
+  double v[DT_STACK_MAX], dv[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+      double dist = leaf_dist(lf, o) + s * nd, dda = 0;
+      if (lf->r > 0) v[sp] = leaf_va(dist * lf->inv_r, &dda);
+      else v[sp] = dt_halfspace(dist, 0);
+      dv[sp] = dda * nd * lf->inv_r;
+      sp++;
+    } else if (in->op == DT_CONST) {
+      v[sp] = in->c;
+      dv[sp] = 0;
+      sp++;
+    } else {
+      sp--;
+      double out;
+      v[sp - 1] = apply_d(in->op, v[sp - 1], &dv[sp - 1], v[sp], &dv[sp],
+                          &out, 1);
+      dv[sp - 1] = out;
+    }
+  }
+  if (drho_ds) *drho_ds = dv[0];
+  return v[0];
+}
+
+/* eq. (5): Displacement.  The paper's trigonometric root
+ * alpha = 2 cos((acos(2 rho - 1) + 4 pi)/3) loses all relative accuracy
+ * near rho = 0 and 1 (acos is infinitely steep at -1 and 1) and rounds the
+ * sign away near 0.5, so we solve the cubic in better-conditioned
+ * variables instead.  By the symmetry rho(-a) = 1 - rho(a) only
+ * tau = min(level, 1 - level) (exact in binary) is needed:
+ *   tau >= 1/4: a^3 - 3a + c = 0, c = 2 - 4 tau (exact), a in [0, 0.35],
+ *               Newton from a = c/3 (the series a = c/3 + c^3/81 + ...);
+ *   tau <  1/4: u = 1 - a solves u^2 (3 - u) = 4 tau, u in (0, 0.66],
+ *               Newton from the series u = s (1 + s/6), s = sqrt(4 tau/3),
+ *               which is already exact to rounding for tau < 1e-200. */
+double dt_displacement(double r, double level) {
+  if (!(level > 0)) return r;
+  if (level >= 1) return -r;
+  double tau = level <= 0.5 ? level : 1 - level;
+  double a;
+  if (tau >= 0.25) {
+    double c = 2 - 4 * tau;
+    a = c / 3;
+    for (int i = 0; i < 6; i++) {
+      double h = (a * a - 3) * a + c, dh = 3 * (a * a - 1);
+      double na = a - h / dh;
+      if (na == a) break;
+      a = na;
+    }
+  } else {
+    double s = sqrt(tau) * 1.1547005383792515; /* sqrt(4/3) */
+    double u = s * (1 + s / 6);
+    if (tau > 1e-200) {
+      for (int i = 0; i < 8; i++) {
+        double g = u * u * (3 - u) - 4 * tau, dg = 3 * u * (2 - u);
+        double nu = u - g / dg;
+        if (nu == u) break;
+        u = nu;
+      }
+    }
+    a = 1 - u;
+  }
+  return level <= 0.5 ? a * r : -a * r;
+}
+
+/* A leaf's value if it is constant over the ray segment, else -1. */
+static double leaf_const(const dt_leaf *lf, const double o[3],
+                         const double d[3], double s0, double s1) {
+  double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+  double base = leaf_dist(lf, o);
+  double a = nd == 0 ? base : base + s0 * nd;
+  double b = nd == 0 ? base : base + s1 * nd;
+  double lo = a < b ? a : b, hi = a < b ? b : a;
+  if (lf->r > 0) {
+    if (lo >= lf->r) return 0;
+    if (hi <= -lf->r) return 1;
+  } else {
+    if (lo > 0) return 0;
+    if (hi < 0) return 1;
+  }
+  return -1;
+}
+
+/* Per-segment pruning (Section 3.4.1: a leaf contributes nothing to L and
+ * G where the segment misses its filter).  Constants are kept lazily on
+ * the fold stack and only emitted when combined with live code. */
+int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
+                 double s0, double s1, dt_instr *buf, dt_tape *view) {
+  struct { int isc; double c; int start; } st[DT_STACK_MAX];
+  int sp = 0, n = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF || in->op == DT_CONST) {
+      double c = in->op == DT_CONST
+                     ? in->c : leaf_const(&t->leaves[in->arg], o, d, s0, s1);
+      if (in->op == DT_CONST || c >= 0) {
+        st[sp].isc = 1;
+        st[sp].c = c;
+        st[sp].start = n;
+      } else {
+        st[sp].isc = 0;
+        st[sp].start = n;
+        buf[n++] = *in;
+      }
+      sp++;
+      continue;
+    }
+    sp--;
+    int xc = st[sp - 1].isc, yc = st[sp].isc, op = in->op;
+    if (xc && yc) {
+      st[sp - 1].c = apply(op, st[sp - 1].c, st[sp].c);
+      continue;
+    }
+    if (!xc && !yc) {
+      buf[n++] = *in;
+      continue;
+    }
+    /* Exactly one constant c; the live operand's code is buf[start..n). */
+    double c = xc ? st[sp - 1].c : st[sp].c;
+    int start = xc ? st[sp].start : st[sp - 1].start;
+    int keep = 0, fold = 0;
+    double fv = 0;
+    switch (op) {
+    case DT_SUM: keep = c == 0; break;
+    case DT_PRODUCT:
+      if (c == 0) { fold = 1; fv = 0; } else keep = c == 1;
+      break;
+    case DT_UNION:
+      if (c == 1) { fold = 1; fv = 1; } else keep = c == 0;
+      break;
+    case DT_DIFF: keep = yc && c == 0; break;   /* x - 0 */
+    case DT_RDIFF: keep = xc && c == 0; break;  /* y - 0 */
+    }
+    st[sp - 1].start = start;
+    if (fold) {
+      n = start;
+      st[sp - 1].isc = 1;
+      st[sp - 1].c = fv;
+    } else if (keep) {
+      st[sp - 1].isc = 0;
+    } else {
+      /* Emit the constant after the live code: the operands are now in
+       * swapped order, so differences flip. */
+      dt_instr ci = {DT_CONST, 0, c};
+      buf[n++] = ci;
+      dt_instr oi = *in;
+      if (xc) {
+        if (op == DT_DIFF) oi.op = DT_RDIFF;
+        else if (op == DT_RDIFF) oi.op = DT_DIFF;
+      }
+      buf[n++] = oi;
+      st[sp - 1].isc = 0;
+    }
+  }
+  if (st[0].isc) {
+    dt_instr ci = {DT_CONST, 0, st[0].c};
+    n = 0;
+    buf[n++] = ci;
+  }
+  *view = *t;
+  view->code = buf;
+  view->ncode = n;
+  tape_range(view);
+  return n;
+}

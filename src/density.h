@@ -1,0 +1,112 @@
+/* density.h: density trees as flat tapes (Lobb, "Quasi-Convolutional
+ * Smoothing of Polyhedra", Section 2).
+ *
+ * A density tree is built in postfix order with a dt_builder (leaves are
+ * smoothed halfspaces, each with its own plane and radius; ops are Sum,
+ * Product, Difference and the density Union a+b-ab) and finished into a
+ * dt_tape: a flat array of instructions evaluated with a small fixed
+ * stack, no pointer chasing and no allocation per evaluation.  Finishing
+ * reorders the tape (Sethi-Ullman) so any tree needs at most DT_STACK_MAX
+ * stack slots.
+ *
+ * Memory: dt_builder_new returns a builder owned by the caller; it is
+ * freed by dt_builder_finish (which always consumes it) or by
+ * dt_builder_free.  dt_builder_finish returns a tape owned by the caller,
+ * freed with dt_tape_free.  A tape is immutable after finishing, so any
+ * number of threads may evaluate it at once.  A "view" (see dt_prune_ray)
+ * borrows the leaves of its parent tape and the code buffer of its caller
+ * and must never be passed to dt_tape_free. */
+#ifndef QCS_DENSITY_H
+#define QCS_DENSITY_H
+
+#include <stddef.h>
+
+#define DT_STACK_MAX 64
+
+typedef enum {
+  DT_LEAF,      /* push the smoothed halfspace leaves[arg] */
+  DT_CONST,     /* push the constant c (only in pruned views) */
+  DT_SUM,       /* x y -> x + y */
+  DT_PRODUCT,   /* x y -> x * y */
+  DT_DIFF,      /* x y -> x - y            (y on top of the stack) */
+  DT_RDIFF,     /* x y -> y - x            (made by the reordering) */
+  DT_UNION      /* x y -> x + y - x*y      (stays in [0,1]) */
+} dt_op;
+
+/* Error codes (0 is success). */
+enum {
+  DT_OK = 0,
+  DT_EPLANE,      /* zero or non-finite normal, or non-finite offset */
+  DT_ERADIUS,     /* negative or non-finite radius */
+  DT_EOP,         /* unknown op, or fewer than two operands on the stack */
+  DT_EUNBALANCED, /* finish with no tree or more than one tree */
+  DT_ENOMEM
+};
+
+/* A smoothed halfspace: solid side n.x < d, |n| = 1, filter radius r
+ * (r = 0: sharp step density).  inv_r is 1/r, or 0 when r = 0. */
+typedef struct dt_leaf {
+  double n[3], d, r, inv_r;
+} dt_leaf;
+
+typedef struct dt_instr {
+  int op;       /* dt_op */
+  int arg;      /* leaf index for DT_LEAF */
+  double c;     /* value for DT_CONST */
+} dt_instr;
+
+typedef struct dt_tape {
+  int ncode;
+  dt_instr *code;
+  int nleaves;
+  dt_leaf *leaves;
+  int depth;        /* stack slots needed, <= DT_STACK_MAX */
+  double lo, hi;    /* range of the density, assuming leaves in [0,1] */
+  double rmax;      /* largest leaf radius */
+} dt_tape;
+
+typedef struct dt_builder dt_builder;
+
+dt_builder *dt_builder_new(void);
+/* Append a smoothed halfspace: raw plane (n, d) with solid side n.x < d,
+ * normalised here; radius r >= 0. */
+int dt_builder_leaf(dt_builder *b, const double n[3], double d, double r);
+int dt_builder_op(dt_builder *b, dt_op op);
+/* Consumes b.  On failure returns NULL and sets *err (if err != NULL). */
+dt_tape *dt_builder_finish(dt_builder *b, int *err);
+void dt_builder_free(dt_builder *b);
+void dt_tape_free(dt_tape *t);
+const char *dt_strerror(int err);
+
+/* eq. (2): one smoothed halfspace's density at signed distance s from its
+ * plane (positive outside), radius r (r = 0: 1, 0.5, 0 for s <,=,> 0). */
+double dt_halfspace(double s, double r);
+
+/* Figure 4: the density at point p. */
+double dt_density(const dt_tape *t, const double p[3]);
+
+/* Section 2.4: the density and its analytic gradient at p. */
+double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]);
+
+/* The density at o + s*d and its derivative d rho / d s (d any length). */
+double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
+                      double s, double *drho_ds);
+
+/* eq. (5): Displacement.  The signed distance (positive outward, i.e. > 0
+ * for level < 0.5) from a plane to the level-isosurface of its halfspace
+ * smoothed with radius r.  level <= 0 gives r, level >= 1 gives -r. */
+double dt_displacement(double r, double level);
+
+/* M: the largest density the tape can take (Section 3.4.1), assuming each
+ * leaf lies in [0,1]; > 1 flags an ill-formed tree (paper Figure 15b). */
+double dt_max(const dt_tape *t);
+
+/* The specialisation of t to the ray segment o + s*d, s in [s0, s1]:
+ * leaves whose filter support the segment does not touch become constants
+ * and are folded away (0*x = 0, 1*x = x, ...).  Writes at most t->ncode
+ * instructions to buf and fills *view (borrowing t's leaves and buf).
+ * Returns the number of instructions in the view (>= 1). */
+int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
+                 double s0, double s1, dt_instr *buf, dt_tape *view);
+
+#endif

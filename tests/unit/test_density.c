@@ -1,0 +1,450 @@
+/* test_density.c: density tapes (eq. 2, Figure 4, Section 2.4, eq. 5)
+ * against MPFR and long double references from ref_density.h, which share
+ * no code with src/density.c. */
+#include <float.h>
+
+#include "check.h"
+#include "density.h"
+#include "ref_density.h"
+
+static const double EPS = DBL_EPSILON;
+
+/* The rounded unit cube of scenes/README.md, shifted by sh, radius r. */
+static int unit_cube(rtree *t, double sh, double r) {
+  double lo[3] = {sh, sh, sh}, hi[3] = {sh + 1, sh + 1, sh + 1};
+  double rr[6] = {r, r, r, r, r, r};
+  t->n = 0;
+  return rt_box(t, lo, hi, rr);
+}
+
+static void test_paper_values(void) {
+  rtree t;
+  for (int k = 0; k < 2; k++) {
+    double sh = k ? 1e6 : 0;   /* exact in double either way */
+    int root = unit_cube(&t, sh, 0.07);
+    dt_tape *tp = rt_tape(&t, root);
+    double face[3] = {sh + 0.5, sh + 0.5, sh + 1};
+    double edge[3] = {sh + 0.5, sh + 1, sh + 1};
+    double corner[3] = {sh + 1, sh + 1, sh + 1};
+    /* The paper's exact values (Section 2.3.1 (c),(d)); exact in double. */
+    CHECK_NEAR(k ? "face 0.5 (shifted 1e6)" : "face 0.5",
+               dt_density(tp, face), 0.5, 0);
+    CHECK_NEAR(k ? "edge 0.25 (shifted 1e6)" : "edge 0.25",
+               dt_density(tp, edge), 0.25, 0);
+    CHECK_NEAR(k ? "corner 0.125 (shifted 1e6)" : "corner 0.125",
+               dt_density(tp, corner), 0.125, 0);
+    double g[3];
+    double v = dt_density_grad(tp, corner, g);
+    CHECK_NEAR("grad value = density at corner", v, 0.125, 0);
+    /* d/dx of 0.5^3 product: 0.25 * (-3/4)/r on each axis, to 1e-15 rel. */
+    for (int i = 0; i < 3; i++)
+      CHECK_NEAR("corner gradient component", g[i], 0.25 * -0.75 / 0.07,
+                 1e-15 * 0.25 * 0.75 / 0.07 * 4);
+    CHECK_NEAR("M of the unit cube", dt_max(tp), 1, 0);
+    dt_tape_free(tp);
+  }
+}
+
+/* Random points against MPFR.  Tolerance: a leaf's alpha = s/r carries an
+ * absolute error of at most ~4 eps (|n.p| + |d|)/r from double rounding,
+ * so the density error is at most 0.75 * that per leaf times the number of
+ * leaves (all other factors are <= 1 in magnitude, sums <= 4): we use
+ * 8 * nleaves * eps * scale / rmin + 4 eps. */
+static void test_random_points(void) {
+  rng_t g = {12111};
+  double worst = 0, worst_ratio = 0;
+  int bad = 0;
+  for (int sc = 0; sc < 60; sc++) {
+    rtree t;
+    int root = rt_random_scene(&t, &g);
+    dt_tape *tp = rt_tape(&t, root);
+    double rmin = 1;
+    for (int i = 0; i < t.n; i++)
+      if (t.nodes[i].op == R_LEAF && t.nodes[i].r < rmin) rmin = t.nodes[i].r;
+    for (int k = 0; k < 40; k++) {
+      double p[3] = {rng_range(&g, -1.3, 2.3), rng_range(&g, -1.3, 2.3),
+                     rng_range(&g, -1.3, 2.3)};
+      double got = dt_density(tp, p), want = ref_density(&t, root, p);
+      double tol = 8 * tp->nleaves * EPS * 4 / rmin + 4 * EPS;
+      double err = fabs(got - want);
+      if (err > worst) worst = err;
+      if (err / tol > worst_ratio) worst_ratio = err / tol;
+      if (err > tol) bad++;
+    }
+    dt_tape_free(tp);
+  }
+  printf("# random points: max |density - mpfr| = %.3g (%.3g of tolerance)\n",
+         worst, worst_ratio);
+  CHECK("2400 random points match MPFR within the rounding bound", bad == 0);
+}
+
+/* MPFR central difference of the reference density along dir at q+s*dir,
+ * step 2^-90 at 320 bits: the truncation error is below 1e-40. */
+static double ref_deriv(const rtree *t, int root, const double q[3],
+                        const double dir[3], double s) {
+  mpfr_t p[3], a, b, tmp, h;
+  mpfr_inits2(REF_PREC, p[0], p[1], p[2], a, b, tmp, h, (mpfr_ptr)0);
+  mpfr_set_ui_2exp(h, 1, -90, MPFR_RNDN);
+  for (int sign = 0; sign < 2; sign++) {
+    for (int i = 0; i < 3; i++) {
+      mpfr_set_d(tmp, s, MPFR_RNDN);
+      if (sign) mpfr_add(tmp, tmp, h, MPFR_RNDN);
+      else mpfr_sub(tmp, tmp, h, MPFR_RNDN);
+      mpfr_mul_d(tmp, tmp, dir[i], MPFR_RNDN);
+      mpfr_add_d(p[i], tmp, q[i], MPFR_RNDN);
+    }
+    ref_eval(sign ? b : a, t, root, p);
+  }
+  mpfr_sub(a, b, a, MPFR_RNDN);
+  mpfr_div(a, a, h, MPFR_RNDN);
+  mpfr_div_ui(a, a, 2, MPFR_RNDN);
+  double v = mpfr_get_d(a, MPFR_RNDN);
+  mpfr_clears(p[0], p[1], p[2], a, b, tmp, h, (mpfr_ptr)0);
+  return v;
+}
+
+/* Gradient and ray derivative against MPFR central differences.
+ * Tolerance: 1e-9 relative to the sum of |leaf gradient| magnitudes
+ * (bounded by nleaves * 0.75/rmin * |dir|), which covers the alpha
+ * rounding of the previous test propagated through one differentiation
+ * (condition ~ |alpha|/(1 - alpha^2) stays far below 1e6 at random
+ * points). */
+static void test_gradients(void) {
+  rng_t g = {777};
+  int bad_g = 0, bad_r = 0, n = 0;
+  double worst = 0;
+  for (int sc = 0; sc < 30; sc++) {
+    rtree t;
+    int root = rt_random_scene(&t, &g);
+    dt_tape *tp = rt_tape(&t, root);
+    double rmin = 1;
+    for (int i = 0; i < t.n; i++)
+      if (t.nodes[i].op == R_LEAF && t.nodes[i].r < rmin) rmin = t.nodes[i].r;
+    for (int k = 0; k < 20; k++) {
+      double p[3] = {rng_range(&g, -1.3, 2.3), rng_range(&g, -1.3, 2.3),
+                     rng_range(&g, -1.3, 2.3)};
+      double gr[3];
+      dt_density_grad(tp, p, gr);
+      double scale = tp->nleaves * 0.75 / rmin;
+      for (int i = 0; i < 3; i++) {
+        double e[3] = {0, 0, 0};
+        e[i] = 1;
+        double want = ref_deriv(&t, root, p, e, 0);
+        double err = fabs(gr[i] - want) / scale;
+        if (err > worst) worst = err;
+        if (err > 1e-9) bad_g++;
+      }
+      /* Ray derivative with |dir| in {1e-3, 1, 1e3}. */
+      double len = pow(10, 3.0 * (int)(rng_u64(&g) % 3) - 3);
+      double dir[3] = {rng_range(&g, -1, 1), rng_range(&g, -1, 1),
+                       rng_range(&g, -1, 1)};
+      double dl = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+      for (int i = 0; i < 3; i++) dir[i] *= len / dl;
+      double s = rng_range(&g, -1, 1) / len;
+      double o[3] = {p[0] - s * dir[0], p[1] - s * dir[1], p[2] - s * dir[2]};
+      double dv;
+      dt_density_ray(tp, o, dir, s, &dv);
+      double want = ref_deriv(&t, root, o, dir, s);
+      if (fabs(dv - want) > 1e-9 * scale * len) bad_r++;
+      n++;
+    }
+    dt_tape_free(tp);
+  }
+  printf("# gradients: max |grad - mpfr diff| / scale = %.3g\n", worst);
+  CHECK("gradient matches MPFR central differences (1e-9 rel)", bad_g == 0);
+  CHECK("ray derivative matches MPFR for |d| = 1e-3, 1, 1e3 (1e-9 rel)",
+        bad_r == 0 && n == 600);
+}
+
+/* MPFR reference for eq. (5): bisect the cap fraction h^2(3r-h)/(4r^3)
+ * (r = 1) for the cap height h in [0, 2] with 300 steps; the distance of
+ * the isosurface from the plane is 1 - h. */
+static void ref_displacement(mpfr_t x, double level) {
+  mpfr_t lo, hi, mid, s, f;
+  mpfr_inits2(REF_PREC, lo, hi, mid, s, f, (mpfr_ptr)0);
+  mpfr_set_si(lo, -1, MPFR_RNDN);  /* distance s: density 1 at -1 */
+  mpfr_set_si(hi, 1, MPFR_RNDN);
+  for (int i = 0; i < 300; i++) {
+    mpfr_add(mid, lo, hi, MPFR_RNDN);
+    mpfr_div_2ui(mid, mid, 1, MPFR_RNDN);
+    ref_cap(f, mid, 1.0);
+    if (mpfr_cmp_d(f, level) > 0) mpfr_set(lo, mid, MPFR_RNDN);
+    else mpfr_set(hi, mid, MPFR_RNDN);
+  }
+  mpfr_set(x, lo, MPFR_RNDN);
+  mpfr_clears(lo, hi, mid, s, f, (mpfr_ptr)0);
+}
+
+static void test_displacement(void) {
+  double levels[64];
+  int nl = 0;
+  levels[nl++] = 1e-300;
+  levels[nl++] = 4.9e-324;
+  levels[nl++] = 1e-15;
+  levels[nl++] = 0.5 - 1e-15;
+  levels[nl++] = 0.5;
+  levels[nl++] = 0.5 + 1e-15;
+  levels[nl++] = 1 - 1e-15;
+  levels[nl++] = nextafter(1, 0);
+  levels[nl++] = nextafter(0.5, 0);
+  levels[nl++] = nextafter(0.5, 1);
+  levels[nl++] = 0.25;
+  levels[nl++] = 0.75;
+  levels[nl++] = 1e-8;
+  rng_t g = {4242};
+  while (nl < 64) levels[nl++] = rng_unit(&g);
+  double radii[] = {1e-9, 1e-3, 0.07, 1, 1e3};
+  double worst_rho = 0, worst_x = 0;
+  int bad_rho = 0, bad_x = 0, bad_sign = 0;
+  mpfr_t xr, s, f;
+  mpfr_inits2(REF_PREC, xr, s, f, (mpfr_ptr)0);
+  for (int i = 0; i < nl; i++) {
+    double lv = levels[i];
+    ref_displacement(xr, lv);
+    for (size_t k = 0; k < sizeof radii / sizeof *radii; k++) {
+      double r = radii[k], x = dt_displacement(r, lv);
+      /* density of the halfspace (radius r) at the returned distance,
+       * by the MPFR cap formula: |rho - level| <= 1e-15 (brief: 1e-14). */
+      mpfr_set_d(s, x, MPFR_RNDN);
+      ref_cap(f, s, r);
+      mpfr_sub_d(f, f, lv, MPFR_RNDN);
+      double e = fabs(mpfr_get_d(f, MPFR_RNDN));
+      if (e > worst_rho) worst_rho = e;
+      if (e > 1e-15) bad_rho++;
+      /* distance against the MPFR root: within 2 ulps of r (4.5e-16 r). */
+      mpfr_mul_d(s, xr, r, MPFR_RNDN);
+      double ex = fabs(x - mpfr_get_d(s, MPFR_RNDN)) / r;
+      if (ex > worst_x) worst_x = ex;
+      if (ex > 4.5e-16) bad_x++;
+      if ((lv < 0.5 && !(x > 0)) || (lv > 0.5 && !(x < 0)) ||
+          (lv == 0.5 && x != 0) || fabs(x) > r)
+        bad_sign++;
+    }
+  }
+  mpfr_clears(xr, s, f, (mpfr_ptr)0);
+  printf("# displacement: max |rho(x) - t| = %.3g, max |x - x_mpfr|/r = %.3g\n",
+         worst_rho, worst_x);
+  CHECK("displacement: rho(x) = t to 1e-15 for t near 0, 0.5, 1 and random",
+        bad_rho == 0);
+  CHECK("displacement: x within 2 ulps of r of the MPFR root", bad_x == 0);
+  CHECK("displacement: positive outward, exact 0 at 0.5, |x| <= r",
+        bad_sign == 0);
+  CHECK_NEAR("displacement t=0 is +r", dt_displacement(0.3, 0), 0.3, 0);
+  CHECK_NEAR("displacement t=1 is -r", dt_displacement(0.3, 1), -0.3, 0);
+  CHECK_NEAR("displacement r=0 is 0", dt_displacement(0, 0.3), 0, 0);
+  int mono = 1;
+  double prev = dt_displacement(1, 0);
+  for (int i = 1; i <= 100000; i++) {
+    double x = dt_displacement(1, i / 100000.0);
+    if (x > prev) mono = 0;
+    prev = x;
+  }
+  CHECK("displacement is non-increasing in t (1e5 steps)", mono);
+}
+
+/* Radii from 1e-9 to 1e3 with the geometry scaled alike (so the rounding
+ * bound of test_random_points stays the same relative size). */
+static void test_radius_scales(void) {
+  rng_t g = {99};
+  int bad = 0;
+  for (int e = -9; e <= 3; e++) {
+    double r = pow(10, e), S = r / 0.07;
+    rtree t;
+    double lo[3] = {0, 0, 0}, hi[3] = {S, S, S};
+    double rr[6] = {r, r, r, r, r, r};
+    t.n = 0;
+    int root = rt_box(&t, lo, hi, rr);
+    dt_tape *tp = rt_tape(&t, root);
+    for (int k = 0; k < 50; k++) {
+      double p[3] = {rng_range(&g, -0.1, 1.1) * S, rng_range(&g, -0.1, 1.1) * S,
+                     rng_range(&g, -0.1, 1.1) * S};
+      double got = dt_density(tp, p), want = ref_density(&t, root, p);
+      if (fabs(got - want) > 6 * 8 * EPS * 2 / 0.07) bad++;
+    }
+    dt_tape_free(tp);
+  }
+  CHECK("radii 1e-9..1e3 (scaled cubes) match MPFR (1.5e-13)", bad == 0);
+}
+
+/* The scene shifted to 1e6: the alpha rounding bound grows with |p| = 1e6:
+ * tolerance 6 leaves * 0.75 * 4 eps * 3e6 / r. */
+static void test_shifted(void) {
+  rng_t g = {31337};
+  rtree t;
+  int root = unit_cube(&t, 1e6, 0.07);
+  dt_tape *tp = rt_tape(&t, root);
+  int bad = 0;
+  double tol = 6 * 0.75 * 4 * EPS * 3e6 / 0.07;
+  for (int k = 0; k < 300; k++) {
+    double p[3] = {1e6 + rng_range(&g, -0.1, 1.1), 1e6 + rng_range(&g, -0.1, 1.1),
+                   1e6 + rng_range(&g, -0.1, 1.1)};
+    if (fabs(dt_density(tp, p) - ref_density(&t, root, p)) > tol) bad++;
+  }
+  dt_tape_free(tp);
+  CHECK("cube shifted to 1e6 matches MPFR (tol 2e-8 from |p| = 1e6)", bad == 0);
+}
+
+static void test_max_bound(void) {
+  rtree t;
+  t.n = 0;
+  double rr[6] = {0.1, 0.1, 0.1, 0.1, 0.1, 0.1};
+  double off[4][2] = {{0, 0}, {0.95, 0}, {0, 0.95}, {0.95, 0.95}};
+  int k = -1, box[4];
+  for (int i = 0; i < 4; i++) {
+    double lo[3] = {off[i][0], 0, off[i][1]};
+    double hi[3] = {off[i][0] + 1, 1, off[i][1] + 1};
+    int b = box[i] = rt_box(&t, lo, hi, rr);
+    k = k < 0 ? b : rt_op(&t, R_SUM, k, b);
+  }
+  dt_tape *tp = rt_tape(&t, k);
+  CHECK_NEAR("Figure 15b: M of four summed cubes is 4", dt_max(tp), 4, 0);
+  double p[3] = {0.975, 0.5, 0.975};
+  /* The overlap is thinner than the filter, so the peak stays below 4
+   * but above 1; tol 1e-14 against MPFR. */
+  CHECK("Figure 15b: density exceeds 1 in the overlap", dt_density(tp, p) > 1);
+  CHECK_NEAR("Figure 15b: overlap density matches MPFR", dt_density(tp, p),
+             ref_density(&t, k, p), 1e-14);
+  dt_tape_free(tp);
+  int u = rt_op(&t, R_UNION, box[0], box[1]);
+  tp = rt_tape(&t, u);
+  CHECK_NEAR("density Union keeps M = 1", dt_max(tp), 1, 0);
+  dt_tape_free(tp);
+  int d = rt_op(&t, R_DIFF, box[0], box[1]);
+  tp = rt_tape(&t, d);
+  CHECK("Difference range is [-1, 1]", tp->lo == -1 && tp->hi == 1);
+  dt_tape_free(tp);
+}
+
+static void test_builder_errors(void) {
+  double z[3] = {0, 0, 0}, n[3] = {0, 2, 0}, inf[3] = {INFINITY, 0, 0};
+  dt_builder *b = dt_builder_new();
+  CHECK("zero normal rejected", dt_builder_leaf(b, z, 1, 0.1) == DT_EPLANE);
+  CHECK("infinite normal rejected",
+        dt_builder_leaf(b, inf, 1, 0.1) == DT_EPLANE);
+  CHECK("NaN offset rejected", dt_builder_leaf(b, n, NAN, 0.1) == DT_EPLANE);
+  CHECK("negative radius rejected",
+        dt_builder_leaf(b, n, 1, -0.1) == DT_ERADIUS);
+  CHECK("op without operands rejected", dt_builder_op(b, DT_SUM) == DT_EOP);
+  CHECK("good leaf accepted", dt_builder_leaf(b, n, 2, 0.1) == DT_OK);
+  CHECK("good leaf accepted (2)", dt_builder_leaf(b, n, 4, 0) == DT_OK);
+  int err = 0;
+  dt_tape *tp = dt_builder_finish(b, &err);
+  CHECK("two trees left: unbalanced", !tp && err == DT_EUNBALANCED);
+  b = dt_builder_new();
+  dt_builder_leaf(b, n, 2, 0.1);   /* normalised: y < 1 */
+  tp = dt_builder_finish(b, &err);
+  CHECK("single leaf finishes", tp && err == DT_OK);
+  double p[3] = {0, 1, 0};
+  CHECK_NEAR("normal normalised at build: 0.5 on y = 1", dt_density(tp, p),
+             0.5, 0);
+  dt_tape_free(tp);
+  CHECK("strerror names the error",
+        strstr(dt_strerror(DT_EPLANE), "normal") != NULL);
+}
+
+static void test_sharp_leaves(void) {
+  rtree t;
+  double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  double rr[6] = {0, 0.1, 0, 0.1, 0, 0.1};
+  t.n = 0;
+  int root = rt_box(&t, lo, hi, rr);
+  dt_tape *tp = rt_tape(&t, root);
+  int bad = 0;
+  rng_t g = {5};
+  for (int k = 0; k < 500; k++) {
+    double p[3] = {rng_range(&g, -0.2, 1.2), rng_range(&g, -0.2, 1.2),
+                   rng_range(&g, -0.2, 1.2)};
+    if (k == 0) { p[0] = 1; }   /* exactly on a sharp plane */
+    double gr[3], v = dt_density_grad(tp, p, gr), dv;
+    double d[3] = {1, 0, 0};
+    double v2 = dt_density_ray(tp, p, d, 0, &dv);
+    if (!isfinite(v) || !isfinite(gr[0]) || !isfinite(gr[1]) ||
+        !isfinite(gr[2]) || !isfinite(dv) || v != v2 ||
+        fabs(v - ref_density(&t, root, p)) > 1e-14)
+      bad++;
+  }
+  dt_tape_free(tp);
+  CHECK("r = 0 leaves: step density, finite gradients, matches MPFR", bad == 0);
+  CHECK_NEAR("r = 0 on the plane is 0.5", dt_halfspace(0, 0), 0.5, 0);
+}
+
+/* A right-deep chain of 3000 slabs: Sethi-Ullman reordering keeps the
+ * stack tiny; value vs long double (tol 1e-13: products of values <= 1). */
+static void test_deep_chain(void) {
+  dt_builder *b = dt_builder_new();
+  double n[3] = {1, 0.5, 0}, m[3] = {-1, -0.5, 0};
+  for (int i = 0; i < 1500; i++) {
+    dt_builder_leaf(b, n, 1 + i * 1e-4, 0.2);
+    dt_builder_leaf(b, m, 0.0, 0.2);
+  }
+  for (int i = 0; i < 2999; i++) dt_builder_op(b, DT_PRODUCT);
+  int err;
+  dt_tape *tp = dt_builder_finish(b, &err);
+  CHECK("3000-leaf right-deep chain builds", tp && err == DT_OK);
+  if (!tp) return;
+  CHECK("chain needs few stack slots", tp->depth <= 13);
+  double p[3] = {0.5, 0.1, 0};
+  long double want = 1;
+  long double len = sqrtl(1.25L);
+  for (int i = 0; i < 1500; i++) {
+    long double s1 = (0.5L + 0.05L - (1 + i * 1e-4L)) / len, s2 = -0.55L / len;
+    long double h1 = 0.2L - s1, h2 = 0.2L - s2;
+    long double f1 = h1 >= 0.4L ? 1 : h1 * h1 * (0.6L - h1) / (4 * 0.008L);
+    long double f2 = h2 >= 0.4L ? 1 : h2 * h2 * (0.6L - h2) / (4 * 0.008L);
+    want *= f1 * f2;
+  }
+  CHECK_NEAR("chain density vs long double (1e-13)", dt_density(tp, p),
+             (double)want, 1e-13);
+  dt_tape_free(tp);
+}
+
+/* Pruned views equal the full tape inside their segment (1e-15: folding
+ * only drops exact identities 1*x, x+0, x-0 and 1+x-x). */
+static void test_prune(void) {
+  rng_t g = {2024};
+  int bad = 0, shrunk = 0;
+  for (int sc = 0; sc < 40; sc++) {
+    rtree t;
+    int root = rt_random_scene(&t, &g);
+    dt_tape *tp = rt_tape(&t, root);
+    dt_instr *buf = malloc((size_t)tp->ncode * sizeof *buf);
+    for (int k = 0; k < 20; k++) {
+      double o[3] = {rng_range(&g, -2, 2), rng_range(&g, -2, 2),
+                     rng_range(&g, -2, 2)};
+      double d[3] = {rng_range(&g, -1, 1), rng_range(&g, -1, 1),
+                     rng_range(&g, -1, 1)};
+      double s0 = rng_range(&g, 0, 3), s1 = s0 + rng_range(&g, 0, 0.5);
+      dt_tape view;
+      int nv = dt_prune_ray(tp, o, d, s0, s1, buf, &view);
+      if (nv > tp->ncode || nv < 1) bad++;
+      if (nv < tp->ncode) shrunk++;
+      for (int j = 0; j <= 10; j++) {
+        double s = s0 + (s1 - s0) * j / 10, d1, d2;
+        double a = dt_density_ray(tp, o, d, s, &d1);
+        double c = dt_density_ray(&view, o, d, s, &d2);
+        if (fabs(a - c) > 1e-15 || fabs(d1 - d2) > 1e-12 * (1 + fabs(d1)))
+          bad++;
+      }
+    }
+    free(buf);
+    dt_tape_free(tp);
+  }
+  CHECK("pruned views agree with the full tape on their segment", bad == 0);
+  CHECK("pruning shortens most views", shrunk > 400);
+}
+
+int main(void) {
+  check_prefix = "density";
+  test_paper_values();
+  test_random_points();
+  test_gradients();
+  test_displacement();
+  test_radius_scales();
+  test_shifted();
+  test_max_bound();
+  test_builder_errors();
+  test_sharp_leaves();
+  test_deep_chain();
+  test_prune();
+  CHECK_DONE();
+}
