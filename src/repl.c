@@ -435,6 +435,46 @@ static void feed_line(Repl *R, const char *line) {
   submit(R, MODE_REPL);
 }
 
+/* Does any line of text start with ':' (a command) in column 1? */
+static int has_command_line(const char *text) {
+  for (const char *s = text; s; s = strchr(s, '\n'), s = s ? s + 1 : s)
+    if (*s == ':') return 1;
+  return 0;
+}
+
+/* What readline returns: one line, or several when text was pasted (with
+   bracketed paste the newlines stay in the line). A paste of plain code
+   at the top level is run as a script, like a ':{ ... :}' block, so that
+   it means what it meant in the file it came from; otherwise its lines
+   are fed one by one, as if typed. */
+static void feed_text(Repl *R, const char *text) {
+  if (!strchr(text, '\n')) {
+    feed_line(R, text);
+    return;
+  }
+  if (!R->in_block && R->pending.len == 0 && !has_command_line(text)) {
+    for (const char *s = text; (s = strchr(s, '\n')) != NULL; s++)
+      R->line_no++;
+    R->line_no++;
+    if (!is_blank_text(text)) {
+      buf_add(&R->pending, text, strlen(text));
+      submit(R, MODE_SCRIPT);
+    }
+    reset_entry(R);
+    return;
+  }
+  Buf line = {0};
+  for (const char *s = text; s;) {
+    const char *nl = strchr(s, '\n');
+    size_t n = nl ? (size_t)(nl - s) : strlen(s);
+    buf_clear(&line);
+    buf_add(&line, s, n);
+    feed_line(R, line.s);
+    s = nl ? nl + 1 : NULL;
+  }
+  free(line.s);
+}
+
 /* End of input with an entry still open. */
 static void feed_eof(Repl *R) {
   if (R->in_block) {
@@ -703,7 +743,7 @@ static int run_terminal(Repl *R) {
       break;
     }
     history_note(R, line);
-    feed_line(R, line);
+    feed_text(R, line);
     free(line);
   }
   feed_eof(R);

@@ -8,7 +8,7 @@ QCS=${QCS:-./qcs}
 case $QCS in /*) ;; *) QCS=$PWD/$QCS ;; esac
 
 TMUX_CHECKS="repl-prompt repl-expression repl-definition repl-error-keeps-defs
-repl-continuation repl-ctrl-c-eval repl-ctrl-c-prompt repl-tab-name
+repl-continuation repl-paste repl-ctrl-c-eval repl-ctrl-c-prompt repl-tab-name
 repl-tab-command repl-tab-file repl-browse repl-unknown-command repl-history-live
 repl-ctrl-d repl-history-file"
 
@@ -130,6 +130,12 @@ else fail repl-error-keeps-defs "$(why 'no error for f 1 2 3, or f 5 not 10 afte
 if enter '^\.\.\.> ' 'g x =' && enter '^qcs> ' 'x + 1' && enter '^2$' 'g 1'; then
   ok repl-continuation
 else fail repl-continuation "$(why 'g x = / x + 1 / g 1 did not show 2')"; fi
+
+# A multi-line paste (bracketed) runs as a script, items in column 1.
+T set-buffer "$(printf 'pa = 50\npb = 61\npa + pb')"
+T paste-buffer -p -t qcs
+if enter '^111$' ''; then ok repl-paste
+else fail repl-paste "$(why 'pasted definitions and pa + pb did not show 111')"; fi
 
 # Ctrl-C while an infinite evaluation runs; the sleep lets it start.
 n=$(count '^qcs> ')
