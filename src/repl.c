@@ -437,9 +437,10 @@ static void feed_line(Repl *R, const char *line) {
 
 /* Does any line of text start with ':' (a command) in column 1? */
 static int has_command_line(const char *text) {
-  for (const char *s = text; s; s = strchr(s, '\n'), s = s ? s + 1 : s)
+  for (const char *s = text;; s++) {
     if (*s == ':') return 1;
-  return 0;
+    if ((s = strchr(s, '\n')) == NULL) return 0;
+  }
 }
 
 /* What readline returns: one line, or several when text was pasted (with
