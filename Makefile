@@ -1,0 +1,109 @@
+# qcs: a scene language for rounded polyhedra and soft objects.
+#
+#   make            build ./qcs
+#   make demo       install what is missing, build, run the bundled example
+#   make test       install what is missing, build, run every test suite
+#   make sanitize   the test suite under ASan + UBSan (clang)
+#   make install    PREFIX=/usr/local DESTDIR=
+#
+# System packages are installed through apt-get when make runs as root and
+# something is missing; otherwise the missing packages are named.
+
+CC      ?= cc
+PREFIX  ?= /usr/local
+DESTDIR ?=
+BUILD   ?= build
+OPT     ?= -O2
+
+# Debian packages the build and the tests need.
+DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
+            libmpfr-dev libgmp-dev tmux
+PC_PKGS  := readline bdw-gc libpng OpenEXR
+
+WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
+          -Wmissing-prototypes -Wno-unused-parameter
+PKG_CFLAGS = $(shell pkg-config --cflags $(PC_PKGS) 2>/dev/null)
+PKG_LIBS   = $(shell pkg-config --libs $(PC_PKGS) 2>/dev/null)
+CFLAGS  ?= $(OPT) -g
+ALL_CFLAGS = -std=c11 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -DGC_THREADS \
+             $(WARN) $(CFLAGS) $(PKG_CFLAGS) -MMD -MP -Isrc -I$(BUILD)
+LIBS    = $(PKG_LIBS) -lm -lpthread
+
+SRCS    := $(sort $(wildcard src/*.c))
+OBJS    := $(SRCS:src/%.c=$(BUILD)/%.o)
+LIBOBJS := $(filter-out $(BUILD)/main.o,$(OBJS))
+UNIT_SRCS := $(sort $(wildcard tests/unit/test_*.c))
+UNIT_BINS := $(UNIT_SRCS:tests/unit/%.c=$(BUILD)/tests/%)
+
+.PHONY: all units deps demo test check sanitize install uninstall clean bench
+
+BIN ?= qcs
+
+all: $(BIN)
+
+$(BIN): $(OBJS)
+	$(CC) $(ALL_CFLAGS) -o $@ $(OBJS) $(LIBS)
+
+units: $(UNIT_BINS)
+
+$(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc
+	@mkdir -p $(BUILD)
+	$(CC) $(ALL_CFLAGS) -c -o $@ $<
+
+# The prelude is qcs source, embedded in the binary as a C string.
+$(BUILD)/prelude.inc: stdlib/prelude.qcs tools/embed.sh
+	@mkdir -p $(BUILD)
+	sh tools/embed.sh qcs_prelude_source < $< > $@.tmp && mv $@.tmp $@
+
+$(BUILD)/tests/%: tests/unit/%.c $(LIBOBJS) tests/unit/check.h
+	@mkdir -p $(BUILD)/tests
+	$(CC) $(ALL_CFLAGS) -Itests/unit -o $@ $< $(LIBOBJS) $(LIBS) -lmpfr -lgmp
+
+# deps: install (as root) or name the missing Debian packages.
+deps:
+	@missing=""; for p in $(DEB_PKGS); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "installing:$$missing"; \
+	    (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing) >/dev/null || \
+	      { echo "error: apt-get could not install:$$missing" >&2; exit 1; }; \
+	  else \
+	    echo "error: missing Debian packages:$$missing" >&2; \
+	    echo "       run 'sudo apt-get install$$missing' or run make as root" >&2; exit 1; \
+	  fi; \
+	fi
+
+demo: deps
+	$(MAKE) qcs
+	./qcs examples/demo.qcs
+
+test: deps
+	@$(MAKE) -s $(BIN) units
+	@sh tests/run-all.sh
+
+check: test
+
+SAN_FLAGS := -g -fsanitize=address,undefined -fno-sanitize-recover=all
+sanitize: deps
+	@$(MAKE) -s BUILD=build-san BIN=build-san/qcs CC=clang \
+	  OPT="-O1 -fno-omit-frame-pointer" CFLAGS="$(SAN_FLAGS)" build-san/qcs units
+	@QCS=build-san/qcs QCS_UNIT_DIR=build-san/tests \
+	  ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 sh tests/run-all.sh
+
+install: qcs
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/qcs \
+	  $(DESTDIR)$(PREFIX)/share/man/man1
+	install -m 755 qcs $(DESTDIR)$(PREFIX)/bin/qcs
+	install -m 644 stdlib/prelude.qcs $(DESTDIR)$(PREFIX)/share/qcs/prelude.qcs
+	install -m 644 doc/qcs.1 $(DESTDIR)$(PREFIX)/share/man/man1/qcs.1
+
+uninstall:
+	rm -f $(DESTDIR)$(PREFIX)/bin/qcs $(DESTDIR)$(PREFIX)/share/man/man1/qcs.1
+	rm -rf $(DESTDIR)$(PREFIX)/share/qcs
+
+clean:
+	rm -rf $(BUILD) build-san qcs
+
+-include $(OBJS:.o=.d)

@@ -1,0 +1,119 @@
+/* error.c: positioned errors, the handler chain, and error display. */
+#include "error.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+const Pos pos_none = {NULL, 0, 0};
+
+static _Thread_local ErrFrame *err_top;
+static _Thread_local ErrInfo err_current;
+
+ErrInfo *err_info(void) { return &err_current; }
+
+void err_push(ErrFrame *f) {
+  f->prev = err_top;
+  err_top = f;
+}
+
+void err_pop(ErrFrame *f) {
+  if (err_top == f) err_top = f->prev;
+}
+
+static _Noreturn void err_throw(void) {
+  ErrFrame *f = err_top;
+  if (!f) {
+    err_report(stderr, "error", err_current.pos, err_current.msg);
+    exit(1);
+  }
+  err_top = f->prev;
+  longjmp(f->jb, 1);
+}
+
+_Noreturn void qcs_verror(Pos pos, const char *fmt, va_list ap) {
+  err_current.pos = pos;
+  err_current.incomplete = 0;
+  err_current.trace[0] = 0;
+  vsnprintf(err_current.msg, sizeof err_current.msg, fmt, ap);
+  err_throw();
+}
+
+_Noreturn void qcs_error(Pos pos, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  qcs_verror(pos, fmt, ap);
+}
+
+_Noreturn void qcs_error_incomplete(Pos pos, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  err_current.pos = pos;
+  err_current.trace[0] = 0;
+  vsnprintf(err_current.msg, sizeof err_current.msg, fmt, ap);
+  va_end(ap);
+  err_current.incomplete = 1;
+  err_throw();
+}
+
+/* The text of line `line` of src, without its newline. */
+static const char *line_start(const Src *src, int line, int *len) {
+  const char *p = src->text;
+  for (int l = 1; l < line && *p; p++)
+    if (*p == '\n') l++;
+  const char *e = p;
+  while (*e && *e != '\n') e++;
+  *len = (int)(e - p);
+  return p;
+}
+
+void err_report(FILE *out, const char *kind, Pos pos, const char *msg) {
+  if (pos.src && pos.line > 0) {
+    fprintf(out, "%s:%d:%d: %s: %s\n", pos.src->name, pos.line, pos.col, kind,
+            msg);
+    if (pos.src->text) {
+      int len;
+      const char *l = line_start(pos.src, pos.line, &len);
+      if (len > 200) len = 200;
+      fprintf(out, "  %.*s\n  ", len, l);
+      /* The caret under the column, keeping the line's own tabs. */
+      int col = 1;
+      for (int i = 0; i < len && col < pos.col; i++) {
+        if (l[i] == '\t') {
+          fputc('\t', out);
+          col = ((col - 1) / 8 + 1) * 8 + 1;
+        } else {
+          fputc(' ', out);
+          col++;
+        }
+      }
+      fputs("^\n", out);
+    }
+  } else {
+    fprintf(out, "qcs: %s: %s\n", kind, msg);
+  }
+}
+
+void qcs_warning(Pos pos, const char *fmt, ...) {
+  char buf[1024];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  err_report(stderr, "warning", pos, buf);
+}
+
+int edit_distance(const char *a, const char *b) {
+  size_t la = strlen(a), lb = strlen(b);
+  if (la > 64 || lb > 64) return 99;
+  int d[65][65];
+  for (size_t i = 0; i <= la; i++) d[i][0] = (int)i;
+  for (size_t j = 0; j <= lb; j++) d[0][j] = (int)j;
+  for (size_t i = 1; i <= la; i++)
+    for (size_t j = 1; j <= lb; j++) {
+      int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+      if (d[i - 1][j] + 1 < c) c = d[i - 1][j] + 1;
+      if (d[i][j - 1] + 1 < c) c = d[i][j - 1] + 1;
+      d[i][j] = c;
+    }
+  return d[la][lb];
+}

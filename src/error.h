@@ -1,0 +1,67 @@
+/* error.h: source positions and the one way errors leave the interpreter.
+ *
+ * Every token, AST node and scene node carries a Pos, so an error found
+ * late (while evaluating, while compiling a scene) still points at the
+ * source. qcs_error() formats the message and longjmps to the innermost
+ * handler (one per script item or REPL entry, set with ERR_TRY); the
+ * handler prints it with the source line and a caret. Memory touched
+ * before the jump belongs to the garbage-collected heap, so nothing leaks.
+ * The handler chain is thread-local: each interpreter thread has its own. */
+#ifndef QCS_ERROR_H
+#define QCS_ERROR_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stdio.h>
+
+/* A source text: a file, a REPL entry, the prelude, a -e expression. */
+typedef struct Src {
+  const char *name;
+  const char *text;
+} Src;
+
+typedef struct Pos {
+  const Src *src;
+  int line, col;  /* 1-based; line 0 means "no position" */
+} Pos;
+
+extern const Pos pos_none;
+
+typedef struct ErrFrame {
+  jmp_buf jb;
+  struct ErrFrame *prev;
+} ErrFrame;
+
+typedef struct ErrInfo {
+  Pos pos;
+  char msg[1024];
+  int incomplete;     /* the parser ran into the end of the text */
+  char trace[2048];   /* call trace lines, filled in by the evaluator */
+} ErrInfo;
+
+/* The error that the innermost handler catches. */
+ErrInfo *err_info(void);
+void err_push(ErrFrame *f);
+void err_pop(ErrFrame *f);
+
+/* ERR_TRY(f) { body } else { handle: err_info() holds the error } ; the
+   frame is popped in both branches by the macro's caller via err_pop. */
+#define ERR_TRY(f) (err_push(&(f)), setjmp((f).jb) == 0)
+
+_Noreturn void qcs_error(Pos pos, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+_Noreturn void qcs_verror(Pos pos, const char *fmt, va_list ap);
+/* Like qcs_error, but marks the error as "more input would help". */
+_Noreturn void qcs_error_incomplete(Pos pos, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+/* Print "NAME:LINE:COL: KIND: MSG", the source line and a caret. */
+void err_report(FILE *out, const char *kind, Pos pos, const char *msg);
+/* A warning at a position, printed at once to stderr. */
+void qcs_warning(Pos pos, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+/* Levenshtein distance, for "did you mean" suggestions. */
+int edit_distance(const char *a, const char *b);
+
+#endif

@@ -1,0 +1,525 @@
+/* interp.c: running source text. See interp.h.
+ *
+ * A run parses the whole text first (a syntax error runs nothing), checks
+ * every name it uses (an unknown name is reported before anything is
+ * evaluated, with a suggestion), installs the definitions, and then
+ * evaluates the top-level expressions in order. */
+#include "interp.h"
+
+#include <errno.h>
+#include <gc.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "builtins.h"
+#include "eval.h"
+#include "parse.h"
+#include "print.h"
+
+#include "prelude.inc"
+
+#ifndef QCS_VERSION
+#define QCS_VERSION "0.1"
+#endif
+
+static int run_counter;
+
+/* ---- error display ---- */
+
+static void report_error(Interp *I) {
+  ErrInfo *e = err_info();
+  err_report(stderr, "error", e->pos, e->msg);
+  int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
+  int shown = 0;
+  for (int i = n - 1; i >= 0 && shown < 6; i--, shown++) {
+    TraceEntry *t = &I->trace[i];
+    if (t->pos.src && t->pos.line)
+      fprintf(stderr, "  in %s, called at %s:%d:%d\n", t->name,
+              t->pos.src->name, t->pos.line, t->pos.col);
+    else
+      fprintf(stderr, "  in %s\n", t->name);
+  }
+  if (n > shown) fprintf(stderr, "  ... and %d more calls\n", n - shown);
+}
+
+/* Put back every thunk that was being forced when the error struck, so
+   a later evaluation retries it instead of seeing a false loop. */
+static void unwind(Interp *I, int nforcing) {
+  while (I->nforcing > nforcing) {
+    I->nforcing--;
+    *I->forcing[I->nforcing].v = I->forcing[I->nforcing].saved;
+  }
+  I->ntrace = 0;
+  qcs_interrupted = 0;
+}
+
+/* ---- the static check ---- */
+
+typedef struct Scope {
+  struct Scope *up;
+  int n, cap;
+  Sym **names;
+} Scope;
+
+typedef struct Check {
+  Interp *I;
+  Item **items;
+  int nitems;
+} Check;
+
+static void scope_add(Scope *s, Sym *name) {
+  if (s->n == s->cap) {
+    s->cap = s->cap ? 2 * s->cap : 8;
+    Sym **a = GC_MALLOC(sizeof(Sym *) * (size_t)s->cap);
+    if (s->n) memcpy(a, s->names, sizeof(Sym *) * (size_t)s->n);
+    s->names = a;
+  }
+  s->names[s->n++] = name;
+}
+
+static void pat_scope(Check *C, Pat *p, Scope *s) {
+  switch (p->kind) {
+  case P_VAR: scope_add(s, p->u.var); break;
+  case P_CON:
+    if (p->u.con.con->con_arity < 0) {
+      qcs_error(p->pos, "'%s' in a pattern is not a constructor",
+                p->u.con.con->name);
+    }
+    if (p->u.con.con->con_arity != p->u.con.n)
+      qcs_error(p->pos, "constructor %s takes %d argument%s, this pattern "
+                "gives %d", p->u.con.con->name, p->u.con.con->con_arity,
+                p->u.con.con->con_arity == 1 ? "" : "s", p->u.con.n);
+    for (int i = 0; i < p->u.con.n; i++) pat_scope(C, p->u.con.args[i], s);
+    break;
+  case P_TUPLE: case P_LIST:
+    for (int i = 0; i < p->u.tuple.n; i++) pat_scope(C, p->u.tuple.items[i], s);
+    break;
+  case P_CONS:
+    pat_scope(C, p->u.cons.head, s);
+    pat_scope(C, p->u.cons.tail, s);
+    break;
+  default: break;
+  }
+}
+
+static int defined_in_batch(Check *C, Sym *s) {
+  for (int i = 0; i < C->nitems; i++)
+    if (C->items[i]->kind == ITEM_DEF && C->items[i]->def->name == s) return 1;
+  return 0;
+}
+
+static _Noreturn void check_unknown(Check *C, Sym *s, Scope *sc, Pos pos) {
+  const char *best = NULL;
+  int bestd = s->name[1] ? 3 : 1;
+  for (Scope *x = sc; x; x = x->up)
+    for (int i = 0; i < x->n; i++) {
+      int d = edit_distance(s->name, x->names[i]->name);
+      if (d < bestd && x->names[i]->name[0] != '%')
+        bestd = d, best = x->names[i]->name;
+    }
+  for (int i = 0; i < C->nitems; i++)
+    if (C->items[i]->kind == ITEM_DEF && C->items[i]->def->name) {
+      int d = edit_distance(s->name, C->items[i]->def->name->name);
+      if (d < bestd) bestd = d, best = C->items[i]->def->name->name;
+    }
+  Interp *I = C->I;
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *g = I->symtab[h]; g; g = g->next)
+      if ((g->global || g->con_arity >= 0) && g->name[0] != '%') {
+        int d = edit_distance(s->name, g->name);
+        if (d < bestd) bestd = d, best = g->name;
+      }
+  if (best) qcs_error(pos, "unknown name '%s' (did you mean '%s'?)", s->name, best);
+  qcs_error(pos, "unknown name '%s'", s->name);
+}
+
+static void check_expr(Check *C, Expr *e, Scope *sc);
+static void check_defs(Check *C, int n, Def **defs, Scope *sc);
+
+static void check_var(Check *C, Sym *s, Scope *sc, Pos pos) {
+  for (Scope *x = sc; x; x = x->up)
+    for (int i = 0; i < x->n; i++)
+      if (x->names[i] == s) return;
+  if (s->con_arity >= 0 || s->global || defined_in_batch(C, s)) return;
+  check_unknown(C, s, sc, pos);
+}
+
+static void check_def(Check *C, Def *d, Scope *sc) {
+  for (int c = 0; c < d->nclauses; c++) {
+    Clause *cl = d->clauses[c];
+    Scope s = {sc, 0, 0, NULL};
+    for (int i = 0; i < cl->npats; i++) pat_scope(C, cl->pats[i], &s);
+    if (cl->nwhere) {
+      for (int i = 0; i < cl->nwhere; i++) {
+        Def *w = cl->where[i];
+        if (w->pat) pat_scope(C, w->pat, &s);
+        else scope_add(&s, w->name);
+      }
+      check_defs(C, cl->nwhere, cl->where, &s);
+    }
+    for (int b = 0; b < cl->nbodies; b++) {
+      if (cl->guards[b]) check_expr(C, cl->guards[b], &s);
+      check_expr(C, cl->bodies[b], &s);
+    }
+  }
+}
+
+static void check_defs(Check *C, int n, Def **defs, Scope *sc) {
+  for (int i = 0; i < n; i++) check_def(C, defs[i], sc);
+}
+
+static void check_expr(Check *C, Expr *e, Scope *sc) {
+  char probe;
+  if ((size_t)(C->I->stack_base - &probe) > C->I->stack_limit)
+    qcs_error(e->pos, "expression nested too deeply");
+  switch (e->kind) {
+  case E_VAR: check_var(C, e->u.var, sc, e->pos); break;
+  case E_WILD: qcs_error(e->pos, "'_' stands only in patterns");
+  case E_APP:
+    check_expr(C, e->u.app.fn, sc);
+    for (int i = 0; i < e->u.app.n; i++) check_expr(C, e->u.app.args[i], sc);
+    break;
+  case E_LAMBDA: check_def(C, e->u.lambda, sc); break;
+  case E_LET: {
+    Scope s = {sc, 0, 0, NULL};
+    for (int i = 0; i < e->u.let.n; i++) {
+      Def *w = e->u.let.defs[i];
+      if (w->pat) pat_scope(C, w->pat, &s);
+      else scope_add(&s, w->name);
+    }
+    check_defs(C, e->u.let.n, e->u.let.defs, &s);
+    check_expr(C, e->u.let.body, &s);
+    break;
+  }
+  case E_IF:
+    check_expr(C, e->u.cond.c, sc);
+    check_expr(C, e->u.cond.t, sc);
+    check_expr(C, e->u.cond.f, sc);
+    break;
+  case E_TUPLE: case E_LIST:
+    for (int i = 0; i < e->u.tuple.n; i++) check_expr(C, e->u.tuple.items[i], sc);
+    break;
+  case E_RANGE:
+    check_expr(C, e->u.range.from, sc);
+    if (e->u.range.then) check_expr(C, e->u.range.then, sc);
+    if (e->u.range.to) check_expr(C, e->u.range.to, sc);
+    break;
+  case E_BINOP:
+    check_expr(C, e->u.bin.a, sc);
+    check_expr(C, e->u.bin.b, sc);
+    break;
+  case E_NEG: check_expr(C, e->u.neg, sc); break;
+  case E_DEFBODY: check_def(C, e->u.def, sc); break;
+  default: break;
+  }
+}
+
+/* ---- running ---- */
+
+static void install_type(Interp *I, Item *it) {
+  for (int i = 0; i < it->ncons; i++) {
+    Sym *s = it->cons[i].name;
+    s->con_arity = it->cons[i].arity;
+    s->con_type = it->type;
+    s->con_value = NULL;
+    s->global = NULL;
+    s->def = NULL;
+    s->user = !I->loading_prelude;
+    s->def_pos = it->cons[i].pos;
+  }
+}
+
+/* Re-create every user-defined value from its definition, so that values
+   computed from a definition the REPL has just replaced are computed
+   again (a scene follows its parameters). */
+static void refresh_values(Interp *I) {
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next)
+      if (s->user && s->def && s->def->arity == 0 && !s->overridden)
+        s->global = eval_global_value(I, s->def);
+}
+
+static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
+                           const char *runname) {
+  int runid = ++run_counter;
+  Check C = {I, items, n};
+  /* Duplicate definitions within one script are mistakes. */
+  for (int i = 0; i < n; i++) {
+    if (items[i]->kind != ITEM_DEF) continue;
+    Def *d = items[i]->def;
+    for (int j = 0; j < i; j++)
+      if (items[j]->kind == ITEM_DEF && items[j]->def->name == d->name)
+        qcs_error(d->pos, "%s is already defined at %d:%d (the clauses of a "
+                  "function must be together)", d->name->name,
+                  items[j]->def->pos.line, items[j]->def->pos.col);
+  }
+  for (int i = 0; i < n; i++)
+    if (items[i]->kind == ITEM_TYPE) install_type(I, items[i]);
+  for (int i = 0; i < n; i++) {
+    if (items[i]->kind == ITEM_DEF) {
+      Def *d = items[i]->def;
+      Scope top = {NULL, 0, 0, NULL};
+      check_def(&C, d, &top);
+    } else if (items[i]->kind == ITEM_EXPR) {
+      check_expr(&C, items[i]->expr, NULL);
+    }
+  }
+  int redefined = 0;
+  for (int i = 0; i < n; i++) {
+    Item *it = items[i];
+    if (it->kind == ITEM_SIG) {
+      it->signame->sig = it->sigtext;
+    } else if (it->kind == ITEM_DEF) {
+      Sym *s = it->def->name;
+      if (s->overridden) continue;
+      if (s->def && s->user) redefined = 1;
+      s->def = it->def;
+      s->global = eval_global_value(I, it->def);
+      s->user = !I->loading_prelude;
+      s->def_pos = it->def->pos;
+      s->def_file = runname;
+      (void)runid;
+    }
+  }
+  if (redefined && mode == MODE_REPL) refresh_values(I);
+  for (int i = 0; i < n; i++) {
+    if (items[i]->kind != ITEM_EXPR) continue;
+    Value *v = eval(I, items[i]->expr, NULL);
+    print_value(I, stdout, v);
+    fputc('\n', stdout);
+    fflush(stdout);
+  }
+  return RUN_OK;
+}
+
+RunStatus interp_run_string(Interp *I, const char *name, const char *text,
+                            RunMode mode) {
+  Src *src = GC_MALLOC(sizeof *src);
+  char *nm = GC_MALLOC_ATOMIC(strlen(name) + 1);
+  strcpy(nm, name);
+  size_t len = strlen(text);
+  char *tx = GC_MALLOC_ATOMIC(len + 1);
+  memcpy(tx, text, len + 1);
+  src->name = nm;
+  src->text = tx;
+  int nforcing = I->nforcing;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    int n;
+    Item **items = parse_program(I, src, mode, &n);
+    RunStatus st = run_items(I, items, n, mode, nm);
+    err_pop(&f);
+    return st;
+  }
+  err_pop(&f);
+  fflush(stdout);
+  if (err_info()->incomplete && mode == MODE_REPL) {
+    unwind(I, nforcing);
+    return RUN_INCOMPLETE;
+  }
+  report_error(I);
+  unwind(I, nforcing);
+  return RUN_ERROR;
+}
+
+/* Reads a whole file; NULL with errno set on failure. */
+static char *read_file(const char *path, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  size_t cap = 4096, n = 0;
+  char *buf = malloc(cap);
+  for (;;) {
+    if (n + 1 >= cap) {
+      char *nb = realloc(buf, cap *= 2);
+      if (!nb) {
+        free(buf);
+        fclose(f);
+        errno = ENOMEM;
+        return NULL;
+      }
+      buf = nb;
+    }
+    size_t r = fread(buf + n, 1, cap - n - 1, f);
+    n += r;
+    if (r == 0) break;
+  }
+  int err = ferror(f);
+  fclose(f);
+  if (err) {
+    free(buf);
+    errno = EIO;
+    return NULL;
+  }
+  buf[n] = 0;
+  *len = n;
+  return buf;
+}
+
+RunStatus interp_run_file(Interp *I, const char *path) {
+  size_t len;
+  char *text = read_file(path, &len);
+  if (!text) {
+    fprintf(stderr, "qcs: error: cannot read %s: %s\n", path, strerror(errno));
+    return RUN_ERROR;
+  }
+  /* A NUL byte would silently end the text: say where it is. */
+  size_t nul = strlen(text);
+  if (nul < len) {
+    int line = 1, col = 1;
+    for (size_t i = 0; i < nul; i++) {
+      if (text[i] == '\n') line++, col = 1;
+      else col++;
+    }
+    fprintf(stderr, "%s:%d:%d: error: NUL byte in source\n", path, line, col);
+    free(text);
+    return RUN_ERROR;
+  }
+  RunStatus st = interp_run_string(I, path, text, MODE_SCRIPT);
+  free(text);
+  return st;
+}
+
+RunStatus interp_eval_print(Interp *I, const char *text) {
+  Src *src = GC_MALLOC(sizeof *src);
+  src->name = "<-e>";
+  char *tx = GC_MALLOC_ATOMIC(strlen(text) + 1);
+  strcpy(tx, text);
+  src->text = tx;
+  int nforcing = I->nforcing;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    int n;
+    Item **items = parse_program(I, src, MODE_REPL, &n);
+    RunStatus st = run_items(I, items, n, MODE_REPL, "<-e>");
+    err_pop(&f);
+    return st;
+  }
+  err_pop(&f);
+  fflush(stdout);
+  report_error(I);
+  unwind(I, nforcing);
+  return RUN_ERROR;
+}
+
+RunStatus interp_set_override(Interp *I, const char *name, const char *expr) {
+  Src *src = GC_MALLOC(sizeof *src);
+  char *nm = GC_MALLOC_ATOMIC(strlen(name) + 16);
+  snprintf(nm, strlen(name) + 16, "--set %s", name);
+  src->name = nm;
+  char *tx = GC_MALLOC_ATOMIC(strlen(expr) + 1);
+  strcpy(tx, expr);
+  src->text = tx;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    const char *p = name;
+    int ok = *p && ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z'));
+    for (; *p && ok; p++)
+      ok = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') ||
+           (*p >= '0' && *p <= '9') || *p == '_' || *p == '\'';
+    if (!ok) qcs_error(pos_none, "--set needs NAME=VALUE with a plain name, "
+                       "not '%s'", name);
+    Expr *e = parse_expression(I, src);
+    Check C = {I, NULL, 0};
+    check_expr(&C, e, NULL);
+    Sym *s = sym_intern(I, name, (int)strlen(name));
+    if (s->con_arity >= 0)
+      qcs_error(pos_none, "--set cannot replace the constructor %s", name);
+    s->global = delay(I, e, NULL);
+    s->overridden = 1;
+    s->user = 1;
+    err_pop(&f);
+    return RUN_OK;
+  }
+  err_pop(&f);
+  report_error(I);
+  return RUN_ERROR;
+}
+
+/* ---- completion and browsing ---- */
+
+void interp_complete(Interp *I, const char *prefix,
+                     void (*emit)(const char *name, void *ud), void *ud) {
+  size_t len = strlen(prefix);
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next)
+      if ((s->global || s->con_arity >= 0) && s->name[0] != '%' &&
+          !strncmp(s->name, prefix, len))
+        emit(s->name, ud);
+}
+
+static int cmp_sym(const void *a, const void *b) {
+  return strcmp((*(Sym *const *)a)->name, (*(Sym *const *)b)->name);
+}
+
+void interp_browse(Interp *I, FILE *out, int all) {
+  Sym **list = GC_MALLOC(sizeof(Sym *) * (I->nsyms + 1));
+  size_t n = 0;
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next)
+      if ((s->global || s->con_arity >= 0) && s->name[0] != '%' &&
+          (all || s->user))
+        list[n++] = s;
+  qsort(list, n, sizeof *list, cmp_sym);
+  for (size_t i = 0; i < n; i++) {
+    Sym *s = list[i];
+    if (s->con_arity >= 0) {
+      fprintf(out, "%s  -- constructor of %s, %d argument%s\n", s->name,
+              s->con_type ? s->con_type->name : "?", s->con_arity,
+              s->con_arity == 1 ? "" : "s");
+    } else if (s->sig) {
+      fprintf(out, "%s :: %s\n", s->name, s->sig);
+    } else if (s->def) {
+      fprintf(out, "%s  -- %d argument%s, defined at %s:%d\n", s->name,
+              s->def->arity, s->def->arity == 1 ? "" : "s",
+              s->def_pos.src ? s->def_pos.src->name : "?", s->def_pos.line);
+    } else {
+      fprintf(out, "%s\n", s->name);
+    }
+  }
+}
+
+void interp_request_interrupt(void) { qcs_interrupted = 1; }
+void interp_clear_interrupt(void) { qcs_interrupted = 0; }
+
+/* ---- start-up ---- */
+
+Interp *interp_new(void) {
+  static int gc_ready;
+  if (!gc_ready) {
+    GC_INIT();
+    gc_ready = 1;
+  }
+  Interp *I = GC_MALLOC_UNCOLLECTABLE(sizeof *I);
+  char probe;
+  I->stack_base = &probe;
+  I->stack_limit = 6u << 20;
+  I->v_true = GC_MALLOC(sizeof(Value));
+  I->v_true->kind = V_BOOL;
+  I->v_true->u.b = 1;
+  I->v_false = GC_MALLOC(sizeof(Value));
+  I->v_false->kind = V_BOOL;
+  I->v_nil = GC_MALLOC(sizeof(Value));
+  I->v_nil->kind = V_NIL;
+  builtins_install(I);
+  I->loading_prelude = 1;
+  RunStatus st = interp_run_string(I, "<prelude>", qcs_prelude_source,
+                                   MODE_SCRIPT);
+  I->loading_prelude = 0;
+  if (st != RUN_OK) {
+    fprintf(stderr, "qcs: internal error: the prelude does not load\n");
+    exit(2);
+  }
+  return I;
+}
+
+void interp_set_stack(Interp *I, char *base, size_t limit) {
+  I->stack_base = base;
+  I->stack_limit = limit;
+}
+
+void interp_set_max_steps(Interp *I, unsigned long long steps) {
+  I->max_steps = steps;
+  I->steps = 0;
+}
+
+const char *interp_version(void) { return QCS_VERSION; }

@@ -1,0 +1,79 @@
+/* interp.h: one qcs interpreter, the face the front end (main, repl) sees.
+ *
+ * An Interp holds the global environment (the prelude's definitions and the
+ * user's) and runs source text: definitions are added, and every top-level
+ * expression that is not a definition is evaluated and printed on stdout in
+ * the language's own syntax. Errors go to stderr as
+ * "FILE:LINE:COL: error: MESSAGE", the source line and a caret, and a short
+ * call trace; an error abandons the current item but never the definitions
+ * made before it.
+ *
+ * Memory: values, ASTs and source texts live in the garbage-collected heap
+ * (Boehm GC); nothing handed out here needs freeing by the caller. */
+#ifndef QCS_INTERP_H
+#define QCS_INTERP_H
+
+#include <stdio.h>
+
+typedef struct Interp Interp;
+
+typedef enum {
+  RUN_OK = 0,         /* everything ran */
+  RUN_ERROR = 1,      /* an error was reported on stderr */
+  RUN_INCOMPLETE = 2  /* REPL mode only: the text ends inside an unfinished
+                         item (open bracket, trailing operator, ...); nothing
+                         was run, the caller should read more lines */
+} RunStatus;
+
+typedef enum {
+  MODE_SCRIPT, /* a file: items end at ';' or at a line starting in column 1;
+                  the whole file is checked and run in order, stopping at the
+                  first error */
+  MODE_REPL    /* one REPL entry: items end at ';' or at the end of the text */
+} RunMode;
+
+/* A new interpreter with the prelude loaded. Calls GC_INIT on first use. */
+Interp *interp_new(void);
+
+/* Run source text; name is used in error positions ("<stdin>", a path). */
+RunStatus interp_run_string(Interp *I, const char *name, const char *text,
+                            RunMode mode);
+
+/* Read and run a file as a script (MODE_SCRIPT). A missing or unreadable
+   file is an error reported with the path. */
+RunStatus interp_run_file(Interp *I, const char *path);
+
+/* Evaluate one expression given as text and print its value (qcs -e). */
+RunStatus interp_eval_print(Interp *I, const char *text);
+
+/* Replace (or add) the top-level definition NAME = VALUE-TEXT before a
+   script runs (qcs --set NAME=VALUE). The script's own definition of NAME
+   is then ignored. */
+RunStatus interp_set_override(Interp *I, const char *name, const char *expr);
+
+/* Name completion: calls emit for every global name (prelude, builtins and
+   user definitions) that begins with prefix. */
+void interp_complete(Interp *I, const char *prefix,
+                     void (*emit)(const char *name, void *ud), void *ud);
+
+/* List the user's definitions (not the prelude's), one per line, with
+   their type signature when one was given, to out (":browse"). With
+   all != 0, list the prelude and built-ins too. */
+void interp_browse(Interp *I, FILE *out, int all);
+
+/* Where the C stack of the thread running the interpreter begins and how
+   much of it evaluation may use before "recursion too deep". */
+void interp_set_stack(Interp *I, char *base, size_t limit);
+
+/* Stop evaluations after this many steps with a clear error (0: never). */
+void interp_set_max_steps(Interp *I, unsigned long long steps);
+
+const char *interp_version(void);
+
+/* Ask a running evaluation to stop with "interrupted" at its next step.
+   Async-signal-safe: meant to be called from a SIGINT handler. */
+void interp_request_interrupt(void);
+/* Forget a pending interrupt (before starting a new REPL entry). */
+void interp_clear_interrupt(void);
+
+#endif

@@ -1,0 +1,146 @@
+/* main.c: the command line.
+ *
+ *   qcs                  the REPL
+ *   qcs FILE...          run scripts in order, stopping at the first error
+ *   qcs -e EXPR          evaluate EXPR (prelude loaded), print it, exit
+ *
+ * The interpreter runs on a thread of its own with a large stack, so that
+ * deep (non-tail) recursion in user programs is limited by a clear
+ * "recursion too deep" error rather than by the 8 MB default stack. */
+#include <gc.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "interp.h"
+#include "repl.h"
+
+#define STACK_SIZE ((size_t)1 << 30) /* reserved, touched only as used */
+#define STACK_MARGIN ((size_t)8 << 20)
+
+typedef struct Options {
+  const char *exprs[64];
+  int nexprs;
+  const char *sets[64];
+  int nsets;
+  char **files;
+  int nfiles;
+  unsigned long long max_steps;
+  int status;
+} Options;
+
+static void usage(FILE *out) {
+  fprintf(out,
+          "usage: qcs [options] [FILE...]\n"
+          "\n"
+          "  qcs                 start the REPL\n"
+          "  qcs FILE...         run scripts (top-level expressions are printed)\n"
+          "  qcs -e EXPR         evaluate EXPR with the prelude loaded and print it\n"
+          "\n"
+          "options:\n"
+          "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
+          "  --set NAME=VALUE    replace the top-level definition NAME before\n"
+          "                      the scripts run (VALUE is a qcs expression)\n"
+          "  --max-steps N       stop an evaluation after N steps\n"
+          "  -h, --help          this help\n"
+          "  -V, --version       the version\n"
+          "\n"
+          "The language is described in lang/ (lang/manual.md); `man qcs`.\n");
+}
+
+static void *run(void *arg) {
+  Options *o = arg;
+  Interp *I = interp_new();
+  char probe;
+  interp_set_stack(I, &probe, STACK_SIZE - STACK_MARGIN);
+  if (o->max_steps) interp_set_max_steps(I, o->max_steps);
+  for (int i = 0; i < o->nsets; i++) {
+    const char *eq = strchr(o->sets[i], '=');
+    char name[256];
+    size_t n = (size_t)(eq - o->sets[i]);
+    if (n >= sizeof name) n = sizeof name - 1;
+    memcpy(name, o->sets[i], n);
+    name[n] = 0;
+    if (interp_set_override(I, name, eq + 1) != RUN_OK) {
+      o->status = 1;
+      return NULL;
+    }
+  }
+  for (int i = 0; i < o->nfiles; i++)
+    if (interp_run_file(I, o->files[i]) != RUN_OK) {
+      o->status = 1;
+      return NULL;
+    }
+  for (int i = 0; i < o->nexprs; i++)
+    if (interp_eval_print(I, o->exprs[i]) != RUN_OK) {
+      o->status = 1;
+      return NULL;
+    }
+  if (o->nfiles == 0 && o->nexprs == 0) o->status = repl_run(I);
+  return NULL;
+}
+
+int main(int argc, char **argv) {
+  static Options o;
+  o.files = calloc((size_t)argc + 1, sizeof(char *));
+  for (int i = 1; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      usage(stdout);
+      return 0;
+    } else if (!strcmp(a, "-V") || !strcmp(a, "--version")) {
+      printf("qcs %s\n", interp_version());
+      return 0;
+    } else if (!strcmp(a, "-e") || !strcmp(a, "--eval")) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "qcs: error: %s needs an expression\n", a);
+        return 1;
+      }
+      if (o.nexprs == 64) {
+        fprintf(stderr, "qcs: error: too many -e options\n");
+        return 1;
+      }
+      o.exprs[o.nexprs++] = argv[++i];
+    } else if (!strcmp(a, "--set")) {
+      if (i + 1 >= argc || !strchr(argv[i + 1], '=')) {
+        fprintf(stderr, "qcs: error: --set needs NAME=VALUE\n");
+        return 1;
+      }
+      if (o.nsets == 64) {
+        fprintf(stderr, "qcs: error: too many --set options\n");
+        return 1;
+      }
+      o.sets[o.nsets++] = argv[++i];
+    } else if (!strcmp(a, "--max-steps")) {
+      char *end;
+      if (i + 1 >= argc || !(o.max_steps = strtoull(argv[i + 1], &end, 10)) ||
+          *end) {
+        fprintf(stderr, "qcs: error: --max-steps needs a positive whole "
+                "number\n");
+        return 1;
+      }
+      i++;
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "qcs: error: unknown option '%s' (see qcs --help)\n", a);
+      return 1;
+    } else {
+      o.files[o.nfiles++] = argv[i];
+    }
+  }
+  GC_INIT();
+  GC_allow_register_threads();
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, STACK_SIZE);
+  pthread_t th;
+  if (pthread_create(&th, &attr, run, &o) != 0) {
+    /* No big stack to be had: run here with the default one. */
+    run(&o);
+  } else {
+    pthread_join(th, NULL);
+  }
+  fflush(stdout);
+  return o.status;
+}

@@ -1,0 +1,262 @@
+/* print.c: printing values. See print.h. */
+#include "print.h"
+
+#include <gc.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "eval.h"
+
+void format_real(char *buf, double x) {
+  if (isnan(x)) {
+    strcpy(buf, "NaN");
+    return;
+  }
+  if (isinf(x)) {
+    strcpy(buf, x > 0 ? "Infinity" : "-Infinity");
+    return;
+  }
+  if (x == 0) {
+    strcpy(buf, signbit(x) ? "-0" : "0");
+    return;
+  }
+  /* The fewest significant digits that read back as x ... */
+  char tmp[40];
+  int prec;
+  for (prec = 1; prec <= 17; prec++) {
+    snprintf(tmp, sizeof tmp, "%.*e", prec - 1, x);
+    if (strtod(tmp, NULL) == x) break;
+  }
+  /* ... laid out as JavaScript does: plain for 1e-7 <= |x| < 1e21,
+     otherwise with an exponent ("1e-12", "1.5e300"). */
+  char digits[20];
+  int nd = 0;
+  const char *p = tmp;
+  int neg = *p == '-';
+  if (neg) p++;
+  for (; *p && *p != 'e'; p++)
+    if (*p >= '0' && *p <= '9') digits[nd++] = *p;
+  int exp10 = atoi(p + 1);
+  while (nd > 1 && digits[nd - 1] == '0') nd--;
+  digits[nd] = 0;
+  char *o = buf;
+  if (neg) *o++ = '-';
+  if (exp10 >= 21 || exp10 < -7) {
+    *o++ = digits[0];
+    if (nd > 1) {
+      *o++ = '.';
+      memcpy(o, digits + 1, (size_t)nd - 1);
+      o += nd - 1;
+    }
+    sprintf(o, "e%d", exp10);
+  } else if (exp10 >= 0) {
+    for (int i = 0; i <= exp10 || i < nd; i++) {
+      if (i == exp10 + 1) *o++ = '.';
+      *o++ = i < nd ? digits[i] : '0';
+    }
+    *o = 0;
+  } else {
+    *o++ = '0';
+    *o++ = '.';
+    for (int i = 0; i < -exp10 - 1; i++) *o++ = '0';
+    memcpy(o, digits, (size_t)nd);
+    o[nd] = 0;
+  }
+}
+
+static void print_str(FILE *out, const char *s) {
+  fputc('"', out);
+  for (; *s; s++) {
+    switch (*s) {
+    case '"': fputs("\\\"", out); break;
+    case '\\': fputs("\\\\", out); break;
+    case '\n': fputs("\\n", out); break;
+    case '\t': fputs("\\t", out); break;
+    default: fputc(*s, out);
+    }
+  }
+  fputc('"', out);
+}
+
+static int needs_parens(Value *v) {
+  return (v->kind == V_CON && v->u.con.n > 0) ||
+         (v->kind == V_NUM && (signbit(v->u.num) || isnan(v->u.num)));
+}
+
+static void print_fn(FILE *out, Value *v) {
+  if (v->kind == V_PAP) {
+    fputs("<function ", out);
+    Value *f = v->u.pap.fn;
+    if (f->kind == V_FUNC && f->u.fn.kind == F_DEF && f->u.fn.u.def->name)
+      fprintf(out, "%s", f->u.fn.u.def->name->name);
+    else if (f->kind == V_FUNC && f->u.fn.kind == F_BUILTIN)
+      fprintf(out, "%s", f->u.fn.u.bi->name);
+    else if (f->kind == V_FUNC && f->u.fn.kind == F_CON)
+      fprintf(out, "%s", f->u.fn.u.con->name);
+    else
+      fputs("lambda", out);
+    fprintf(out, " applied to %d of %d>", v->u.pap.n,
+            f->kind == V_FUNC ? f->u.fn.arity : 0);
+    return;
+  }
+  switch (v->u.fn.kind) {
+  case F_DEF:
+    fprintf(out, "<function %s/%d>",
+            v->u.fn.u.def->name ? v->u.fn.u.def->name->name : "lambda",
+            v->u.fn.arity);
+    break;
+  case F_BUILTIN:
+    fprintf(out, "<built-in %s/%d>", v->u.fn.u.bi->name, v->u.fn.arity);
+    break;
+  case F_CON:
+    fprintf(out, "<constructor %s/%d>", v->u.fn.u.con->name, v->u.fn.arity);
+    break;
+  }
+}
+
+static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
+  eval_check(I, pos_none);
+  v = force(I, v);
+  char buf[32];
+  if (parens && needs_parens(v)) {
+    fputc('(', out);
+    print_rec(I, out, v, 0);
+    fputc(')', out);
+    return;
+  }
+  switch (v->kind) {
+  case V_NUM:
+    format_real(buf, v->u.num);
+    fputs(buf, out);
+    break;
+  case V_BOOL:
+    fputs(v->u.b ? "True" : "False", out);
+    break;
+  case V_STR:
+    print_str(out, v->u.str);
+    break;
+  case V_TUPLE:
+    fputc('(', out);
+    for (int i = 0; i < v->u.tup.n; i++) {
+      if (i) fputs(", ", out);
+      print_rec(I, out, v->u.tup.items[i], 0);
+    }
+    fputc(')', out);
+    break;
+  case V_NIL:
+  case V_CONS:
+    fputc('[', out);
+    for (int first = 1; v->kind == V_CONS; first = 0) {
+      if (!first) fputs(", ", out);
+      print_rec(I, out, v->u.cons.head, 0);
+      v = force(I, v->u.cons.tail);
+    }
+    if (v->kind != V_NIL) {
+      fputs(" : ", out);
+      print_rec(I, out, v, 0);
+    }
+    fputc(']', out);
+    break;
+  case V_CON:
+    fputs(v->u.con.con->name, out);
+    for (int i = 0; i < v->u.con.n; i++) {
+      fputc(' ', out);
+      print_rec(I, out, v->u.con.args[i], 1);
+    }
+    break;
+  case V_FUNC:
+  case V_PAP:
+    print_fn(out, v);
+    break;
+  case V_FOREIGN:
+    fprintf(out, "<%s>", v->u.foreign.tag);
+    break;
+  default:
+    fputs("<?>", out);
+  }
+}
+
+void print_value(Interp *I, FILE *out, Value *v) { print_rec(I, out, v, 0); }
+
+const char *show_value(Interp *I, Value *v) {
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&buf, &len);
+  if (!f) return "";
+  /* An error while printing must not leak the stream: print to it inside
+     the caller's handler is fine, since the buffer is freed below only on
+     success; a failed show leaks one small buffer at most. */
+  print_value(I, f, v);
+  fclose(f);
+  char *s = GC_MALLOC_ATOMIC(len + 1);
+  memcpy(s, buf, len + 1);
+  free(buf);
+  return s;
+}
+
+void print_brief(FILE *out, Value *v, int depth) {
+  char buf[32];
+  switch (v->kind) {
+  case V_NUM:
+    format_real(buf, v->u.num);
+    fputs(buf, out);
+    break;
+  case V_BOOL:
+    fputs(v->u.b ? "True" : "False", out);
+    break;
+  case V_STR:
+    print_str(out, v->u.str);
+    break;
+  case V_TUPLE:
+    fputc('(', out);
+    for (int i = 0; i < v->u.tup.n; i++) {
+      if (i) fputs(", ", out);
+      if (depth > 0) print_brief(out, v->u.tup.items[i], depth - 1);
+      else fputs("...", out);
+    }
+    fputc(')', out);
+    break;
+  case V_NIL:
+    fputs("[]", out);
+    break;
+  case V_CONS: {
+    fputc('[', out);
+    int i = 0;
+    for (; v->kind == V_CONS && i < 4; i++) {
+      if (i) fputs(", ", out);
+      if (depth > 0) print_brief(out, v->u.cons.head, depth - 1);
+      else fputs("...", out);
+      v = v->u.cons.tail;
+    }
+    if (v->kind != V_NIL) fputs(i ? ", ..." : "...", out);
+    fputc(']', out);
+    break;
+  }
+  case V_CON:
+    fputs(v->u.con.con->name, out);
+    for (int i = 0; i < v->u.con.n; i++) {
+      fputc(' ', out);
+      Value *a = v->u.con.args[i];
+      if (depth <= 0) {
+        fputs("...", out);
+        continue;
+      }
+      int p = needs_parens(a);
+      if (p) fputc('(', out);
+      print_brief(out, a, depth - 1);
+      if (p) fputc(')', out);
+    }
+    break;
+  case V_FUNC:
+  case V_PAP:
+    print_fn(out, v);
+    break;
+  case V_FOREIGN:
+    fprintf(out, "<%s>", v->u.foreign.tag);
+    break;
+  default:
+    fputs("...", out);
+  }
+}

@@ -1,0 +1,137 @@
+/* value.h: the runtime values of qcs and the interpreter's state.
+ *
+ * Values are lazy: a field of a tuple, list or constructor, an argument,
+ * a binding, may be a thunk (an expression with its environment) until
+ * something forces it. Forcing overwrites the thunk in place with its
+ * weak-head normal form, so each thunk runs at most once (call by need).
+ * All values live in the Boehm GC heap: no ownership to track, cycles
+ * (a list defined in terms of itself) are fine. */
+#ifndef QCS_VALUE_H
+#define QCS_VALUE_H
+
+#include <signal.h>
+#include <stddef.h>
+
+#include "ast.h"
+
+typedef struct Value Value;
+typedef struct Env Env;
+typedef struct Interp Interp;
+typedef struct Builtin Builtin;
+
+/* An interned name. Global bindings hang off the symbol itself. */
+struct Sym {
+  const char *name;
+  Sym *next;           /* hash chain */
+  Value *global;       /* top-level value, or NULL */
+  Def *def;            /* its definition (for :browse), or NULL */
+  int con_arity;       /* >= 0: a constructor of this arity; -1: not one */
+  Sym *con_type;       /* the type a constructor belongs to */
+  Value *con_value;    /* the constructor as a value */
+  int user;            /* defined outside the prelude */
+  int overridden;      /* fixed by --set: later definitions are ignored */
+  const char *sig;     /* type signature text */
+  Pos def_pos;         /* where it was defined (for "already defined") */
+  const char *def_file;/* which run defined it */
+};
+
+typedef enum {
+  V_NUM, V_BOOL, V_STR, V_TUPLE, V_NIL, V_CONS, V_CON,
+  V_FUNC, V_PAP, V_THUNK, V_APTHUNK, V_PATSEL, V_BLACKHOLE, V_FOREIGN
+} VKind;
+
+typedef enum { F_DEF, F_BUILTIN, F_CON } FnKind;
+
+typedef Value *(*BuiltinFn)(Interp *I, Value **args, Pos pos);
+
+struct Builtin {
+  const char *name;
+  int arity;
+  BuiltinFn fn;
+  const char *doc;
+};
+
+struct Value {
+  unsigned char kind;
+  union {
+    double num;
+    int b;
+    const char *str;
+    struct { int n; Value **items; } tup;
+    struct { Value *head, *tail; } cons;
+    struct { Sym *con; int n; Value **args; } con;
+    struct {
+      FnKind kind;
+      int arity;
+      union { Def *def; const Builtin *bi; Sym *con; } u;
+      Env *env;
+    } fn;
+    struct { Value *fn; int n; Value **args; } pap; /* V_PAP, V_APTHUNK */
+    struct { Expr *e; Env *env; } thunk;
+    struct { Pat *pat; Sym *var; Value *whole; } patsel;
+    struct { void *ptr; const char *tag; } foreign;
+  } u;
+};
+
+/* A frame of local bindings; `up` is the enclosing scope. */
+struct Env {
+  Env *up;
+  int n, cap;
+  Sym **names;
+  Value **vals;
+};
+
+/* One entry of the call trace shown with runtime errors. */
+typedef struct TraceEntry {
+  const char *name;
+  Pos pos;
+} TraceEntry;
+
+/* A thunk being forced, with its contents, to restore after an error. */
+typedef struct Forcing {
+  Value *v;
+  Value saved;
+} Forcing;
+
+#define TRACE_MAX 4096
+
+struct Interp {
+  Sym **symtab;
+  size_t symcap, nsyms;
+  char *stack_base;          /* for the recursion-depth check */
+  size_t stack_limit;        /* bytes of C stack evaluation may use */
+  unsigned long long steps;  /* evaluation steps so far */
+  unsigned long long max_steps; /* 0 = no limit */
+  TraceEntry trace[TRACE_MAX];
+  int ntrace;                /* entries in use (may exceed TRACE_MAX) */
+  Forcing *forcing;
+  int nforcing, capforcing;
+  const char *run_name;      /* the file currently being run */
+  int loading_prelude;
+  Value *v_true, *v_false, *v_nil;
+  /* Shared symbols the evaluator looks for. */
+  Sym *s_otherwise;
+};
+
+extern volatile sig_atomic_t qcs_interrupted;
+
+Sym *sym_intern(Interp *I, const char *name, int len);
+
+Value *val_num(double x);
+Value *val_bool(Interp *I, int b);
+Value *val_str(const char *s);
+Value *val_tuple(int n, Value **items);
+Value *val_tuple3(double x, double y, double z);
+Value *val_cons(Value *head, Value *tail);
+Value *val_nil(Interp *I);
+Value *val_con(Sym *con, int n, Value **args);
+Value *val_builtin(const Builtin *b);
+Value *val_foreign(void *ptr, const char *tag);
+Value **val_array(int n);
+
+Env *env_new(Env *up, int cap);
+void env_bind(Env *env, Sym *name, Value *v);
+
+/* "a number", "a list", "constructor Sum", ... for error messages. */
+const char *val_describe(Value *v);
+#endif
