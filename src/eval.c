@@ -338,7 +338,36 @@ Value *eval_global_value(Interp *I, Def *d) {
   return mk_thunk(defbody_expr(d), NULL);
 }
 
-static void brief_args(int n, Value **args, char *buf, size_t size) {
+/* Forces v a few levels deep for an error message; an error on the way
+   is swallowed (the value then shows as "..." where it failed). */
+static void force_some(Interp *I, Value *v, int depth) {
+  if (depth <= 0) return;
+  int nforcing = I->nforcing, ntrace = I->ntrace;
+  ErrInfo saved = *err_info();
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    v = force(I, v);
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    while (I->nforcing > nforcing) {
+      I->nforcing--;
+      *I->forcing[I->nforcing].v = I->forcing[I->nforcing].saved;
+    }
+    I->ntrace = ntrace;
+    *err_info() = saved;
+    return;
+  }
+  *err_info() = saved;
+  if (v->kind == V_TUPLE)
+    for (int i = 0; i < v->u.tup.n; i++) force_some(I, v->u.tup.items[i], depth - 1);
+  else if (v->kind == V_CON)
+    for (int i = 0; i < v->u.con.n; i++) force_some(I, v->u.con.args[i], depth - 1);
+  else if (v->kind == V_CONS)
+    force_some(I, v->u.cons.head, depth - 1);
+}
+
+static void brief_args(Interp *I, int n, Value **args, char *buf, size_t size) {
   size_t len = 0;
   buf[0] = 0;
   for (int i = 0; i < n && len + 4 < size; i++) {
@@ -346,6 +375,7 @@ static void brief_args(int n, Value **args, char *buf, size_t size) {
       snprintf(buf + len, size - len, ", ");
       len = strlen(buf);
     }
+    force_some(I, args[i], 3);
     val_brief(args[i], buf + len, size - len);
     len = strlen(buf);
   }
@@ -372,7 +402,7 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
     }
   }
   char buf[400];
-  brief_args(d->arity, args, buf, sizeof buf);
+  brief_args(I, d->arity, args, buf, sizeof buf);
   if (d->name)
     qcs_error(pos, "no clause of %s matches the argument%s %s", d->name->name,
               d->arity == 1 ? "" : "s", buf);
@@ -711,6 +741,8 @@ static Value *range(Interp *I, Expr *e, Env *env) {
 
 Value *eval(Interp *I, Expr *e, Env *env) {
   int depth = I->ntrace;
+  /* Trace slots: the first call made here, then the latest tail call. */
+  int tslot = depth;
   Value *result;
   for (;;) {
     eval_check(I, e->pos);
@@ -736,7 +768,8 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
       Expr *body;
       Env *benv;
-      if (call(I, f, n, args, e->pos, &result, &body, &benv, depth)) {
+      if (call(I, f, n, args, e->pos, &result, &body, &benv, tslot)) {
+        tslot = depth + 1;
         e = body;
         env = benv;
         continue;

@@ -30,16 +30,28 @@ static void report_error(Interp *I) {
   ErrInfo *e = err_info();
   err_report(stderr, "error", e->pos, e->msg);
   int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
-  int shown = 0;
-  for (int i = n - 1; i >= 0 && shown < 6; i--, shown++) {
+  int lines = 0, i = n - 1;
+  /* Innermost first; a run of identical entries (deep recursion) is
+     shown once with its count. */
+  while (i >= 0 && lines < 8) {
     TraceEntry *t = &I->trace[i];
+    int same = 1;
+    while (i - same >= 0 && I->trace[i - same].name == t->name &&
+           I->trace[i - same].pos.line == t->pos.line &&
+           I->trace[i - same].pos.col == t->pos.col &&
+           I->trace[i - same].pos.src == t->pos.src)
+      same++;
     if (t->pos.src && t->pos.line)
-      fprintf(stderr, "  in %s, called at %s:%d:%d\n", t->name,
+      fprintf(stderr, "  in %s, called at %s:%d:%d", t->name,
               t->pos.src->name, t->pos.line, t->pos.col);
     else
-      fprintf(stderr, "  in %s\n", t->name);
+      fprintf(stderr, "  in %s", t->name);
+    if (same > 1) fprintf(stderr, " (%d times)", same);
+    fputc('\n', stderr);
+    i -= same;
+    lines++;
   }
-  if (n > shown) fprintf(stderr, "  ... and %d more calls\n", n - shown);
+  if (i >= 0) fprintf(stderr, "  ... and %d more calls\n", i + 1);
 }
 
 /* Put back every thunk that was being forced when the error struck, so

@@ -17,8 +17,9 @@
 #include "interp.h"
 #include "repl.h"
 
-#define STACK_SIZE ((size_t)1 << 30) /* reserved, touched only as used */
-#define STACK_MARGIN ((size_t)8 << 20)
+#define STACK_SIZE ((size_t)512 << 20) /* reserved, touched only as used */
+#define STACK_USE ((size_t)256 << 20)  /* ~350000 nested calls */
+#define FALLBACK_STACK_USE ((size_t)6 << 20)
 
 typedef struct Options {
   const char *exprs[64];
@@ -29,6 +30,7 @@ typedef struct Options {
   int nfiles;
   unsigned long long max_steps;
   int status;
+  size_t stack_use;
 } Options;
 
 static void usage(FILE *out) {
@@ -54,7 +56,7 @@ static void *run(void *arg) {
   Options *o = arg;
   Interp *I = interp_new();
   char probe;
-  interp_set_stack(I, &probe, STACK_SIZE - STACK_MARGIN);
+  interp_set_stack(I, &probe, o->stack_use);
   if (o->max_steps) interp_set_max_steps(I, o->max_steps);
   for (int i = 0; i < o->nsets; i++) {
     const char *eq = strchr(o->sets[i], '=');
@@ -135,8 +137,10 @@ int main(int argc, char **argv) {
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, STACK_SIZE);
   pthread_t th;
+  o.stack_use = STACK_USE;
   if (pthread_create(&th, &attr, run, &o) != 0) {
     /* No big stack to be had: run here with the default one. */
+    o.stack_use = FALLBACK_STACK_USE;
     run(&o);
   } else {
     pthread_join(th, NULL);

@@ -913,6 +913,18 @@ static int skip_atype(Parser *P) {
   return 0;
 }
 
+/* type -> atype {atype} {'->' type} */
+static void skip_type(Parser *P) {
+  for (;;) {
+    if (skip_atype(P)) continue;
+    if (peek(P) == T_ARROW) {
+      next(P);
+      continue;
+    }
+    return;
+  }
+}
+
 /* typedecl -> '::' CNAME {NAME} ('=' alt {'|' alt} | ':==' type)
    alt -> CNAME {atype} */
 static Item *type_decl(Parser *P, Pos pos) {
@@ -927,12 +939,12 @@ static Item *type_decl(Parser *P, Pos pos) {
   while (peek(P) == T_NAME) next(P);
   if (peek(P) == T_SYNONYM) {
     next(P);
-    while (skip_atype(P) || peek(P) == T_ARROW) next(P);
+    skip_type(P);
     return it;
   }
   expect(P, T_EQUALS, "in the type declaration");
   if (peek(P) != T_CNAME) { /* (Vector, Real), [Key], ...: a synonym */
-    while (skip_atype(P) || peek(P) == T_ARROW) next(P);
+    skip_type(P);
     return it;
   }
   Vec cons = {0};
