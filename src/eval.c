@@ -454,6 +454,11 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
       Value **cargs = val_array(a);
       memcpy(cargs, args, sizeof(Value *) * (size_t)a);
       *result = val_con(c, a, cargs);
+      if (pos.src) { /* scene errors found later point back here */
+        Pos *p = GC_MALLOC(sizeof *p);
+        *p = pos;
+        (*result)->u.con.pos = p;
+      }
       return 0;
     }
     case F_BUILTIN:

@@ -59,7 +59,7 @@ struct Value {
     const char *str;
     struct { int n; Value **items; } tup;
     struct { Value *head, *tail; } cons;
-    struct { Sym *con; int n; Value **args; } con;
+    struct { Sym *con; int n; Value **args; const Pos *pos; } con; /* pos: where it was built, or NULL */
     struct {
       FnKind kind;
       int arity;
