@@ -1,0 +1,679 @@
+/* test_soft.c: soft.c against independent references.
+ *
+ * The field reference evaluates eq. (1) in the paper's own form, from the
+ * distance r (or the full 4x4 quadratic form u'Mu) at each point: in MPFR
+ * at 256 bits for point tests, in long double for ray tests. It never
+ * builds a polynomial in t. Ray crossings are found by dense sampling of
+ * that field along the ray (spacing DT) and long double bisection of each
+ * sign change. A ray is "ambiguous" when the sampled g = field - magic has
+ * a discrete local extremum with |g| below the largest dip that could hide
+ * between two samples (M DT^2, M a bound on |g''|); for those only the
+ * well-conditioned reference crossings are required, not the count. */
+#include "check.h"
+#include "soft.h"
+
+#include <float.h>
+#include <mpfr.h>
+#include <stdint.h>
+
+static uint64_t rng_state = 12111;
+static double rnd(void)  /* uniform in [0, 1), xorshift64* */
+{
+  rng_state ^= rng_state >> 12;
+  rng_state ^= rng_state << 25;
+  rng_state ^= rng_state >> 27;
+  return (double)((rng_state * 2685821657736338717ULL) >> 11) * 0x1p-53;
+}
+
+/* A test key: the soft_key plus what the test knows about its shape from
+ * construction: a bounding sphere and its smallest semi-axis. */
+typedef struct {
+  soft_key k;
+  double bc[3], brad, emin;
+} tkey;
+
+static tkey sphere_key(double x, double y, double z, double R, double w)
+{
+  tkey t;
+  memset(&t, 0, sizeof t);
+  t.k.kind = SOFT_SPHERE;
+  t.k.c[0] = x; t.k.c[1] = y; t.k.c[2] = z;
+  t.k.R = R; t.k.w = w;
+  t.bc[0] = x; t.bc[1] = y; t.bc[2] = z;
+  t.brad = R; t.emin = R;
+  return t;
+}
+
+/* Ellipsoid key: centre c, semi-axes R*ax[i] along a random rotation.
+ * M = [[A, -A c], [-c'A, c'A c]] with A = Rot diag(1/ax^2) Rot'. */
+static tkey quadric_key(const double c[3], const double ax[3], double R, double w)
+{
+  tkey t;
+  memset(&t, 0, sizeof t);
+  double q[4] = {rnd() - 0.5, rnd() - 0.5, rnd() - 0.5, rnd() - 0.5}, n = 0;
+  for (int i = 0; i < 4; i++) n += q[i] * q[i];
+  n = sqrt(n);
+  for (int i = 0; i < 4; i++) q[i] /= n;
+  double a = q[0], b = q[1], cc = q[2], d = q[3];
+  double rot[3][3] = {
+    {a*a + b*b - cc*cc - d*d, 2*(b*cc - a*d), 2*(b*d + a*cc)},
+    {2*(b*cc + a*d), a*a - b*b + cc*cc - d*d, 2*(cc*d - a*b)},
+    {2*(b*d - a*cc), 2*(cc*d + a*b), a*a - b*b - cc*cc + d*d}};
+  double A[3][3];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      A[i][j] = 0;
+      for (int k = 0; k < 3; k++) A[i][j] += rot[i][k] * rot[j][k] / (ax[k] * ax[k]);
+    }
+  t.k.kind = SOFT_QUADRIC;
+  double Ac[3], cAc = 0;
+  for (int i = 0; i < 3; i++) {
+    Ac[i] = A[i][0] * c[0] + A[i][1] * c[1] + A[i][2] * c[2];
+    cAc += c[i] * Ac[i];
+  }
+  for (int i = 0; i < 3; i++) {
+    for (int j = 0; j < 3; j++) t.k.m[i][j] = A[i][j];
+    t.k.m[i][3] = t.k.m[3][i] = -Ac[i];
+  }
+  t.k.m[3][3] = cAc;
+  t.k.R = R; t.k.w = w;
+  double amax = fmax(ax[0], fmax(ax[1], ax[2])), amin = fmin(ax[0], fmin(ax[1], ax[2]));
+  for (int i = 0; i < 3; i++) t.bc[i] = c[i];
+  t.brad = R * amax * 1.001;
+  t.emin = R * amin;
+  return t;
+}
+
+static soft_obj *build(const tkey *tk, int n, double magic)
+{
+  soft_key keys[256];
+  for (int i = 0; i < n; i++) keys[i] = tk[i].k;
+  soft_obj *o;
+  size_t bad;
+  if (soft_build(keys, n, magic, &o, &bad) != SOFT_OK) return NULL;
+  return o;
+}
+
+/* ---- references ---------------------------------------------------------- */
+
+/* eq. (1) in MPFR from the distance / the full quadratic form. */
+static void mp_field(mpfr_t f, const tkey *tk, int n, const double p[3])
+{
+  mpfr_t s, t, u, x2, R2;
+  mpfr_inits2(256, s, t, u, x2, R2, (mpfr_ptr)0);
+  mpfr_set_zero(f, 1);
+  for (int j = 0; j < n; j++) {
+    const soft_key *k = &tk[j].k;
+    mpfr_set_zero(s, 1);
+    if (k->kind == SOFT_SPHERE) {
+      for (int i = 0; i < 3; i++) {
+        mpfr_set_d(t, p[i], MPFR_RNDN);
+        mpfr_sub_d(t, t, k->c[i], MPFR_RNDN);
+        mpfr_sqr(t, t, MPFR_RNDN);
+        mpfr_add(s, s, t, MPFR_RNDN);
+      }
+    } else {
+      double uu[4] = {p[0], p[1], p[2], 1};
+      for (int a = 0; a < 4; a++)
+        for (int b = 0; b < 4; b++) {
+          mpfr_set_d(t, uu[a], MPFR_RNDN);
+          mpfr_mul_d(t, t, uu[b], MPFR_RNDN);
+          mpfr_mul_d(t, t, k->m[a][b], MPFR_RNDN);
+          mpfr_add(s, s, t, MPFR_RNDN);
+        }
+    }
+    mpfr_set_d(R2, k->R, MPFR_RNDN);
+    mpfr_sqr(R2, R2, MPFR_RNDN);
+    mpfr_div(x2, s, R2, MPFR_RNDN);  /* (r/R)^2 */
+    if (mpfr_cmp_ui(x2, 1) >= 0) continue;
+    /* -4/9 x^6 + 17/9 x^4 - 22/9 x^2 + 1 */
+    mpfr_pow_ui(t, x2, 3, MPFR_RNDN);
+    mpfr_mul_si(t, t, -4, MPFR_RNDN);
+    mpfr_sqr(u, x2, MPFR_RNDN);
+    mpfr_mul_ui(u, u, 17, MPFR_RNDN);
+    mpfr_add(t, t, u, MPFR_RNDN);
+    mpfr_mul_ui(u, x2, 22, MPFR_RNDN);
+    mpfr_sub(t, t, u, MPFR_RNDN);
+    mpfr_div_ui(t, t, 9, MPFR_RNDN);
+    mpfr_add_ui(t, t, 1, MPFR_RNDN);
+    mpfr_mul_d(t, t, k->w, MPFR_RNDN);
+    mpfr_add(f, f, t, MPFR_RNDN);
+  }
+  mpfr_clears(s, t, u, x2, R2, (mpfr_ptr)0);
+}
+
+/* The same in long double at the point o + tau dn (dn unit). */
+static long double ld_field(const tkey *tk, int n, const long double o[3],
+                            const long double dn[3], long double tau)
+{
+  long double f = 0, x[3];
+  for (int i = 0; i < 3; i++) x[i] = o[i] + tau * dn[i];
+  for (int j = 0; j < n; j++) {
+    const soft_key *k = &tk[j].k;
+    long double s = 0;
+    if (k->kind == SOFT_SPHERE) {
+      long double r2 = 0;
+      for (int i = 0; i < 3; i++) r2 += (x[i] - k->c[i]) * (x[i] - k->c[i]);
+      long double q = sqrtl(r2) / k->R;  /* r/R */
+      if (q >= 1) continue;
+      f += k->w * (-4.0L / 9 * powl(q, 6) + 17.0L / 9 * powl(q, 4) - 22.0L / 9 * q * q + 1);
+      continue;
+    }
+    long double uu[4] = {x[0], x[1], x[2], 1};
+    for (int a = 0; a < 4; a++)
+      for (int b = 0; b < 4; b++) s += (long double)k->m[a][b] * uu[a] * uu[b];
+    s /= (long double)k->R * k->R;
+    if (s >= 1) continue;
+    f += k->w * (-4.0L / 9 * s * s * s + 17.0L / 9 * s * s - 22.0L / 9 * s + 1);
+  }
+  return f;
+}
+
+typedef struct {
+  double tau[512];   /* crossings, in length along the unit direction */
+  double slope[512]; /* |dg/dtau| there */
+  int n, ambiguous;
+} ref_t;
+
+/* Dense sign-change search of g = field - magic on [ta, tb] (length units). */
+static void ref_roots(const tkey *tk, int n, double magic, const double o[3],
+                      const double d[3], double ta, double tb, double dt,
+                      ref_t *ref)
+{
+  long double lo_[3], dn[3], len = 0;
+  for (int i = 0; i < 3; i++) len += (long double)d[i] * d[i];
+  len = sqrtl(len);
+  for (int i = 0; i < 3; i++) { lo_[i] = o[i]; dn[i] = d[i] / len; }
+  /* clip to the keys' bounding spheres: outside, g = -magic */
+  double kmin = INFINITY, kmax = -INFINITY, M = 0;
+  for (int j = 0; j < n; j++) {
+    long double b = 0, c2 = 0;
+    for (int i = 0; i < 3; i++) {
+      long double p = lo_[i] - tk[j].bc[i];
+      b += p * dn[i];
+      c2 += p * p;
+    }
+    long double disc = b * b - (c2 - (long double)tk[j].brad * tk[j].brad);
+    if (disc < 0) continue;
+    kmin = fmin(kmin, (double)(-b - sqrtl(disc)));
+    kmax = fmax(kmax, (double)(-b + sqrtl(disc)));
+    M += fabs(tk[j].k.w) * 20 / (tk[j].emin * tk[j].emin);
+  }
+  ref->n = 0;
+  ref->ambiguous = 0;
+  double a = fmax(ta, kmin - dt), b = fmin(tb, kmax + dt);
+  if (!(a < b)) return;
+  double delta = 2 * M * dt * dt;  /* largest hidden dip: M dt^2 / 2, x4 */
+  int ns = (int)ceil((b - a) / dt);
+  long double gprev2 = 0, gprev = 0;
+  for (int i = 0; i <= ns; i++) {
+    long double t = a + (long double)(b - a) * i / ns;
+    long double g = ld_field(tk, n, lo_, dn, t) - magic;
+    if (i >= 2 && fabsl(gprev) <= delta && (gprev - gprev2) * (g - gprev) < 0)
+      ref->ambiguous = 1;
+    if (i >= 1 && (g > 0) != (gprev > 0) && ref->n < 512) {
+      long double lo = a + (long double)(b - a) * (i - 1) / ns, hi = t;
+      int slo = gprev > 0;
+      for (int it = 0; it < 80; it++) {
+        long double mid = 0.5L * (lo + hi);
+        if ((ld_field(tk, n, lo_, dn, mid) - magic > 0) == slo) lo = mid; else hi = mid;
+      }
+      long double r = 0.5L * (lo + hi), e = 1e-7L;
+      ref->tau[ref->n] = (double)r;
+      ref->slope[ref->n] = (double)fabsl((ld_field(tk, n, lo_, dn, r + e) -
+                                          ld_field(tk, n, lo_, dn, r - e)) / (2 * e));
+      ref->n++;
+    }
+    gprev2 = gprev;
+    gprev = g;
+  }
+}
+
+/* ---- comparing -------------------------------------------------------------- */
+
+typedef struct {
+  int rays, ambiguous, bad_count, bad_pos, bad_order, bad_ret;
+  double worst;  /* largest |error| / tolerance seen */
+} tally;
+
+/* Compare soft_roots with the reference on one ray. Tolerance for a
+ * crossing with reference slope g' (length units):
+ *   tol = (2e-15 * W + 4e-16 * D) / |g'| + 2e-15 * (1 + D)
+ * W = sum |w| (rounding of the sextic's coefficients), D = distance from
+ * the origin to the keys plus |tau| (rounding of the key offsets). Only
+ * crossings with |g'| >= 1e-4 are held to it (the rest are near-tangent). */
+static void compare_ray(const tkey *tk, int n, const soft_obj *obj, double magic,
+                        const double o[3], const double d[3], double t0,
+                        double t1, double dt, soft_scratch *s, soft_stats *st,
+                        tally *ty)
+{
+  double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  ref_t ref;
+  ref_roots(tk, n, magic, o, d, t0 * dl, t1 * dl, dt, &ref);
+  double got[512];
+  int ng = soft_roots(obj, o, d, t0, t1, got, 512, s, st);
+  ty->rays++;
+  if (ng < 0) { ty->bad_ret++; return; }
+  for (int i = 1; i < ng; i++) if (!(got[i] > got[i - 1])) ty->bad_order++;
+  for (int i = 0; i < ng; i++) if (!(got[i] > t0 && got[i] < t1)) ty->bad_order++;
+  double W = 0, D = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+  for (int j = 0; j < n; j++) {
+    W += fabs(tk[j].k.w);
+    double e = 0;
+    for (int i = 0; i < 3; i++) e += (o[i] - tk[j].bc[i]) * (o[i] - tk[j].bc[i]);
+    D = fmax(D, sqrt(e));
+  }
+  if (ref.ambiguous) ty->ambiguous++;
+  else if (ng != ref.n) {
+    ty->bad_count++;
+    printf("# count: got %d ref %d\n", ng, ref.n);
+    return;
+  }
+  /* every well-conditioned reference crossing has a computed one nearby */
+  for (int i = 0; i < ref.n; i++) {
+    if (ref.slope[i] < 1e-4) continue;
+    double tol = (2e-15 * W + 4e-16 * (D + fabs(ref.tau[i]))) / ref.slope[i] +
+                 2e-15 * (1 + D + fabs(ref.tau[i]));
+    double best = INFINITY;
+    for (int j = 0; j < ng; j++) best = fmin(best, fabs(got[j] * dl - ref.tau[i]));
+    if (best > tol) {
+      ty->bad_pos++;
+      printf("# position: ref %.17g slope %.3g err %.3g tol %.3g\n", ref.tau[i], ref.slope[i], best, tol);
+    }
+    if (best / tol > ty->worst) ty->worst = best / tol;
+  }
+}
+
+static void report(const char *what, const tally *ty)
+{
+  char name[200];
+  snprintf(name, sizeof name, "%s: %d rays (%d ambiguous) count matches dense reference", what, ty->rays, ty->ambiguous);
+  CHECK(name, ty->bad_count == 0 && ty->bad_ret == 0 && ty->rays > 0);
+  snprintf(name, sizeof name, "%s: crossings within tolerance (worst err/tol %.3g)", what, ty->worst);
+  CHECK(name, ty->bad_pos == 0);
+  snprintf(name, sizeof name, "%s: crossings strictly ascending, inside (t0, t1)", what);
+  CHECK(name, ty->bad_order == 0);
+}
+
+static void random_dir(double d[3])
+{
+  double n;
+  do {
+    for (int i = 0; i < 3; i++) d[i] = 2 * rnd() - 1;
+    n = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  } while (n > 1 || n < 1e-3);
+  n = sqrt(n);
+  for (int i = 0; i < 3; i++) d[i] /= n;
+}
+
+/* A random ray passing near a point of the cloud box [-1.5, 1.5]^3 + off. */
+static void aim_ray(const double off[3], double span, double o[3], double d[3])
+{
+  double target[3];
+  random_dir(d);
+  for (int i = 0; i < 3; i++) target[i] = off[i] + (rnd() - 0.5) * span;
+  for (int i = 0; i < 3; i++) o[i] = target[i] - 6 * d[i];
+}
+
+/* ---- tests ------------------------------------------------------------------- */
+
+static void test_build(void)
+{
+  soft_key k[3];
+  memset(k, 0, sizeof k);
+  for (int i = 0; i < 3; i++) { k[i].kind = SOFT_SPHERE; k[i].R = 1; k[i].w = 1; }
+  soft_obj *o;
+  size_t bad;
+  k[1].R = 0;
+  CHECK("build: R = 0 rejected with the key's index", soft_build(k, 3, 0.5, &o, &bad) == SOFT_ERR_RADIUS && bad == 1 && !o);
+  k[1].R = 1;
+  k[2].c[1] = NAN;
+  CHECK("build: NaN centre rejected", soft_build(k, 3, 0.5, &o, &bad) == SOFT_ERR_NONFINITE && bad == 2);
+  k[2].c[1] = 0;
+  k[0].w = INFINITY;
+  CHECK("build: infinite weight rejected", soft_build(k, 3, 0.5, &o, &bad) == SOFT_ERR_NONFINITE && bad == 0);
+  k[0].w = 1;
+  CHECK("build: magic <= 0 rejected", soft_build(k, 3, 0, &o, &bad) == SOFT_ERR_MAGIC);
+  k[2].kind = SOFT_QUADRIC;  /* cylinder x^2 + y^2: 3x3 block singular */
+  k[2].m[0][0] = k[2].m[1][1] = 1;
+  CHECK("build: cylinder quadric rejected as unbounded", soft_build(k, 3, 0.5, &o, &bad) == SOFT_ERR_UNBOUNDED && bad == 2);
+  k[2].m[2][2] = 4;
+  int err = soft_build(k, 3, 0.5, &o, &bad);
+  CHECK("build: ellipsoid quadric accepted", err == SOFT_OK && o && soft_nkeys(o) == 3);
+  double lo[3], hi[3];
+  /* ellipsoid x^2 + y^2 + 4 z^2 < 1: z half-extent 0.5 (tol 1e-9) */
+  if (o) {
+    soft_bounds(o, lo, hi);
+    CHECK_NEAR("bounds: z extent of ellipsoid key and unit spheres", hi[2], 1, 1e-9);
+    soft_free(o);
+  }
+  k[2].w = -5;  /* negative keys only subtract: not in the box */
+  k[1].c[0] = 10;
+  err = soft_build(k, 3, 0.5, &o, &bad);
+  if (err == SOFT_OK) {
+    soft_bounds(o, lo, hi);
+    CHECK_NEAR("bounds: union of positive keys only, hi x (tol 1e-12)", hi[0], 11, 1e-12);
+    CHECK_NEAR("bounds: union of positive keys only, lo x (tol 1e-12)", lo[0], -1, 1e-12);
+    soft_free(o);
+  }
+  CHECK("strerror names errors", strstr(soft_strerror(SOFT_ERR_UNBOUNDED), "bounded") != NULL);
+}
+
+static int make_cloud(tkey *tk, int n, const double off[3], int negatives,
+                      int quadrics)
+{
+  for (int j = 0; j < n; j++) {
+    double c[3] = {off[0] + (rnd() - 0.5) * 2.4, off[1] + (rnd() - 0.5) * 2.4,
+                   off[2] + (rnd() - 0.5) * 2.4};
+    double R = 0.4 + 0.5 * rnd(), w = 0.5 + rnd();
+    if (negatives && rnd() < 0.3) w = -w;
+    if (quadrics && rnd() < 0.4) {
+      double ax[3] = {0.5 + rnd(), 0.5 + rnd(), 0.5 + rnd()};
+      tk[j] = quadric_key(c, ax, R, w);
+    } else {
+      tk[j] = sphere_key(c[0], c[1], c[2], R, w);
+    }
+  }
+  return n;
+}
+
+static void test_field(void)
+{
+  tkey tk[40];
+  double off[3] = {0, 0, 0};
+  make_cloud(tk, 40, off, 1, 1);
+  soft_obj *o = build(tk, 40, 0.5);
+  CHECK("field: mixed cloud builds", o != NULL);
+  if (!o) return;
+  mpfr_t f, fp, fm;
+  mpfr_inits2(256, f, fp, fm, (mpfr_ptr)0);
+  double W = 0;
+  for (int j = 0; j < 40; j++) W += fabs(tk[j].k.w);
+  int fbad = 0, gbad = 0;
+  double worst = 0;
+  for (int i = 0; i < 2000; i++) {
+    double p[3] = {(rnd() - 0.5) * 4, (rnd() - 0.5) * 4, (rnd() - 0.5) * 4}, g[3];
+    double v = soft_field(o, p), v2 = soft_field_grad(o, p, g);
+    mp_field(f, tk, 40, p);
+    double ref = mpfr_get_d(f, MPFR_RNDN);
+    /* tolerance: 1e-14 * sum |w| (a few roundings per key) */
+    if (fabs(v - ref) > 1e-14 * W || v2 != v) fbad++;
+    worst = fmax(worst, fabs(v - ref) / W);
+    for (int a = 0; a < 3; a++) {
+      /* central difference of the MPFR field, h = 1e-6: truncation
+       * h^2 |f'''| / 6 < 1e-9 W here, so tolerance 1e-7 * sum |w| */
+      double pp[3] = {p[0], p[1], p[2]};
+      pp[a] = p[a] + 1e-6;
+      mp_field(fp, tk, 40, pp);
+      pp[a] = p[a] - 1e-6;
+      mp_field(fm, tk, 40, pp);
+      mpfr_sub(fp, fp, fm, MPFR_RNDN);
+      double dref = mpfr_get_d(fp, MPFR_RNDN) / ((p[a] + 1e-6) - (p[a] - 1e-6));
+      if (fabs(g[a] - dref) > 1e-7 * W) gbad++;
+    }
+  }
+  mpfr_clears(f, fp, fm, (mpfr_ptr)0);
+  char name[160];
+  snprintf(name, sizeof name, "field vs MPFR at 2000 points, 40 mixed keys (tol 1e-14 sum|w|; worst %.2g)", worst);
+  CHECK(name, fbad == 0);
+  CHECK("gradient vs MPFR central difference (tol 1e-7 sum|w|)", gbad == 0);
+  /* bounds: no inside point outside the box */
+  double lo[3], hi[3];
+  soft_bounds(o, lo, hi);
+  int out = 0;
+  for (int i = 0; i < 20000; i++) {
+    double p[3] = {(rnd() - 0.5) * 6, (rnd() - 0.5) * 6, (rnd() - 0.5) * 6};
+    if (soft_field(o, p) > 0.5)
+      for (int a = 0; a < 3; a++) if (p[a] < lo[a] || p[a] > hi[a]) out++;
+  }
+  CHECK("bounds: every sampled inside point lies in soft_bounds", out == 0);
+  soft_free(o);
+}
+
+static void cloud_rays(const char *what, tkey *tk, int n, double magic,
+                       const double off[3], int nrays, double dscale)
+{
+  soft_obj *o = build(tk, n, magic);
+  if (!o) { CHECK(what, 0); return; }
+  soft_scratch *s = soft_scratch_new(n);
+  soft_stats st;
+  memset(&st, 0, sizeof st);
+  tally ty;
+  memset(&ty, 0, sizeof ty);
+  for (int r = 0; r < nrays; r++) {
+    double or_[3], d[3];
+    aim_ray(off, 3, or_, d);
+    for (int i = 0; i < 3; i++) d[i] *= dscale;
+    compare_ray(tk, n, o, magic, or_, d, 0, INFINITY, 2e-3, s, &st, &ty);
+  }
+  report(what, &ty);
+  printf("# %s: keys/ray %.1f intervals/ray %.1f solves %ld laguerre %ld fallbacks %ld\n", what,
+         (double)st.keys / st.rays, (double)st.intervals / st.rays, st.poly.solves,
+         st.poly.laguerre, st.poly.fallbacks);
+  soft_scratch_free(s);
+  soft_free(o);
+}
+
+static void test_clouds(void)
+{
+  tkey tk[64];
+  double off[3] = {0, 0, 0};
+  make_cloud(tk, 20, off, 0, 0);
+  cloud_rays("random rays, 20 positive spheres", tk, 20, 0.5, off, 150, 1);
+  make_cloud(tk, 24, off, 1, 0);
+  cloud_rays("random rays, 24 spheres incl. negative", tk, 24, 0.5, off, 150, 1);
+  make_cloud(tk, 24, off, 1, 1);
+  cloud_rays("random rays, 24 mixed spheres/quadrics incl. negative", tk, 24, 0.5, off, 150, 1);
+  make_cloud(tk, 20, off, 1, 1);
+  cloud_rays("direction length 1e-3", tk, 20, 0.5, off, 60, 1e-3);
+  cloud_rays("direction length 1e3", tk, 20, 0.5, off, 60, 1e3);
+  cloud_rays("magic 1e-6", tk, 20, 1e-6, off, 60, 1);
+
+  /* keys at 1e6 from the origin, rays from near the origin (spheres: the
+   * long double reference keeps r exact enough there) */
+  double far[3] = {1e6, -1e6, 1e6};
+  make_cloud(tk, 20, far, 1, 0);
+  soft_obj *o = build(tk, 20, 0.5);
+  soft_scratch *s = soft_scratch_new(20);
+  tally ty;
+  memset(&ty, 0, sizeof ty);
+  for (int r = 0; r < 40; r++) {
+    double org[3] = {rnd(), rnd(), rnd()}, tg[3], d[3];
+    for (int i = 0; i < 3; i++) tg[i] = far[i] + (rnd() - 0.5) * 3;
+    for (int i = 0; i < 3; i++) d[i] = tg[i] - org[i];  /* |d| ~ 1.7e6 */
+    compare_ray(tk, 20, o, 0.5, org, d, 0, INFINITY, 2e-3, s, NULL, &ty);
+  }
+  report("keys at 1e6 from the ray origin", &ty);
+  soft_scratch_free(s);
+  soft_free(o);
+}
+
+static void test_helix(void)
+{
+  tkey tk[50];
+  for (int k = 0; k < 50; k++)
+    tk[k] = sphere_key(cos(0.45 * k), sin(0.45 * k), 0.08 * k - 2, 0.6, 1);
+  double off[3] = {0, 0, 0};
+  soft_obj *o = build(tk, 50, 0.5);
+  soft_scratch *s = soft_scratch_new(50);
+  tally ty;
+  memset(&ty, 0, sizeof ty);
+  for (int r = 0; r < 150; r++) {
+    double org[3], d[3];
+    aim_ray(off, 3, org, d);
+    compare_ray(tk, 50, o, 0.5, org, d, 0, INFINITY, 2e-3, s, NULL, &ty);
+  }
+  /* rays along the helix axis cross many keys */
+  for (int r = 0; r < 20; r++) {
+    double org[3] = {(rnd() - 0.5) * 0.5, (rnd() - 0.5) * 0.5, -4}, d[3] = {0.05 * (rnd() - 0.5), 0.05 * (rnd() - 0.5), 1};
+    compare_ray(tk, 50, o, 0.5, org, d, 0, INFINITY, 2e-3, s, NULL, &ty);
+  }
+  report("fifty keys on a helix", &ty);
+  soft_scratch_free(s);
+  soft_free(o);
+}
+
+/* Near the field's maximum: one key (max 1 at its centre) and a pair. */
+static void test_magic_extremes(void)
+{
+  tkey tk[3];
+  tk[0] = sphere_key(0.1, -0.2, 0.3, 0.6, 1);
+  double magic = 1 - 1e-6;
+  soft_obj *o = build(tk, 1, magic);
+  soft_scratch *s = soft_scratch_new(4);
+  double out[8];
+  double org[3] = {0.1 - 2, -0.2, 0.3}, d[3] = {1, 0, 0};
+  int n = soft_roots(o, org, d, 0, INFINITY, out, 8, s, NULL);
+  /* reference: C(x^2) = magic for the paper's cubic, solved by long double
+   * bisection on the distance x = r/R */
+  long double lo = 0, hi = 1;
+  for (int i = 0; i < 100; i++) {
+    long double m = 0.5L * (lo + hi), q = m;
+    long double cv = -4.0L / 9 * powl(q, 6) + 17.0L / 9 * powl(q, 4) - 22.0L / 9 * q * q + 1;
+    if (cv > magic) lo = m; else hi = m;
+  }
+  double rr = (double)(0.6L * lo);
+  /* tolerance: the crossing is flat (g' ~ 3e-3): 1e-13 / g' ~ 1e-10 */
+  CHECK("magic 1 - 1e-6, single key: two crossings", n == 2);
+  if (n == 2) {
+    CHECK_NEAR("magic 1 - 1e-6: entry at centre - r (tol 1e-10)", out[0], 2 - rr, 1e-10);
+    CHECK_NEAR("magic 1 - 1e-6: exit at centre + r (tol 1e-10)", out[1], 2 + rr, 1e-10);
+  }
+  /* a ray missing the tiny sphere by a hair: no crossing */
+  double org2[3] = {0.1 - 2, -0.2 + 1.5 * rr, 0.3};
+  n = soft_roots(o, org2, d, 0, INFINITY, out, 8, s, NULL);
+  CHECK("magic 1 - 1e-6: ray at 1.5 r misses", n == 0);
+  soft_free(o);
+
+  /* two overlapping keys, magic just below their joint maximum */
+  tk[0] = sphere_key(0, 0, 0, 0.6, 1);
+  tk[1] = sphere_key(0.3, 0, 0, 0.6, 1);
+  double off[3] = {0.15, 0, 0};
+  /* the maximum lies on the x axis between the two, by symmetry at 0.15 */
+  long double o3[3] = {0.15L, 0, 0}, d3[3] = {1, 0, 0};
+  double fmaxv = (double)ld_field(tk, 2, o3, d3, 0);
+  tally ty;
+  memset(&ty, 0, sizeof ty);
+  o = build(tk, 2, fmaxv * (1 - 1e-4));
+  for (int r = 0; r < 60; r++) {
+    double ro[3], dd[3];
+    random_dir(dd);
+    for (int i = 0; i < 3; i++) ro[i] = off[i] + (rnd() - 0.5) * 0.05 - 3 * dd[i];
+    compare_ray(tk, 2, o, fmaxv * (1 - 1e-4), ro, dd, 0, INFINITY, 2e-4, s, NULL, &ty);
+  }
+  report("magic 1e-4 below the maximum of two keys", &ty);
+  soft_free(o);
+
+  /* positive and negative keys that nearly cancel: w = 1 and -1, 1e-3 apart */
+  tk[0] = sphere_key(0, 0, 0, 0.6, 1);
+  tk[1] = sphere_key(1e-3, 0, 0, 0.6, -1);
+  tk[2] = sphere_key(-0.2, 0.1, 0, 0.5, 1e-3);
+  memset(&ty, 0, sizeof ty);
+  o = build(tk, 3, 5e-4);
+  for (int r = 0; r < 60; r++) {
+    double ro[3], dd[3];
+    random_dir(dd);
+    for (int i = 0; i < 3; i++) ro[i] = (rnd() - 0.5) * 0.6 - 3 * dd[i];
+    compare_ray(tk, 3, o, 5e-4, ro, dd, 0, INFINITY, 1e-3, s, NULL, &ty);
+  }
+  report("nearly cancelling +1/-1 keys, magic 5e-4", &ty);
+  soft_free(o);
+  soft_scratch_free(s);
+}
+
+/* A crossing exactly at a bound event: key B's sphere of influence starts
+ * where key A's surface is, so the root sits on an interval boundary. */
+static void test_boundary_root(void)
+{
+  long double lo = 0, hi = 1;
+  for (int i = 0; i < 100; i++) {
+    long double m = 0.5L * (lo + hi);
+    long double cv = -4.0L / 9 * powl(m, 6) + 17.0L / 9 * powl(m, 4) - 22.0L / 9 * m * m + 1;
+    if (cv > 0.5L) lo = m; else hi = m;
+  }
+  double rs = (double)lo;  /* A (R = 1) crosses 0.5 at r = rs */
+  tkey tk[2] = {sphere_key(0, 0, 0, 1, 1), sphere_key(rs + 0.7, 0, 0, 0.7, 1)};
+  soft_obj *o = build(tk, 2, 0.5);
+  soft_scratch *s = soft_scratch_new(2);
+  double out[16], org[3] = {-3, 0, 0}, d[3] = {1, 0, 0};
+  int n = soft_roots(o, org, d, 0, INFINITY, out, 16, s, NULL);
+  int near = 0;
+  for (int i = 0; i < n; i++) if (fabs(out[i] - 3 - rs) < 1e-9) near++;
+  tally ty;
+  memset(&ty, 0, sizeof ty);
+  compare_ray(tk, 2, o, 0.5, org, d, 0, INFINITY, 1e-3, s, NULL, &ty);
+  report("root on an interval boundary", &ty);
+  /* the field is C1 there and decreasing through magic: one crossing, and
+   * then B's own surface is entered and left */
+  CHECK("root on an interval boundary reported exactly once (tol 1e-9)", near == 1);
+  soft_free(o);
+  soft_scratch_free(s);
+}
+
+/* Spatial index: cost follows the keys near the ray, and maxout / t0 / t1. */
+static void test_index_and_limits(void)
+{
+  int N = 20000;
+  soft_key *keys = calloc(N, sizeof *keys);
+  double L = 0.5 * cbrt((double)N);
+  for (int k = 0; k < N; k++) {
+    keys[k].kind = SOFT_SPHERE;
+    keys[k].c[0] = L * fmod(0.5 + k * 0.8191725134, 1.0);
+    keys[k].c[1] = L * fmod(0.5 + k * 0.6710436067, 1.0);
+    keys[k].c[2] = L * fmod(0.5 + k * 0.5497004779, 1.0);
+    keys[k].R = 0.6;
+    keys[k].w = 1;
+  }
+  soft_obj *o;
+  size_t bad;
+  CHECK("soft-cloud 20000 builds", soft_build(keys, N, 0.5, &o, &bad) == SOFT_OK);
+  soft_scratch *s = soft_scratch_new(N);
+  soft_stats st;
+  memset(&st, 0, sizeof st);
+  double org[3] = {-1, L / 2, L / 2}, d[3] = {1, 0.01, 0.02}, all[4096], first[4];
+  int na = soft_roots(o, org, d, 0, INFINITY, all, 4096, s, &st);
+  /* a straight line through the box meets about L * pi R^2 * density keys */
+  CHECK("index: a ray through the cloud touches < 2% of the keys", na > 0 && st.keys < N / 50);
+  int nf = soft_roots(o, org, d, 0, INFINITY, first, 1, s, NULL);
+  CHECK("maxout 1 returns the nearest crossing", nf == 1 && first[0] == all[0]);
+  /* clipping: rays through the cloud until one has >= 4 crossings */
+  int tried = 0, clip_ok = 0, state_ok = 0;
+  for (int r = 0; r < 200 && !tried; r++) {
+    double ro[3] = {-1, L * (0.2 + 0.6 * rnd()), L * (0.2 + 0.6 * rnd())};
+    double rd[3] = {1, 0.2 * (rnd() - 0.5), 0.2 * (rnd() - 0.5)};
+    na = soft_roots(o, ro, rd, 0, INFINITY, all, 4096, s, NULL);
+    if (na < 4) continue;
+    tried = 1;
+    double t0 = 0.5 * (all[1] + all[2]), t1 = 0.5 * (all[na - 2] + all[na - 1]), part[4096];
+    int np = soft_roots(o, ro, rd, t0, t1, part, 4096, s, NULL);
+    clip_ok = np == na - 3;
+    for (int i = 0; clip_ok && i < np; i++) clip_ok = fabs(part[i] - all[i + 2]) < 1e-9;  /* tol 1e-9 */
+    double p[3];
+    for (int i = 0; i < 3; i++) p[i] = ro[i] + t0 * rd[i];
+    state_ok = soft_field(o, p) > 0.5;  /* between crossings 1 and 2: outside */
+    state_ok = !state_ok;
+  }
+  CHECK("t0/t1 clip the crossings (tol 1e-9)", tried && clip_ok);
+  CHECK("state at t0 from soft_field agrees with crossing parity", tried && state_ok);
+  soft_scratch *small = soft_scratch_new(10);
+  CHECK("scratch too small is an error", soft_roots(o, org, d, 0, INFINITY, all, 4, small, NULL) == -1);
+  double z[3] = {0, 0, 0};
+  CHECK("zero direction is an error", soft_roots(o, org, z, 0, INFINITY, all, 4, s, NULL) == -1);
+  soft_scratch_free(small);
+  soft_scratch_free(s);
+  soft_free(o);
+  free(keys);
+}
+
+int main(void)
+{
+  check_prefix = "soft";
+  test_build();
+  test_field();
+  test_clouds();
+  test_helix();
+  test_magic_extremes();
+  test_boundary_root();
+  test_index_and_limits();
+  CHECK_DONE();
+}
