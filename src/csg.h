@@ -1,0 +1,99 @@
+/* csg.h: sharp CSG objects as flat tapes: point classification and the
+ * inside spans of a ray (Roth, "Ray Casting for Modelling Solids", 1982).
+ *
+ * Leaves are sharp halfspaces n.x < d (n normalised when the leaf is
+ * added) or the constants Empty and Everything; ops are Union,
+ * Intersection and Difference.  Constants are folded as the tape is
+ * built, and finishing reorders it (Sethi-Ullman) so evaluation needs at
+ * most CSG_STACK_MAX stack slots.  The bounds of bounds.h are csg tapes.
+ *
+ * Memory: csg_builder_new returns a builder owned by the caller, consumed
+ * by csg_builder_finish (always) or freed by csg_builder_free; the
+ * finished tape is owned by the caller and freed with csg_tape_free.  A
+ * finished tape is immutable and may be shared by threads.  Ray queries
+ * never allocate: they use a caller-provided scratch array of
+ * csg_scratch_spans(tape) spans (or, for small tapes, an internal one). */
+#ifndef QCS_CSG_H
+#define QCS_CSG_H
+
+#define CSG_STACK_MAX 64
+#define CSG_LOCAL_SPANS 256   /* internal scratch when the caller gives none */
+
+typedef enum {
+  CSG_PLANE,   /* planes[arg] */
+  CSG_EMPTY,
+  CSG_ALL,     /* everything */
+  CSG_UNION,
+  CSG_INTER,
+  CSG_DIFF,    /* x y -> x - y (y on top of the stack) */
+  CSG_RDIFF    /* x y -> y - x (made by the reordering) */
+} csg_op;
+
+enum { CSG_OK = 0, CSG_EPLANE, CSG_EOP, CSG_EUNBALANCED, CSG_ENOMEM };
+
+typedef struct csg_plane { double n[3], d; } csg_plane;
+typedef struct csg_instr { int op, arg; } csg_instr;
+
+typedef struct csg_tape {
+  int ncode;
+  csg_instr *code;
+  int nplanes;
+  csg_plane *planes;
+  int depth;     /* stack slots needed */
+  int nleaves;   /* planes and constants in the code */
+} csg_tape;
+
+/* One inside interval of a ray, t0 < t1.  id0/id1 name the plane whose
+ * surface bounds the span at t0/t1 (-1: the end of the query range or a
+ * constant); the solid's outward normal there is planes[id].n, negated
+ * when flip0/flip1 is set (a surface of a subtracted object). */
+typedef struct csg_span {
+  double t0, t1;
+  int id0, id1;
+  unsigned char flip0, flip1;
+} csg_span;
+
+typedef struct csg_builder csg_builder;
+
+csg_builder *csg_builder_new(void);
+/* Append the sharp halfspace n.x < d (n is normalised here). */
+int csg_builder_plane(csg_builder *b, const double n[3], double d);
+/* Append CSG_EMPTY or CSG_ALL. */
+int csg_builder_const(csg_builder *b, csg_op c);
+/* Append CSG_UNION, CSG_INTER, CSG_DIFF or CSG_RDIFF. */
+int csg_builder_op(csg_builder *b, csg_op op);
+csg_tape *csg_builder_finish(csg_builder *b, int *err);
+void csg_builder_free(csg_builder *b);
+void csg_tape_free(csg_tape *t);
+const char *csg_strerror(int err);
+
+/* Constant tapes (if the whole object folded to one). */
+int csg_is_empty(const csg_tape *t);
+int csg_is_all(const csg_tape *t);
+
+/* Point classification (Figure 4, PointInObject for sharp objects): 1 if
+ * p is strictly inside. */
+int csg_inside(const csg_tape *t, const double p[3]);
+
+/* Scratch spans a ray query on t needs. */
+int csg_scratch_spans(const csg_tape *t);
+
+/* The inside spans of the ray o + s*d for s in [s0, s1], sorted and
+ * disjoint, written to out (at most maxout).  d may have any non-zero
+ * length; rays parallel to a plane are classified by their origin.
+ * scratch may be NULL when csg_scratch_spans(t) <= CSG_LOCAL_SPANS.
+ * Returns the number of spans, or -1 if out or scratch is too small. */
+int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
+                  double s0, double s1, csg_span *out, int maxout,
+                  csg_span *scratch, int nscratch);
+
+/* Span-list set operations (Roth).  Inputs sorted and disjoint; out must
+ * hold na + nb spans.  Return the output count. */
+int csg_spans_union(const csg_span *a, int na, const csg_span *b, int nb,
+                    csg_span *out);
+int csg_spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
+                    csg_span *out);
+int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
+                   csg_span *out);
+
+#endif
