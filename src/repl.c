@@ -566,9 +566,11 @@ static char *command_generator(const char *text, int state) {
   return NULL;
 }
 
+/* Names from interp_complete, copied with malloc; names[next..n) are not
+   yet handed to readline, which frees the ones it gets. */
 typedef struct {
   char **names;
-  size_t n, cap;
+  size_t n, cap, next;
 } NameList;
 
 static NameList name_matches;
@@ -585,16 +587,18 @@ static void collect_name(const char *name, void *ud) {
   l->names[l->n++] = dup_or_die(name);
 }
 
-/* Hands each collected name to readline, which takes ownership. */
+static void names_clear(NameList *l) {
+  for (size_t k = l->next; k < l->n; k++) free(l->names[k]);
+  l->n = l->next = 0;
+}
+
 static char *name_generator(const char *text, int state) {
-  static size_t i;
+  NameList *l = &name_matches;
   if (state == 0) {
-    for (size_t k = i; k < name_matches.n; k++) free(name_matches.names[k]);
-    name_matches.n = 0;
-    i = 0;
-    interp_complete(completion_interp, text, collect_name, &name_matches);
+    names_clear(l);
+    interp_complete(completion_interp, text, collect_name, l);
   }
-  return i < name_matches.n ? name_matches.names[i++] : NULL;
+  return l->next < l->n ? l->names[l->next++] : NULL;
 }
 
 /* If line is ":CMD ..." with CMD naming :load, where its argument starts. */
@@ -749,7 +753,7 @@ static int run_terminal(Repl *R) {
   }
   feed_eof(R);
   history_close(R);
-  for (size_t k = 0; k < name_matches.n; k++) free(name_matches.names[k]);
+  names_clear(&name_matches);
   free(name_matches.names);
   name_matches = (NameList){0};
   fflush(stdout);
