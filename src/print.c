@@ -29,7 +29,7 @@ void format_real(char *buf, double x) {
     snprintf(tmp, sizeof tmp, "%.*e", prec - 1, x);
     if (strtod(tmp, NULL) == x) break;
   }
-  /* ... laid out as JavaScript does: plain for 1e-7 <= |x| < 1e21,
+  /* ... laid out as JavaScript does: plain for 1e-6 <= |x| < 1e21,
      otherwise with an exponent ("1e-12", "1.5e300"). */
   char digits[20];
   int nd = 0;
@@ -43,7 +43,7 @@ void format_real(char *buf, double x) {
   digits[nd] = 0;
   char *o = buf;
   if (neg) *o++ = '-';
-  if (exp10 >= 21 || exp10 < -7) {
+  if (exp10 >= 21 || exp10 < -6) {
     *o++ = digits[0];
     if (nd > 1) {
       *o++ = '.';
