@@ -15,6 +15,7 @@
 #include "eval.h"
 #include "parse.h"
 #include "print.h"
+#include "probes.h"
 
 #include "prelude.inc"
 
@@ -513,6 +514,7 @@ Interp *interp_new(void) {
   I->v_nil = GC_MALLOC(sizeof(Value));
   I->v_nil->kind = V_NIL;
   builtins_install(I);
+  probes_install(I);
   I->loading_prelude = 1;
   RunStatus st = interp_run_string(I, "<prelude>", qcs_prelude_source,
                                    MODE_SCRIPT);

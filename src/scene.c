@@ -1,0 +1,406 @@
+/* scene.c: compiling constructor trees into scenes. See scene.h. */
+#include "scene.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "eval.h"
+
+/* The constructors a scene is made of, recognised by name. */
+typedef enum {
+  K_NONE, K_UNION, K_INTER, K_SETDIFF, K_ROUNDED, K_HALFSPACE, K_SUM,
+  K_PRODUCT, K_DIFFERENCE, K_DHALFSPACE, K_RHALFSPACE, K_DUNION, K_SOFT,
+  K_KEY, K_QKEY, K_COLOUR
+} ConKind;
+
+static const struct {
+  const char *name;
+  ConKind kind;
+} con_names[] = {
+    {"Union", K_UNION},           {"Intersection", K_INTER},
+    {"SetDifference", K_SETDIFF}, {"Rounded", K_ROUNDED},
+    {"Halfspace", K_HALFSPACE},   {"Sum", K_SUM},
+    {"Product", K_PRODUCT},       {"Difference", K_DIFFERENCE},
+    {"DensityHalfspace", K_DHALFSPACE}, {"RoundedHalfspace", K_RHALFSPACE},
+    {"DensityUnion", K_DUNION},   {"SoftObject", K_SOFT},
+    {"Key", K_KEY},               {"QuadricKey", K_QKEY},
+    {"Colour", K_COLOUR},
+};
+
+static ConKind con_kind(Value *v) {
+  if (v->kind != V_CON) return K_NONE;
+  const char *name = v->u.con.con->name;
+  for (size_t i = 0; i < sizeof con_names / sizeof *con_names; i++)
+    if (!strcmp(name, con_names[i].name)) return con_names[i].kind;
+  return K_NONE;
+}
+
+static int is_density_kind(ConKind k) {
+  return k == K_SUM || k == K_PRODUCT || k == K_DIFFERENCE ||
+         k == K_DHALFSPACE || k == K_RHALFSPACE || k == K_DUNION;
+}
+
+typedef struct Compile {
+  Interp *I;
+  Scene *s;
+  dt_builder *db;     /* while compiling a density tree */
+  Pos pos;            /* position of the enclosing constructor */
+} Compile;
+
+static Pos vpos(Compile *C, Value *v) {
+  return v->kind == V_CON && v->u.con.pos ? *v->u.con.pos : C->pos;
+}
+
+static _Noreturn void not_a(Compile *C, Value *v, const char *want) {
+  char buf[200];
+  val_brief(v, buf, sizeof buf);
+  qcs_error(vpos(C, v), "%s is needed here, not %s: %s", want,
+            val_describe(v), buf);
+}
+
+/* A plane (n, d): n a 3-tuple, not zero, everything finite. */
+static void get_plane(Compile *C, Value *v, Pos pos, double n[3], double *d) {
+  v = force(C->I, v);
+  if (v->kind != V_TUPLE || v->u.tup.n != 2) {
+    char buf[160];
+    val_brief(v, buf, sizeof buf);
+    qcs_error(pos, "a plane is (normal, offset), like ((0, 1, 0), 0); "
+              "not %s", buf);
+  }
+  force_vec3(C->I, v->u.tup.items[0], pos, "the normal of a plane", n);
+  *d = force_num(C->I, v->u.tup.items[1], pos, "the offset of a plane");
+  if (!isfinite(n[0]) || !isfinite(n[1]) || !isfinite(n[2]) || !isfinite(*d))
+    qcs_error(pos, "a plane needs finite numbers, not ((%g, %g, %g), %g)",
+              n[0], n[1], n[2], *d);
+  if (n[0] == 0 && n[1] == 0 && n[2] == 0)
+    qcs_error(pos, "the normal of a plane cannot be zero");
+  double len = hypot(hypot(n[0], n[1]), n[2]);
+  if (!isfinite(len)) { /* rescale before normalising huge normals */
+    double m = fmax(fabs(n[0]), fmax(fabs(n[1]), fabs(n[2])));
+    for (int i = 0; i < 3; i++) n[i] /= m;
+    *d /= m;
+  }
+}
+
+static double get_radius(Compile *C, Value *v, Pos pos) {
+  double r = force_num(C->I, v, pos, "a radius");
+  if (!isfinite(r) || r < 0)
+    qcs_error(pos, "a radius must be finite and >= 0, not %g", r);
+  return r;
+}
+
+/* ---- density trees ---- */
+
+static void dt_check(Compile *C, int err, Pos pos) {
+  if (err) qcs_error(pos, "%s", dt_strerror(err));
+}
+
+/* Emits the density tree v in postfix order into C->db. */
+static void emit_density(Compile *C, Value *v, double r) {
+  eval_check(C->I, C->pos);
+  v = force(C->I, v);
+  ConKind k = con_kind(v);
+  Pos pos = vpos(C, v);
+  Value **a = v->kind == V_CON ? v->u.con.args : NULL;
+  dt_op op;
+  switch (k) {
+  case K_SUM: op = DT_SUM; break;
+  case K_PRODUCT: case K_INTER: op = DT_PRODUCT; break;
+  case K_DIFFERENCE: op = DT_DIFF; break;
+  case K_DUNION: case K_UNION: op = DT_UNION; break;
+  case K_DHALFSPACE: case K_HALFSPACE: {
+    double n[3], d;
+    get_plane(C, a[0], pos, n, &d);
+    dt_check(C, dt_builder_leaf(C->db, n, d, r), pos);
+    return;
+  }
+  case K_RHALFSPACE: {
+    double rr = get_radius(C, a[0], pos);
+    double n[3], d;
+    get_plane(C, a[1], pos, n, &d);
+    dt_check(C, dt_builder_leaf(C->db, n, d, rr), pos);
+    return;
+  }
+  case K_SETDIFF:
+    qcs_error(pos, "SetDifference is a scene operation; inside a density "
+              "tree use Difference (density subtraction)");
+  case K_ROUNDED:
+    qcs_error(pos, "Rounded inside a density tree: the radius is given once, "
+              "by the outer Rounded (use RoundedHalfspace r plane for a "
+              "radius per plane)");
+  case K_SOFT:
+    qcs_error(pos, "a soft object cannot be part of a density tree; combine "
+              "it with Union, Intersection or SetDifference");
+  case K_COLOUR:
+    qcs_error(pos, "Colour belongs outside a density tree: Colour c "
+              "(Rounded r tree)");
+  default:
+    not_a(C, v, "a density tree (Sum, Product, Difference, DensityHalfspace, "
+          "...)");
+  }
+  emit_density(C, a[0], r);
+  emit_density(C, a[1], r);
+  dt_check(C, dt_builder_op(C->db, op), pos);
+}
+
+static dt_tape *density_tape(Compile *C, Value *tree, double r, Pos pos) {
+  C->db = dt_builder_new();
+  if (!C->db) qcs_error(pos, "out of memory");
+  /* The builder must not leak if an error unwinds: free it on the way. */
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    emit_density(C, tree, r);
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    dt_builder_free(C->db);
+    C->db = NULL;
+    ErrInfo e = *err_info();
+    qcs_error(e.pos, "%s", e.msg);
+  }
+  int err = 0;
+  dt_tape *t = dt_builder_finish(C->db, &err);
+  C->db = NULL;
+  if (!t) qcs_error(pos, "%s", dt_strerror(err));
+  return t;
+}
+
+dt_tape *scene_density_tape(Interp *I, Value *tree, double r, Pos pos) {
+  Compile C = {I, NULL, NULL, pos};
+  if (!isfinite(r) || r < 0)
+    qcs_error(pos, "a radius must be finite and >= 0, not %g", r);
+  return density_tape(&C, tree, r, pos);
+}
+
+/* ---- scene objects ---- */
+
+static int add_node(Compile *C, ScKind kind, Pos pos) {
+  Scene *s = C->s;
+  if (s->n == s->cap) {
+    int cap = s->cap ? s->cap * 2 : 16;
+    ScNode *nodes = realloc(s->nodes, sizeof(ScNode) * (size_t)cap);
+    if (!nodes) qcs_error(pos, "out of memory");
+    s->nodes = nodes;
+    s->cap = cap;
+  }
+  ScNode *n = &s->nodes[s->n];
+  memset(n, 0, sizeof *n);
+  n->kind = kind;
+  n->pos = pos;
+  n->a = n->b = -1;
+  return s->n++;
+}
+
+static int compile_obj(Compile *C, Value *v);
+
+static int set_node(Compile *C, ScKind kind, Pos pos, int a, int b) {
+  int i = add_node(C, kind, pos);
+  C->s->nodes[i].a = a;
+  C->s->nodes[i].b = b;
+  return i;
+}
+
+/* A density tree with no radius: the sharp polyhedron it describes. */
+static int compile_sharp(Compile *C, Value *v) {
+  eval_check(C->I, C->pos);
+  v = force(C->I, v);
+  ConKind k = con_kind(v);
+  Pos pos = vpos(C, v);
+  Value **a = v->kind == V_CON ? v->u.con.args : NULL;
+  switch (k) {
+  case K_SUM: case K_DUNION: case K_UNION:
+    return set_node(C, SC_UNION, pos, compile_sharp(C, a[0]),
+                    compile_sharp(C, a[1]));
+  case K_PRODUCT: case K_INTER:
+    return set_node(C, SC_INTER, pos, compile_sharp(C, a[0]),
+                    compile_sharp(C, a[1]));
+  case K_DIFFERENCE: case K_SETDIFF:
+    return set_node(C, SC_DIFF, pos, compile_sharp(C, a[0]),
+                    compile_sharp(C, a[1]));
+  case K_DHALFSPACE: case K_HALFSPACE: {
+    double n[3], d;
+    get_plane(C, a[0], pos, n, &d);
+    int i = add_node(C, SC_HALFSPACE, pos);
+    double len = hypot(hypot(n[0], n[1]), n[2]);
+    for (int j = 0; j < 3; j++) C->s->nodes[i].n[j] = n[j] / len;
+    C->s->nodes[i].d = d / len;
+    C->s->flags |= SCENE_HAS_HALFSPACE;
+    return i;
+  }
+  default:
+    return compile_obj(C, v);
+  }
+}
+
+static int all_sharp(const dt_tape *t) { return t->rmax == 0; }
+
+static int compile_soft(Compile *C, Value *v, Pos pos) {
+  Interp *I = C->I;
+  double magic = force_num(I, v->u.con.args[0], pos, "the magic value of a "
+                           "SoftObject");
+  size_t cap = 64, n = 0;
+  soft_key *keys = malloc(sizeof *keys * cap);
+  if (!keys) qcs_error(pos, "out of memory");
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    Value *l = force(I, v->u.con.args[1]);
+    while (l->kind == V_CONS) {
+      eval_check(I, pos);
+      Value *k = force(I, l->u.cons.head);
+      ConKind kk = con_kind(k);
+      Pos kpos = vpos(C, k);
+      if (n == cap) {
+        soft_key *nk = realloc(keys, sizeof *keys * (cap *= 2));
+        if (!nk) qcs_error(pos, "out of memory");
+        keys = nk;
+      }
+      soft_key *key = &keys[n];
+      memset(key, 0, sizeof *key);
+      if (kk == K_KEY) {
+        key->kind = SOFT_SPHERE;
+        force_vec3(I, k->u.con.args[0], kpos, "the centre of a Key", key->c);
+      } else if (kk == K_QKEY) {
+        key->kind = SOFT_QUADRIC;
+        Value *m = force(I, k->u.con.args[0]);
+        if (m->kind != V_TUPLE || m->u.tup.n != 4)
+          qcs_error(kpos, "the matrix of a QuadricKey is four 4-tuples");
+        for (int r = 0; r < 4; r++) {
+          Value *row = force(I, m->u.tup.items[r]);
+          if (row->kind != V_TUPLE || row->u.tup.n != 4)
+            qcs_error(kpos, "the matrix of a QuadricKey is four 4-tuples");
+          for (int c = 0; c < 4; c++)
+            key->m[r][c] = force_num(I, row->u.tup.items[c], kpos,
+                                     "a QuadricKey matrix entry");
+        }
+      } else {
+        not_a(C, k, "a key (Key centre R weight or QuadricKey m R weight)");
+      }
+      key->R = force_num(I, k->u.con.args[1], kpos, "the radius of a key");
+      key->w = force_num(I, k->u.con.args[2], kpos, "the weight of a key");
+      if (!(key->R > 0) || !isfinite(key->R))
+        qcs_error(kpos, "a key's radius must be finite and > 0, not %g",
+                  key->R);
+      n++;
+      l = force(I, l->u.cons.tail);
+    }
+    if (l->kind != V_NIL) not_a(C, l, "a list of keys");
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    free(keys);
+    ErrInfo e = *err_info();
+    qcs_error(e.pos, "%s", e.msg);
+  }
+  soft_obj *obj = NULL;
+  size_t bad = 0;
+  int err = soft_build(keys, n, magic, &obj, &bad);
+  free(keys);
+  if (err) {
+    if (bad < n)
+      qcs_error(pos, "key %zu of this SoftObject: %s", bad + 1,
+                soft_strerror(err));
+    qcs_error(pos, "%s", soft_strerror(err));
+  }
+  int i = add_node(C, SC_SOFT, pos);
+  C->s->nodes[i].soft = obj;
+  C->s->flags |= SCENE_HAS_SOFT;
+  if (n > C->s->max_keys) C->s->max_keys = n;
+  return i;
+}
+
+static int compile_obj(Compile *C, Value *v) {
+  eval_check(C->I, C->pos);
+  v = force(C->I, v);
+  ConKind k = con_kind(v);
+  Pos pos = vpos(C, v);
+  Value **a = v->kind == V_CON ? v->u.con.args : NULL;
+  switch (k) {
+  case K_UNION:
+    return set_node(C, SC_UNION, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
+  case K_INTER:
+    return set_node(C, SC_INTER, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
+  case K_SETDIFF:
+    return set_node(C, SC_DIFF, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
+  case K_HALFSPACE:
+    return compile_sharp(C, v);
+  case K_ROUNDED: {
+    double r = get_radius(C, a[0], pos);
+    dt_tape *t = density_tape(C, a[1], r, pos);
+    if (all_sharp(t)) { /* Rounded 0 t: exactly the sharp polyhedron */
+      dt_tape_free(t);
+      return compile_sharp(C, a[1]);
+    }
+    int i = add_node(C, SC_ROUNDED, pos);
+    C->s->nodes[i].tape = t;
+    C->s->flags |= SCENE_HAS_ROUNDED;
+    if (dt_max(t) > 1) C->s->ill_formed = 1;
+    return i;
+  }
+  case K_SOFT:
+    return compile_soft(C, v, pos);
+  case K_COLOUR: {
+    double c[3];
+    force_vec3(C->I, a[0], pos, "the colour (r, g, b)", c);
+    for (int j = 0; j < 3; j++)
+      if (!isfinite(c[j]) || c[j] < 0)
+        qcs_error(pos, "colour components must be finite and >= 0");
+    int i = compile_obj(C, a[1]);
+    if (!C->s->nodes[i].has_colour) {
+      C->s->nodes[i].has_colour = 1;
+      memcpy(C->s->nodes[i].colour, c, sizeof c);
+    }
+    return i;
+  }
+  default:
+    if (is_density_kind(k)) return compile_sharp(C, v);
+    not_a(C, v, "a scene object (Union, Intersection, SetDifference, "
+          "Rounded, Halfspace, SoftObject, or a density tree)");
+  }
+}
+
+void scene_free(Scene *s) {
+  if (!s) return;
+  for (int i = 0; i < s->n; i++) {
+    if (s->nodes[i].tape) dt_tape_free(s->nodes[i].tape);
+    if (s->nodes[i].soft) soft_free(s->nodes[i].soft);
+  }
+  free(s->nodes);
+  free(s);
+}
+
+Scene *scene_compile(Interp *I, Value *obj, Pos pos) {
+  Scene *s = calloc(1, sizeof *s);
+  if (!s) qcs_error(pos, "out of memory");
+  Compile C = {I, s, NULL, pos};
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    s->root = compile_obj(&C, obj);
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    scene_free(s);
+    ErrInfo e = *err_info();
+    qcs_error(e.pos, "%s", e.msg);
+  }
+  return s;
+}
+
+int scene_inside(const Scene *s, int node, const double p[3]) {
+  const ScNode *n = &s->nodes[node];
+  switch (n->kind) {
+  case SC_HALFSPACE:
+    return n->n[0] * p[0] + n->n[1] * p[1] + n->n[2] * p[2] < n->d;
+  case SC_ROUNDED:
+    return dt_density(n->tape, p) > 0.5;
+  case SC_SOFT:
+    return soft_field(n->soft, p) > soft_magic(n->soft);
+  case SC_UNION:
+    return scene_inside(s, n->a, p) || scene_inside(s, n->b, p);
+  case SC_INTER:
+    return scene_inside(s, n->a, p) && scene_inside(s, n->b, p);
+  case SC_DIFF:
+    return scene_inside(s, n->a, p) && !scene_inside(s, n->b, p);
+  }
+  return 0;
+}
