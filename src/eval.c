@@ -89,7 +89,53 @@ static Value *mk_thunk(Expr *e, Env *env) {
   return v;
 }
 
+/* Cheap eagerness: the value of e if it is arithmetic on Reals that are
+   already known (literals, variables bound to evaluated Reals). Computing
+   it now cannot fail or loop, so laziness is unchanged, and an accumulator
+   such as `count (n - 1) (acc + 1)` stays a number instead of growing a
+   chain of a million thunks that would then be forced recursively. */
+static int known_num(Interp *I, Expr *e, Env *env, double *out) {
+  switch (e->kind) {
+  case E_NUM:
+    *out = e->u.num;
+    return 1;
+  case E_VAR: {
+    Value *v = NULL;
+    for (Env *f = env; f && !v; f = f->up)
+      for (int i = f->n - 1; i >= 0; i--)
+        if (f->names[i] == e->u.var) {
+          v = f->vals[i];
+          break;
+        }
+    if (!v || v->kind != V_NUM) return 0;
+    *out = v->u.num;
+    return 1;
+  }
+  case E_NEG:
+    if (!known_num(I, e->u.neg, env, out)) return 0;
+    *out = -*out;
+    return 1;
+  case E_BINOP: {
+    double a, b;
+    TokKind op = e->u.bin.op;
+    if (op != T_PLUS && op != T_MINUS && op != T_STAR && op != T_SLASH &&
+        op != T_CARET)
+      return 0;
+    if (!known_num(I, e->u.bin.a, env, &a) || !known_num(I, e->u.bin.b, env, &b))
+      return 0;
+    *out = op == T_PLUS ? a + b : op == T_MINUS ? a - b : op == T_STAR ? a * b
+         : op == T_SLASH ? a / b : pow(a, b);
+    return 1;
+  }
+  default:
+    return 0;
+  }
+}
+
 Value *delay(Interp *I, Expr *e, Env *env) {
+  double x;
+  if ((e->kind == E_BINOP || e->kind == E_NEG) && known_num(I, e, env, &x))
+    return val_num(x);
   switch (e->kind) {
   case E_NUM: return val_num(e->u.num);
   case E_STR: return val_str(e->u.str);
