@@ -51,6 +51,7 @@ struct soft_scratch {
   hent_t *nheap;   /* BVH nodes by entry, 2 cap */
   kev_t *kheap;    /* discovered keys by entry, cap */
   kev_t *act;      /* active keys, cap */
+  double *sq;      /* s(v) coefficients of the active keys, 3 cap */
 };
 
 static double cfield(double s)
@@ -338,7 +339,8 @@ soft_scratch *soft_scratch_new(size_t max_keys)
   s->nheap = malloc((2 * cap + 2) * sizeof *s->nheap);
   s->kheap = malloc(cap * sizeof *s->kheap);
   s->act = malloc(cap * sizeof *s->act);
-  if (!s->nheap || !s->kheap || !s->act) { soft_scratch_free(s); return NULL; }
+  s->sq = malloc(3 * cap * sizeof *s->sq);
+  if (!s->nheap || !s->kheap || !s->act || !s->sq) { soft_scratch_free(s); return NULL; }
   return s;
 }
 
@@ -348,6 +350,7 @@ void soft_scratch_free(soft_scratch *s)
   free(s->nheap);
   free(s->kheap);
   free(s->act);
+  free(s->sq);
   free(s);
 }
 
@@ -440,23 +443,45 @@ static int hit_key(const ray_t *r, const skey_t *k, double *te, double *tx)
   return *tx > r->ta && *te < r->tb;
 }
 
-/* eq. (4) about the interval's midpoint: the sum over the active keys of
- * w C(s(v)) - magic as a sextic in v, t = tm + h v, v in [-1, 1]. Returns
- * an upper bound on the field over the interval from the positive keys. */
-static double interval_poly(const soft_obj *o, const ray_t *r, const kev_t *act,
-                            int nact, double tm, double h, double *c)
+/* eq. (3) for each active key along the interval [tm - h, tm + h]: s(v) =
+ * s0 + s1 v + s2 v^2 with t = tm + h v, built from the key's offset at the
+ * midpoint, so it stays well conditioned however far the interval lies from
+ * the ray origin. Also bounds the field over the interval: C falls as s
+ * grows, and s is convex in v, so each key's field lies between C at the
+ * largest s (an end) and C at the smallest. */
+static void interval_s(const soft_obj *o, const ray_t *r, const kev_t *act,
+                       int nact, double tm, double h, double *sq,
+                       double *flo, double *fhi)
 {
   double x[3] = {r->o[0] + tm * r->d[0], r->o[1] + tm * r->d[1], r->o[2] + tm * r->d[2]};
-  double w0 = 0, w1[3] = {0, 0, 0}, w2[5] = {0, 0, 0, 0, 0}, w3[7] = {0};
-  double up = 0;
+  double lo = 0, hi = 0, wsum = 0;
   for (int j = 0; j < nact; j++) {
     const skey_t *k = &o->keys[act[j].i];
     double p[3] = {x[0] - k->x0[0], x[1] - k->x0[1], x[2] - k->x0[2]}, ap[3], ad[3];
     double s0 = key_s(k, p, ap);
     apply_a(k, r->d, ad);
     double s1 = 2 * h * dot3(r->d, ap), s2 = h * h * dot3(r->d, ad);
-    double w = k->w;
-    if (w > 0) up += w * k->cmax;
+    sq[3 * j] = s0; sq[3 * j + 1] = s1; sq[3 * j + 2] = s2;
+    double smax = s0 + fabs(s1) + s2;
+    double smin = fabs(s1) < 2 * s2 ? s0 - s1 * s1 / (4 * s2) : s0 - fabs(s1) + s2;
+    double cl = cfield(smax), ch = cfield(smin), w = k->w;
+    if (w > 0) { lo += w * cl; hi += w * ch; }
+    else { lo += w * ch; hi += w * cl; }
+    wsum += fabs(w);
+  }
+  *flo = lo - 1e-12 * wsum;  /* margin for the rounding of s and C */
+  *fhi = hi + 1e-12 * wsum;
+}
+
+/* eq. (4): the weighted sum of C(s(v)) over the active keys, minus magic,
+ * as a sextic in v in [-1, 1]. */
+static void interval_poly(const soft_obj *o, const kev_t *act, int nact,
+                          const double *sq, double *c)
+{
+  double w0 = 0, w1[3] = {0, 0, 0}, w2[5] = {0, 0, 0, 0, 0}, w3[7] = {0};
+  for (int j = 0; j < nact; j++) {
+    double w = o->keys[act[j].i].w;
+    double s0 = sq[3 * j], s1 = sq[3 * j + 1], s2 = sq[3 * j + 2];
     /* s^2 and s^3 of s = s0 + s1 v + s2 v^2 */
     double q0 = s0 * s0, q1 = 2 * s0 * s1, q2 = s1 * s1 + 2 * s0 * s2,
            q3 = 2 * s1 * s2, q4 = s2 * s2;
@@ -478,9 +503,15 @@ static double interval_poly(const soft_obj *o, const ray_t *r, const kev_t *act,
   c[4] = A2 * w2[4] + A3 * w3[4];
   c[5] = A3 * w3[5];
   c[6] = A3 * w3[6];
-  return up;
 }
 
+/* The paper's algorithm: 1. find the intersections with the keys' bounds
+ * and order them along the ray; 2. solve eq. (4) for f = magic in each
+ * interval; 3. keep the solutions inside it. Bounds are discovered front to
+ * back from the BVH: an interval is solved only once every node that could
+ * hold a key entering before its end has been opened. The state (inside or
+ * not) at each interval boundary is computed once and imposed on both
+ * neighbours, so a root on a boundary is found once. */
 int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
                double t0, double t1, double *out, int maxout,
                soft_scratch *scratch, soft_stats *stats)
@@ -497,6 +528,8 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
     if (!(len > 0) || !isfinite(len)) return -1;
   }
   if (scratch->cap < obj->nkeys) return -1;
+  if (!isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]) || t0 != t0 || t1 != t1)
+    return -1;
   if (maxout <= 0 || obj->nkeys == 0 || !(t0 < t1)) return 0;
 
   /* Work in units of length along the unit direction (tau = t |d|). */
@@ -554,13 +587,21 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
       double tm = 0.5 * (cur + tnext), h = 0.5 * (tnext - cur), c[7];
       stats->intervals++;
       iv++;
-      double up = interval_poly(obj, &r, act, na, tm, h, c);
-      if (state < 0) state = poly_eval(c, 6, -1.0, NULL) > 0;
-      double s1 = fabs(c[1]) + fabs(c[2]) + fabs(c[3]) + fabs(c[4]) + fabs(c[5]) + fabs(c[6]);
-      if (up <= obj->magic && state == 0) {
-        stats->skipped++;  /* the positive keys cannot reach magic */
-      } else if (fabs(c[0]) > s1 * (1 + 1e-12) + 1e-300 && (c[0] > 0) == state) {
-        stats->skipped++;  /* |p(v) - p(0)| < |p(0)| on [-1, 1] */
+      double flo, fhi;
+      int settled = 0;  /* no crossing possible in the interval */
+      interval_s(obj, &r, act, na, tm, h, scratch->sq, &flo, &fhi);
+      if (state < 0 && (flo > obj->magic || fhi <= obj->magic)) state = flo > obj->magic;
+      if ((fhi <= obj->magic && state == 0) || (flo > obj->magic && state == 1))
+        settled = 1;  /* the field stays on one side of magic */
+      if (!settled) {
+        interval_poly(obj, act, na, scratch->sq, c);
+        if (state < 0) state = poly_eval(c, 6, -1.0, NULL) > 0;
+        double s1 = fabs(c[1]) + fabs(c[2]) + fabs(c[3]) + fabs(c[4]) + fabs(c[5]) + fabs(c[6]);
+        if (fabs(c[0]) > s1 * (1 + 1e-12) + 1e-300 && (c[0] > 0) == state)
+          settled = 1;  /* |p(v) - p(0)| < |p(0)| on [-1, 1] */
+      }
+      if (settled) {
+        stats->skipped++;
       } else {
         int sb = poly_eval(c, 6, 1.0, NULL) > 0;
         double v[POLY_MAX_DEG];

@@ -87,7 +87,8 @@ void soft_scratch_free(soft_scratch *s);
 
 /* The crossings of the surface by the ray o + t d, t0 < t < t1 (t1 may be
  * INFINITY), ascending, into out[0..maxout-1]; returns their number, or -1
- * if d is zero or not finite or the scratch is too small. d may have any
+ * if d is zero or not finite, o or t0/t1 is NaN, or the scratch is too
+ * small. d may have any
  * length. Crossings alternate between entering and leaving; the state
  * before the first is that of o + t0 d (inside iff soft_field > magic).
  * Touches (even-multiplicity roots) are not reported. The search runs

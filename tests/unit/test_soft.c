@@ -610,6 +610,51 @@ static void test_boundary_root(void)
   soft_scratch_free(s);
 }
 
+/* Tangent rays: a ray at distance y from a lone key's centre meets its
+ * sphere of radius r* (C = magic) where x = +-sqrt(r*^2 - y^2). Grazing
+ * rays give nearly double roots, which the polynomial solver must resolve
+ * (or, exactly tangent, may drop as a touch). */
+static void test_tangent(void)
+{
+  long double lo = 0, hi = 1;
+  for (int i = 0; i < 100; i++) {
+    long double m = 0.5L * (lo + hi);
+    long double cv = -4.0L / 9 * powl(m, 6) + 17.0L / 9 * powl(m, 4) - 22.0L / 9 * m * m + 1;
+    if (cv > 0.5L) lo = m; else hi = m;
+  }
+  long double rs = lo;
+  tkey tk[1] = {sphere_key(0, 0, 0, 1, 1)};
+  soft_obj *o = build(tk, 1, 0.5);
+  soft_scratch *s = soft_scratch_new(1);
+  soft_stats st;
+  memset(&st, 0, sizeof st);
+  static const double eps[] = {-1e-3, -1e-6, -1e-9, -1e-12, 0, 1e-12, 1e-9, 1e-6};
+  int bad = 0;
+  for (unsigned k = 0; k < sizeof eps / sizeof eps[0]; k++) {
+    double y = (double)(rs * (1 + eps[k])), out[8];
+    double org[3] = {-3, y, 0}, d[3] = {1, 0, 0};
+    int n = soft_roots(o, org, d, 0, INFINITY, out, 8, s, &st);
+    long double disc = rs * rs - (long double)y * y;
+    if (eps[k] > 0) { if (n != 0) bad++; continue; }
+    if (eps[k] == 0) {  /* touch: dropped, or a pair within 1e-7 of x = 0 */
+      if (!(n == 0 || (n == 2 && fabs(out[0] - 3) < 1e-7 && fabs(out[1] - 3) < 1e-7))) bad++;
+      continue;
+    }
+    double x = (double)sqrtl(disc);
+    /* tolerance: rounding 1e-16 of the field over the slope |C'| x / r* */
+    double tol = 1e-15 / x + 1e-15;
+    if (n != 2 || fabs(out[0] - (3 - x)) > tol || fabs(out[1] - (3 + x)) > tol) {
+      bad++;
+      printf("# tangent eps %g: n %d (%.17g %.17g) want +-%.17g tol %g\n", eps[k], n,
+             n > 0 ? out[0] - 3 : 0, n > 1 ? out[1] - 3 : 0, x, tol);
+    }
+  }
+  CHECK("grazing rays: pairs resolved down to 1e-12 of tangency, none beyond", bad == 0);
+  CHECK("grazing rays exercise the cascade fallback", st.poly.fallbacks > 0);
+  soft_scratch_free(s);
+  soft_free(o);
+}
+
 /* Spatial index: cost follows the keys near the ray, and maxout / t0 / t1. */
 static void test_index_and_limits(void)
 {
@@ -674,6 +719,7 @@ int main(void)
   test_helix();
   test_magic_extremes();
   test_boundary_root();
+  test_tangent();
   test_index_and_limits();
   CHECK_DONE();
 }
