@@ -1,0 +1,232 @@
+/* test_lang.c: unit tests of the lexer, the parser, the evaluator and the
+ * printer, through their C interfaces. */
+#include <gc.h>
+#include <stdint.h>
+
+#include "check.h"
+#include "eval.h"
+#include "interp.h"
+#include "lex.h"
+#include "parse.h"
+#include "print.h"
+
+static Interp *I;
+
+static Src mksrc(const char *text) { return (Src){"<test>", text}; }
+
+/* Lexes text; returns the token count or -1 on a lexical error. */
+static int lex(const char *text, Token **toks) {
+  static Src src;
+  src = mksrc(text);
+  ErrFrame f;
+  int n = -1;
+  if (ERR_TRY(f)) {
+    *toks = lex_all(&src, &n);
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+  }
+  return n;
+}
+
+static void test_lexer(void) {
+  Token *t;
+  int n = lex("f1' x = [1..5] \\\\ \\y -> y", &t);
+  CHECK("lex: token count", n == 14);
+  if (n == 14) {
+    CHECK("lex: primed name", t[0].kind == T_NAME && t[0].len == 3);
+    CHECK("lex: 1..5 is NUM DOTDOT NUM",
+          t[4].kind == T_NUM && t[5].kind == T_DOTDOT && t[6].kind == T_NUM &&
+              t[4].num == 1 && t[6].num == 5);
+    CHECK("lex: \\\\ and \\", t[8].kind == T_BACKSLASH2 && t[9].kind == T_LAMBDA);
+    CHECK("lex: -> ", t[11].kind == T_ARROW);
+    CHECK("lex: eof", t[13].kind == T_EOF);
+  }
+  n = lex("a\n  b /* c\n */ d\n\te f", &t);
+  CHECK("lex: comments skipped", n == 6);
+  if (n == 6) {
+    CHECK("lex: line and column", t[1].pos.line == 2 && t[1].pos.col == 3);
+    CHECK("lex: begins line (a comment is not a token)",
+          t[0].bol && t[1].bol && t[2].bol && t[3].bol);
+    CHECK("lex: tab to column 9", t[3].pos.col == 9);
+    CHECK("lex: second token on a line", !t[4].bol);
+  }
+  n = lex("1e-3 0.07 2.5e+2 \"a\\n\\\"b\"", &t);
+  CHECK("lex: numbers and strings", n == 5 && t[0].num == 1e-3 &&
+                                        t[1].num == 0.07 && t[2].num == 250 &&
+                                        !strcmp(t[3].str, "a\n\"b"));
+  CHECK("lex: unterminated string is an error", lex("x = \"abc", &t) < 0 &&
+                                                   err_info()->pos.col == 5);
+  CHECK("lex: unterminated comment is incomplete",
+        lex("/* a", &t) < 0 && err_info()->incomplete);
+  CHECK("lex: huge literal is an error", lex("1e400", &t) < 0);
+  CHECK("lex: tiny literal is an error", lex("1e-400", &t) < 0);
+  CHECK("lex: invalid UTF-8 is an error", lex("\xff", &t) < 0);
+  CHECK("lex: UTF-8 in a comment is fine", lex("// \xc3\xa9t\xc3\xa9\n1", &t) == 2);
+}
+
+static int parse(const char *text, RunMode mode, Item ***items) {
+  static Src src;
+  src = mksrc(text);
+  ErrFrame f;
+  int n = -1;
+  if (ERR_TRY(f)) {
+    *items = parse_program(I, &src, mode, &n);
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+  }
+  return n;
+}
+
+static void test_parser(void) {
+  Item **it;
+  int n = parse("f 0 = 1;\nf n = n * f (n - 1);\nf 3\n", MODE_SCRIPT, &it);
+  CHECK("parse: clauses merge into one definition", n == 2);
+  if (n == 2) {
+    CHECK("parse: two clauses", it[0]->kind == ITEM_DEF &&
+                                    it[0]->def->nclauses == 2 &&
+                                    it[0]->def->arity == 1);
+    CHECK("parse: expression item", it[1]->kind == ITEM_EXPR);
+  }
+  n = parse("a = 1\nb = 2\nc = a +\n  b\n", MODE_SCRIPT, &it);
+  CHECK("parse: column 1 starts a new item, indented lines continue", n == 3);
+  n = parse("g x\n  | x > 0 = 1\n  | otherwise = 2\nwhere\n  y = 3\n  z = 4\nh = 5\n",
+            MODE_SCRIPT, &it);
+  CHECK("parse: guards and a where block at column 1", n == 2);
+  if (n == 2)
+    CHECK("parse: where bindings", it[0]->def->clauses[0]->nwhere == 2 &&
+                                       it[0]->def->clauses[0]->nbodies == 2);
+  n = parse(":: T = A Real | B T T | C;\n:: S = T;\n", MODE_SCRIPT, &it);
+  CHECK("parse: type declaration and synonym", n == 2 && it[0]->ncons == 3 &&
+                                                  it[0]->cons[1].arity == 2 &&
+                                                  it[1]->ncons == 0);
+  n = parse("f x = (x +", MODE_REPL, &it);
+  CHECK("parse: open bracket at the end is incomplete",
+        n < 0 && err_info()->incomplete);
+  n = parse("f x = x)", MODE_REPL, &it);
+  CHECK("parse: stray bracket is an error, not incomplete",
+        n < 0 && !err_info()->incomplete);
+  n = parse("1 < 2 < 3", MODE_REPL, &it);
+  CHECK("parse: comparisons do not chain", n < 0);
+  n = parse("f (a, a) = a", MODE_REPL, &it);
+  CHECK("parse: repeated pattern variable", n < 0);
+}
+
+/* Evaluates text and returns its printed value, or "error: MSG". */
+static const char *ev(const char *text) {
+  static Src src;
+  src = mksrc(text);
+  ErrFrame f;
+  const char *out;
+  int nforcing = I->nforcing;
+  if (ERR_TRY(f)) {
+    Expr *e = parse_expression(I, &src);
+    out = show_value(I, eval(I, e, NULL));
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    static char buf[1200];
+    snprintf(buf, sizeof buf, "error: %s", err_info()->msg);
+    out = buf;
+    while (I->nforcing > nforcing) {
+      I->nforcing--;
+      *I->forcing[I->nforcing].v = I->forcing[I->nforcing].saved;
+    }
+    I->ntrace = 0;
+  }
+  return out;
+}
+
+#define CHECK_EV(expr, want) do {                                        \
+    const char *got_ = ev(expr);                                          \
+    if (!strcmp(got_, want)) printf("ok eval: %s\n", expr);               \
+    else { printf("FAIL eval: %s: got '%s' want '%s'\n", expr, got_, want); \
+           check_failed_count++; }                                        \
+  } while (0)
+
+static void test_eval(void) {
+  CHECK_EV("1 + 2 * 3", "7");
+  CHECK_EV("(1 + 2) * 3", "9");
+  CHECK_EV("2 ^ 3 ^ 2", "512");
+  CHECK_EV("10 - 4 - 3", "3");
+  CHECK_EV("-2 ^ 2", "-4");
+  CHECK_EV("let f 0 = 1; f n = n * f (n - 1) in f 10", "3628800");
+  CHECK_EV("take 3 (iterate (\\x -> x * 2) 1)", "[1, 2, 4]");
+  CHECK_EV("[x \\\\ x <- [1..10] | mod x 3 == 0]", "[3, 6, 9]");
+  CHECK_EV("[(x, y) | x <- [1, 2], y <- [\"ab\" == \"ab\"]]", "[(1, True), (2, True)]");
+  CHECK_EV("[1.5, 2 .. 3]", "[1.5, 2, 2.5, 3]");
+  CHECK_EV("[0, 0.1 .. 0.3]", "[0, 0.1, 0.2, 0.30000000000000004]");
+  CHECK_EV("[10, 8 .. 1]", "[10, 8, 6, 4, 2]");
+  CHECK_EV("let xs = 1 : map (\\x -> x + 1) xs in take 4 xs", "[1, 2, 3, 4]");
+  CHECK_EV("fst (1, error \"never\")", "1");
+  CHECK_EV("length [1..100000]", "100000");
+  CHECK_EV("foldr (+) 0 [1..1000]", "500500");
+  CHECK_EV("sum [1..1000000]", "500000500000");
+  CHECK_EV("if 1 < 2 then \"a\" ++ \"b\" else \"c\"", "\"ab\"");
+  CHECK_EV("(1, 2, 3) * 2 - (1, 1, 1)", "(1, 3, 5)");
+  CHECK_EV("cross (1, 0, 0) (0, 1, 0)", "(0, 0, 1)");
+  CHECK_EV("Shift (0, 1, 0) (Halfspace ((0, 2, 0), 1))",
+           "Halfspace ((0, 2, 0), 3)");
+  CHECK_EV("Rounded 0.07 (DensityHalfspace ((-1, 0, 0), -0.5))",
+           "Rounded 0.07 (DensityHalfspace ((-1, 0, 0), -0.5))");
+  CHECK_EV("let (a, [b : c]) = (1, [2, 3]) in (a, b, c)", "(1, 2, [3])");
+  CHECK_EV("let x = x + 1 in x", "error: this value depends on itself (an "
+                                 "infinite loop)");
+  CHECK_EV("head []", "error: head of an empty list");
+  CHECK_EV("undefinedName", "error: unknown name 'undefinedName'");
+  CHECK_EV("1 2", "error: a Real is not a function, but it is applied to 1 "
+                  "argument: 1");
+  /* The failed thunk is retried, not reported as a loop: */
+  CHECK_EV("let f x = x in f 2", "2");
+}
+
+/* Shortest round-trip printing, against strtod as the reference. */
+static void test_print(void) {
+  uint64_t s = 12111;
+  int bad = 0, longer = 0;
+  for (int i = 0; i < 200000; i++) {
+    s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+    double x;
+    uint64_t bits = s;
+    memcpy(&x, &bits, sizeof x);
+    if (!isfinite(x)) continue;
+    char buf[32], ref[40];
+    format_real(buf, x);
+    if (strtod(buf, NULL) != x) bad++;
+    /* No more significant digits than the shortest %.*e that reads back. */
+    int p;
+    for (p = 1; p <= 17; p++) {
+      snprintf(ref, sizeof ref, "%.*e", p - 1, x);
+      if (strtod(ref, NULL) == x) break;
+    }
+    int digits = 0, seen = 0, trailing = 0;
+    for (const char *c = buf; *c && *c != 'e'; c++)
+      if (*c >= '1' && *c <= '9') digits += trailing + 1, trailing = 0, seen = 1;
+      else if (*c == '0' && seen) trailing++;
+    if (digits > p) longer++;
+  }
+  CHECK("print: 200000 random doubles read back exactly", bad == 0);
+  CHECK("print: with the fewest significant digits", longer == 0);
+  char buf[32];
+  format_real(buf, 0.1);
+  CHECK("print: 0.1", !strcmp(buf, "0.1"));
+  format_real(buf, 100);
+  CHECK("print: 100", !strcmp(buf, "100"));
+  format_real(buf, 1e-12);
+  CHECK("print: 1e-12", !strcmp(buf, "1e-12"));
+  format_real(buf, -2.5);
+  CHECK("print: -2.5", !strcmp(buf, "-2.5"));
+}
+
+int main(void) {
+  check_prefix = "lang";
+  I = interp_new();
+  char probe;
+  interp_set_stack(I, &probe, 4u << 20);
+  test_lexer();
+  test_parser();
+  test_eval();
+  test_print();
+  CHECK_DONE();
+}
