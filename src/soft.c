@@ -554,11 +554,12 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
   double prev_h = 0;       /* half-width of the last solved interval */
   long last_from = -1;     /* interval index of the last crossing */
   long iv = 0;
+  double amin = INFINITY;  /* earliest exit among the active keys */
   for (;;) {
     double tfront = nn ? nheap[0].t : INFINITY;
     double tnext = r.tb;
     if (nk && kheap[0].te < tnext) tnext = kheap[0].te;
-    for (int j = 0; j < na; j++) if (act[j].tx < tnext) tnext = act[j].tx;
+    if (amin < tnext) tnext = amin;
     if (tfront < tnext) {  /* a key may still enter before tnext: discover */
       hent_t e = npop(nheap, &nn);
       const node_t *nd = &obj->nodes[e.i];
@@ -635,6 +636,8 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
       else j++;
     }
     while (nk && kheap[0].te <= cur) act[na++] = kpop(kheap, &nk);
+    amin = INFINITY;
+    for (int j = 0; j < na; j++) if (act[j].tx < amin) amin = act[j].tx;
   }
   return nout;
 }
