@@ -1,0 +1,451 @@
+/* lg.c: LG bounds and the root search of Figure 9 (see lg.h for the
+ * derivations). */
+#include "lg.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Upper bounds get this relative headroom against rounding. */
+#define LG_SAFE (1 + 1e-12)
+
+/* x*y for non-negative bounds where 0 * inf means 0 (a factor that is
+ * identically zero contributes nothing). */
+static double mulnn(double x, double y) {
+  return x == 0 || y == 0 ? 0 : x * y;
+}
+
+static double maxabs(double lo, double hi) {
+  return fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi);
+}
+
+/* eq. (2) and its alpha-derivatives over the segment for one leaf. */
+static void leaf_bounds(const dt_leaf *lf, const double o[3], const double d[3],
+                        double a, double b, double *lo, double *hi, double *L,
+                        double *G, double *split) {
+  double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+  double base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
+  double sa = nd == 0 ? base : base + a * nd;
+  double sb = nd == 0 ? base : base + b * nd;
+  double smin = sa < sb ? sa : sb, smax = sa < sb ? sb : sa;
+  if (lf->r == 0) {
+    if (smin > 0 || smax < 0) {
+      *lo = *hi = smin > 0 ? 0 : 1;
+      *L = *G = 0;
+    } else {
+      *lo = 0;
+      *hi = 1;
+      *L = *G = INFINITY;
+      if (nd != 0) *split = -base / nd;
+    }
+    return;
+  }
+  double amin = smin * lf->inv_r, amax = smax * lf->inv_r;
+  if (amin >= 1 || amax <= -1) {
+    *lo = *hi = amin >= 1 ? 0 : 1;
+    *L = *G = 0;
+    return;
+  }
+  if (amin < -1) amin = -1;
+  if (amax > 1) amax = 1;
+  *lo = dt_halfspace(amax, 1);
+  *hi = dt_halfspace(amin, 1);
+  double near = amin <= 0 && amax >= 0 ? 0 : fmin(fabs(amin), fabs(amax));
+  double far = fmax(fabs(amin), fabs(amax));
+  double k = fabs(nd) * lf->inv_r;
+  *L = 0.75 * (1 - near * near) * k;
+  *G = 1.5 * far * k * k;
+}
+
+/* Section 3.4.1: LG values of a tape over [a, b]. */
+void lg_eval_bounds(const dt_tape *t, const double o[3], const double d[3],
+                    double a, double b, lg_bounds *out) {
+  double lo[DT_STACK_MAX], hi[DT_STACK_MAX], L[DT_STACK_MAX], G[DT_STACK_MAX];
+  int sp = 0;
+  out->split = NAN;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      leaf_bounds(&t->leaves[in->arg], o, d, a, b, &lo[sp], &hi[sp], &L[sp],
+                  &G[sp], &out->split);
+      sp++;
+      continue;
+    }
+    if (in->op == DT_CONST) {
+      lo[sp] = hi[sp] = in->c;
+      L[sp] = G[sp] = 0;
+      sp++;
+      continue;
+    }
+    sp--;
+    int x = sp - 1, y = sp;
+    double rl, rh, rL, rG;
+    switch (in->op) {
+    case DT_SUM:
+    case DT_DIFF:
+    case DT_RDIFF:
+      if (in->op == DT_SUM) { rl = lo[x] + lo[y]; rh = hi[x] + hi[y]; }
+      else if (in->op == DT_DIFF) { rl = lo[x] - hi[y]; rh = hi[x] - lo[y]; }
+      else { rl = lo[y] - hi[x]; rh = hi[y] - lo[x]; }
+      rL = L[x] + L[y];
+      rG = G[x] + G[y];
+      break;
+    default: {
+      /* Product x*y, or Union 1 - (1-x)(1-y) = 1 - X*Y with X = 1-x:
+       * (XY)' = X'Y + XY', (XY)'' = X''Y + 2X'Y' + XY''. */
+      int u = in->op == DT_UNION;
+      double xl = u ? 1 - hi[x] : lo[x], xh = u ? 1 - lo[x] : hi[x];
+      double yl = u ? 1 - hi[y] : lo[y], yh = u ? 1 - lo[y] : hi[y];
+      double p[4] = {xl * yl, xl * yh, xh * yl, xh * yh};
+      rl = rh = p[0];
+      for (int k = 1; k < 4; k++) {
+        if (p[k] < rl) rl = p[k];
+        if (p[k] > rh) rh = p[k];
+      }
+      if (u) { double tmp = rl; rl = 1 - rh; rh = 1 - tmp; }
+      double mx = maxabs(xl, xh), my = maxabs(yl, yh);
+      rL = mulnn(L[x], my) + mulnn(mx, L[y]);
+      rG = mulnn(G[x], my) + 2 * mulnn(L[x], L[y]) + mulnn(mx, G[y]);
+    }
+    }
+    lo[x] = rl;
+    hi[x] = rh;
+    L[x] = rL;
+    G[x] = rG;
+  }
+  out->lo = lo[0];
+  out->hi = hi[0];
+  out->L = L[0] * LG_SAFE;
+  out->G = G[0] * LG_SAFE;
+}
+
+/* x/y for bounds: 0/0 is 0 and x/0 is infinite. */
+static double sdiv(double x, double y) {
+  if (y > 0) return x / y;
+  return x > 0 ? INFINITY : 0;
+}
+
+/* The least distance from an end to a turning point after the first root
+ * (lg.h): f there, df its derivative moving inwards. */
+static double reach(double f, double df, double L, double G) {
+  double g = fabs(f), gp = f >= 0 ? df : -df;
+  double s = 0;
+  if (g > 0) {
+    if (G == 0) s = gp < 0 ? g / -gp : INFINITY;
+    else if (isinf(G)) s = 0;
+    else {
+      double disc = sqrt(gp * gp + 2 * G * g);
+      s = gp >= 0 ? (gp + disc) / G : 2 * g / (disc - gp);
+    }
+  }
+  double r = sdiv(g, L), q = sdiv(fabs(df), G);
+  if (q > r) r = q;
+  return s > r ? s : r;
+}
+
+/* eq. (6), sound form. */
+double lg_multiroot_length(double f0, double df0, double f1, double df1,
+                           double L, double G) {
+  return reach(f0, df0, L, G) + reach(f1, -df1, L, G);
+}
+
+typedef struct {
+  double a, b, fa, dfa, fb, dfb;
+  int depth;
+} segment;
+
+/* Everything one search needs, so helpers stay short. */
+typedef struct {
+  const double *o, *d;
+  double tol;
+  lg_root *out;
+  int n, maxout;
+  lg_stats *st;
+  const lg_hook *hook;
+  dt_instr *segbuf;
+} search;
+
+static double feval(search *s, const dt_tape *t, double x, double *df) {
+  if (s->st) s->st->evals++;
+  return dt_density_ray(t, s->o, s->d, x, df) - 0.5;
+}
+
+/* Returns 0 when out is full (the search stops). */
+static int emit(search *s, double t, int kind) {
+  if (s->n >= s->maxout) return 0;
+  /* One graze seen from two adjacent tiny segments is one touch. */
+  if (kind == LG_TOUCH && s->n > 0 && t - s->out[s->n - 1].t <= s->tol)
+    return 1;
+  s->out[s->n].t = t;
+  s->out[s->n].kind = kind;
+  s->n++;
+  if (kind == LG_TOUCH && s->st) s->st->touches++;
+  return s->n < s->maxout;
+}
+
+static int kind_of(double df) {
+  return df > 0 ? LG_ENTER : (df < 0 ? LG_EXIT : LG_TOUCH);
+}
+
+/* Regula falsi (Illinois) interleaved with bisection on a bracket with
+ * fa, fb of opposite signs. */
+static double regula_falsi(search *s, const dt_tape *t, double a, double b,
+                           double fa, double fb) {
+  double rtol = fmax(1e-3 * s->tol, 4 * DBL_EPSILON * fmax(fabs(a), fabs(b)));
+  int side = 0;
+  for (int it = 0; it < 200 && b - a > rtol; it++) {
+    double x;
+    if (it % 3 == 2) x = 0.5 * (a + b);
+    else {
+      x = (a * fb - b * fa) / (fb - fa);
+      if (!(x > a && x < b)) x = 0.5 * (a + b);
+    }
+    if (!(x > a && x < b)) break;
+    if (s->st) s->st->rf_steps++;
+    double dummy, fx = feval(s, t, x, &dummy);
+    if (fx == 0) return x;
+    if ((fx < 0) == (fa < 0)) {
+      a = x;
+      fa = fx;
+      if (side == -1) fb *= 0.5;
+      side = -1;
+    } else {
+      b = x;
+      fb = fx;
+      if (side == 1) fa *= 0.5;
+      side = 1;
+    }
+  }
+  return 0.5 * (a + b);
+}
+
+/* Lower bound of |f| on [a, a+h] from the quadratic envelope at a, f and
+ * df (derivative moving inwards) given: concave, so the least value is at
+ * an end of the interval. */
+static double envelope_min(double f, double df, double G, double h) {
+  double g = fabs(f), gp = f >= 0 ? df : -df;
+  double e = g + gp * h - 0.5 * G * h * h;
+  return e < g ? e : g;
+}
+
+/* The tolerance rule for a segment shorter than tol (lg.h). */
+static int tiny_rule(search *s, const dt_tape *t, const segment *sg, double G,
+                     int *nroots) {
+  if (sg->fb == 0) { (*nroots)++; return emit(s, sg->b, kind_of(sg->dfb)); }
+  if ((sg->fa < 0) != (sg->fb < 0) && sg->fa != 0) {
+    (*nroots)++;
+    double x = regula_falsi(s, t, sg->a, sg->b, sg->fa, sg->fb);
+    return emit(s, x, sg->fa < 0 ? LG_ENTER : LG_EXIT);
+  }
+  if (sg->fa == 0 || isinf(G)) return 1;
+  double m = 0.5 * (sg->a + sg->b);
+  if ((sg->dfa < 0) != (sg->dfb < 0) && sg->dfa != sg->dfb) {
+    double x = sg->a + (sg->b - sg->a) * sg->dfa / (sg->dfa - sg->dfb);
+    if (x > sg->a && x < sg->b) m = x;
+  }
+  double dfm, fm = feval(s, t, m, &dfm);
+  if (fm == 0 || (fm < 0) != (sg->fa < 0)) {
+    if (fm == 0) { (*nroots)++; return emit(s, m, LG_TOUCH); }
+    int k1 = sg->fa < 0 ? LG_ENTER : LG_EXIT;
+    *nroots += 2;
+    if (!emit(s, regula_falsi(s, t, sg->a, m, sg->fa, fm), k1)) return 0;
+    return emit(s, regula_falsi(s, t, m, sg->b, fm, sg->fb), -k1);
+  }
+  double h1 = m - sg->a, h2 = sg->b - m;
+  double lb1 = fmax(envelope_min(sg->fa, sg->dfa, G, h1),
+                    envelope_min(fm, -dfm, G, h1));
+  double lb2 = fmax(envelope_min(fm, dfm, G, h2),
+                    envelope_min(sg->fb, -sg->dfb, G, h2));
+  if (lb1 > 0 && lb2 > 0) return 1;
+  (*nroots)++;
+  return emit(s, m, LG_TOUCH);
+}
+
+static void trace(search *s, const segment *sg, const lg_bounds *lb,
+                  double lhs, int decision, int ncode, int nroots) {
+  if (!s->hook || !s->hook->fn) return;
+  lg_trace_event ev = {sg->a, sg->b, sg->fa, sg->fb, sg->dfa, sg->dfb,
+                       lb->L, lb->G, lb->lo, lb->hi, lhs, decision,
+                       sg->depth, ncode, nroots};
+  s->hook->fn(s->hook->ctx, &ev);
+}
+
+/* Figure 9 over [a, b] of the (span-pruned) tape t.  Returns 0 when the
+ * output is full. */
+static int search_interval(search *s, const dt_tape *t, double a, double b) {
+  segment stack[LG_STACK];
+  int sp = 0;
+  segment first = {a, b, 0, 0, 0, 0, 0};
+  first.fa = feval(s, t, a, &first.dfa);
+  first.fb = feval(s, t, b, &first.dfb);
+  if (first.fa == 0 && !emit(s, a, kind_of(first.dfa))) return 0;
+  stack[sp++] = first;
+  while (sp) {
+    segment sg = stack[--sp];
+    if (s->st) s->st->segments++;
+    dt_tape view;
+    int nc = dt_prune_ray(t, s->o, s->d, sg.a, sg.b, s->segbuf, &view);
+    lg_bounds lb;
+    lg_eval_bounds(&view, s->o, s->d, sg.a, sg.b, &lb);
+    double margin = 1e-12 * (1 + fabs(lb.lo) + fabs(lb.hi));
+    if (lb.lo > 0.5 + margin || lb.hi < 0.5 - margin) {
+      trace(s, &sg, &lb, INFINITY, LG_SEG_EXCLUDED, nc, 0);
+      continue;
+    }
+    if (lb.L == 0) {
+      trace(s, &sg, &lb, INFINITY, LG_SEG_FLAT, nc, 0);
+      continue;
+    }
+    double len = sg.b - sg.a;
+    double lhs = lg_multiroot_length(sg.fa, sg.dfa, sg.fb, sg.dfb, lb.L, lb.G);
+    int shorty = lhs > len * LG_SAFE;
+    double minlen = fmax(s->tol, 16 * DBL_EPSILON * fmax(fabs(sg.a), fabs(sg.b)));
+    double m = 0.5 * (sg.a + sg.b);
+    if (!isnan(lb.split) && lb.split > sg.a + 0.25 * minlen &&
+        lb.split < sg.b - 0.25 * minlen)
+      m = lb.split;
+    int tiny = len <= minlen || !(m > sg.a && m < sg.b);
+    if (!shorty && !tiny && sp + 2 > LG_STACK) {
+      tiny = 1;
+      if (s->st) s->st->overflows++;
+    }
+    int nroots = 0, more = 1;
+    if (shorty) {
+      if (sg.fb == 0) {
+        nroots = 1;
+        more = emit(s, sg.b, kind_of(sg.dfb));
+      } else if (sg.fa != 0 && (sg.fa < 0) != (sg.fb < 0)) {
+        nroots = 1;
+        more = emit(s, regula_falsi(s, &view, sg.a, sg.b, sg.fa, sg.fb),
+                    sg.fa < 0 ? LG_ENTER : LG_EXIT);
+      }
+      trace(s, &sg, &lb, lhs, nroots ? LG_SEG_ROOT : LG_SEG_NO_ROOT, nc,
+            nroots);
+    } else if (tiny) {
+      more = tiny_rule(s, &view, &sg, lb.G, &nroots);
+      trace(s, &sg, &lb, lhs, LG_SEG_TINY, nc, nroots);
+    } else {
+      trace(s, &sg, &lb, lhs, LG_SEG_SPLIT, nc, 0);
+      segment left = sg, right = sg;
+      double fm, dfm;
+      fm = feval(s, &view, m, &dfm);
+      left.b = right.a = m;
+      left.fb = right.fa = fm;
+      left.dfb = right.dfa = dfm;
+      left.depth = right.depth = sg.depth + 1;
+      stack[sp++] = right;
+      stack[sp++] = left;
+    }
+    if (!more) return 0;
+  }
+  return 1;
+}
+
+/* The part of [t0, t1] where some filter is touched: outside it every
+ * leaf is constant, so the density is too. */
+static int support_hull(const dt_tape *t, const double o[3], const double d[3],
+                        double *t0, double *t1) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (int i = 0; i < t->nleaves; i++) {
+    const dt_leaf *lf = &t->leaves[i];
+    double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+    if (nd == 0) continue;
+    double base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
+    double x = (-lf->r - base) / nd, y = (lf->r - base) / nd;
+    if (x > y) { double tmp = x; x = y; y = tmp; }
+    if (x < lo) lo = x;
+    if (y > hi) hi = y;
+  }
+  if (lo > *t0) *t0 = lo;
+  if (hi < *t1) *t1 = hi;
+  return *t0 <= *t1;
+}
+
+/* Search the sorted, disjoint intervals iv[0..n) (pairs of doubles). */
+static int run(const dt_tape *t, const double o[3], const double d[3],
+               const double *iv, int n, double tol, lg_root *out, int maxout,
+               lg_stats *stats, const lg_hook *hook) {
+  dt_instr local[2 * LG_LOCAL_CODE], *buf = local;
+  if (t->ncode > LG_LOCAL_CODE) {
+    buf = malloc((size_t)t->ncode * 2 * sizeof *buf);
+    if (!buf) return -1;
+  }
+  search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
+              buf + t->ncode};
+  if (maxout > 0) {
+    for (int i = 0; i < n; i++) {
+      double a = iv[2 * i], b = iv[2 * i + 1];
+      if (!support_hull(t, o, d, &a, &b)) continue;
+      dt_tape view;
+      dt_prune_ray(t, o, d, a, b, buf, &view);
+      if (!search_interval(&s, &view, a, b)) break;
+    }
+  }
+  if (buf != local) free(buf);
+  return s.n;
+}
+
+/* Figure 9: Roots. */
+int lg_roots(const dt_tape *t, const double o[3], const double d[3],
+             double t0, double t1, double tol, lg_root *out, int maxout,
+             lg_stats *stats) {
+  double iv[2] = {t0, t1};
+  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL);
+}
+
+int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
+                   double t0, double t1, const csg_span *spans, int nspans,
+                   double tol, lg_root *out, int maxout, lg_stats *stats,
+                   const lg_hook *hook) {
+  double local[2 * 64] = {0}, *iv = local;
+  if (nspans > 64) {
+    iv = malloc((size_t)nspans * 2 * sizeof *iv);
+    if (!iv) return -1;
+  }
+  int n = 0;
+  for (int i = 0; i < nspans; i++) {
+    double pad0 = tol + 8 * DBL_EPSILON * fabs(spans[i].t0);
+    double pad1 = tol + 8 * DBL_EPSILON * fabs(spans[i].t1);
+    double a = fmax(spans[i].t0 - pad0, t0), b = fmin(spans[i].t1 + pad1, t1);
+    if (!(a <= b)) continue;
+    if (n > 0 && a <= iv[2 * n - 1]) {   /* merge widened neighbours */
+      if (b > iv[2 * n - 1]) iv[2 * n - 1] = b;
+      continue;
+    }
+    iv[2 * n] = a;
+    iv[2 * n + 1] = b;
+    n++;
+  }
+  int r = run(t, o, d, iv, n, tol, out, maxout, stats, hook);
+  if (iv != local) free(iv);
+  return r;
+}
+
+/* Figure 7 (c): search where outer and not inner. */
+int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
+                     const csg_tape *inner, const double o[3],
+                     const double d[3], double t0, double t1, double tol,
+                     lg_root *out, int maxout, lg_stats *stats,
+                     const lg_hook *hook) {
+  int no = outer->nleaves + 1, ni = inner ? inner->nleaves + 1 : 0;
+  int nsc = csg_scratch_spans(outer);
+  if (inner && csg_scratch_spans(inner) > nsc) nsc = csg_scratch_spans(inner);
+  size_t need = (size_t)(2 * no + 2 * ni + nsc);
+  csg_span local[4 * 64 + 2 * 64 + 8], *mem = local;
+  if (need > sizeof local / sizeof *local) {
+    mem = malloc(need * sizeof *mem);
+    if (!mem) return -1;
+  }
+  csg_span *os = mem, *is = os + no, *ds = is + ni, *sc = ds + no + ni;
+  int n = csg_ray_spans(outer, o, d, t0, t1, os, no, sc, nsc), r = -1;
+  if (n >= 0) {
+    int m = inner ? csg_ray_spans(inner, o, d, t0, t1, is, ni, sc, nsc) : 0;
+    if (m >= 0) {
+      int k = csg_spans_diff(os, n, is, m, ds);
+      r = lg_roots_spans(t, o, d, t0, t1, ds, k, tol, out, maxout, stats, hook);
+    }
+  }
+  if (mem != local) free(mem);
+  return r;
+}
