@@ -8,6 +8,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "bounds.h"
 #include "density.h"
 #include "eval.h"
 #include "scene.h"
@@ -102,6 +103,87 @@ static Value *pr_field(Interp *I, Value **args, Pos pos) {
   return val_num(f);
 }
 
+/* A sharp CSG tape back into a scene-object value, for printing. */
+static Value *csg_to_value(Interp *I, const csg_tape *t, Pos pos) {
+  Value **stack = val_array(t->depth + 1);
+  int sp = 0;
+  Sym *s_half = sym_intern(I, "Halfspace", 9), *s_union = sym_intern(I, "Union", 5),
+      *s_inter = sym_intern(I, "Intersection", 12),
+      *s_diff = sym_intern(I, "SetDifference", 13),
+      *s_empty = sym_intern(I, "Empty", 5),
+      *s_all = sym_intern(I, "Everything", 10);
+  for (int i = 0; i < t->ncode; i++) {
+    const csg_instr *in = &t->code[i];
+    Value **a;
+    switch (in->op) {
+    case CSG_PLANE: {
+      const csg_plane *p = &t->planes[in->arg];
+      Value **pl = val_array(2);
+      pl[0] = val_tuple3(p->n[0], p->n[1], p->n[2]);
+      pl[1] = val_num(p->d);
+      a = val_array(1);
+      a[0] = val_tuple(2, pl);
+      stack[sp++] = val_con(s_half, 1, a);
+      break;
+    }
+    case CSG_EMPTY: stack[sp++] = val_con(s_empty, 0, NULL); break;
+    case CSG_ALL: stack[sp++] = val_con(s_all, 0, NULL); break;
+    default: {
+      a = val_array(2);
+      Value *y = stack[--sp], *x = stack[--sp];
+      Sym *c = in->op == CSG_UNION ? s_union : in->op == CSG_INTER ? s_inter : s_diff;
+      a[0] = in->op == CSG_RDIFF ? y : x;
+      a[1] = in->op == CSG_RDIFF ? x : y;
+      stack[sp++] = val_con(c, 2, a);
+    }
+    }
+  }
+  if (sp != 1) qcs_error(pos, "internal error: malformed bound");
+  return stack[0];
+}
+
+static Value *bounds_probe(Interp *I, Value **args, Pos pos, int outer) {
+  double r = get_radius(I, args[0], pos);
+  double t = force_num(I, args[1], pos, "the density threshold");
+  if (!(t >= 0 && t <= 1))
+    qcs_error(pos, "the threshold must be in [0, 1], not %g", t);
+  dt_tape *tape = scene_density_tape(I, args[2], r, pos);
+  int flags = 0;
+  csg_tape *b = outer ? bnd_outer(tape, t, &flags) : bnd_inner(tape, t, &flags);
+  dt_tape_free(tape);
+  if (!b) qcs_error(pos, "out of memory");
+  if (flags & BND_RANGE)
+    qcs_warning(pos, "this density tree can exceed 1 (overlapping Sums, as in "
+                "the paper's Figure 15b): the bounds hold by interval "
+                "arithmetic, but seams may bulge");
+  if (flags & BND_FALLBACK)
+    qcs_warning(pos, "no theorem applies to part of this tree: a looser, "
+                "still safe bound was used there");
+  ErrFrame f;
+  Value *v = NULL;
+  if (ERR_TRY(f)) {
+    v = csg_to_value(I, b, pos);
+    err_pop(&f);
+    csg_tape_free(b);
+  } else {
+    err_pop(&f);
+    csg_tape_free(b);
+    ErrInfo e = *err_info();
+    qcs_error(e.pos, "%s", e.msg);
+  }
+  return v;
+}
+
+/* OuterBounds r t tree: Figure 8. */
+static Value *pr_outer(Interp *I, Value **args, Pos pos) {
+  return bounds_probe(I, args, pos, 1);
+}
+
+/* InnerBounds r t tree: Appendix, Theorems 4-6. */
+static Value *pr_inner(Interp *I, Value **args, Pos pos) {
+  return bounds_probe(I, args, pos, 0);
+}
+
 #define PROBES(X)                                                            \
   X("Density", 3, pr_density,                                                \
     "Density r p tree: the density of the tree smoothed with radius r at p") \
@@ -111,7 +193,11 @@ static Value *pr_field(Interp *I, Value **args, Pos pos) {
     "PointInObject p obj: is p inside the object?")                          \
   X("Displacement", 2, pr_displacement,                                      \
     "Displacement r t: distance from a plane to its t-isosurface, outward")  \
-  X("Field", 2, pr_field, "Field p soft: the soft object's field at p")
+  X("Field", 2, pr_field, "Field p soft: the soft object's field at p")   \
+  X("OuterBounds", 3, pr_outer,                                              \
+    "OuterBounds r t tree: a sharp object outside which density <= t")       \
+  X("InnerBounds", 3, pr_inner,                                              \
+    "InnerBounds r t tree: a sharp object inside which density >= t")
 
 static const Builtin probes[] = {
 #define X(name, arity, fn, doc) {name, arity, fn, doc},

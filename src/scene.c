@@ -11,7 +11,7 @@
 typedef enum {
   K_NONE, K_UNION, K_INTER, K_SETDIFF, K_ROUNDED, K_HALFSPACE, K_SUM,
   K_PRODUCT, K_DIFFERENCE, K_DHALFSPACE, K_RHALFSPACE, K_DUNION, K_SOFT,
-  K_KEY, K_QKEY, K_COLOUR
+  K_KEY, K_QKEY, K_COLOUR, K_EMPTY, K_ALL
 } ConKind;
 
 static const struct {
@@ -25,7 +25,8 @@ static const struct {
     {"DensityHalfspace", K_DHALFSPACE}, {"RoundedHalfspace", K_RHALFSPACE},
     {"DensityUnion", K_DUNION},   {"SoftObject", K_SOFT},
     {"Key", K_KEY},               {"QuadricKey", K_QKEY},
-    {"Colour", K_COLOUR},
+    {"Colour", K_COLOUR},         {"Empty", K_EMPTY},
+    {"Everything", K_ALL},
 };
 
 static ConKind con_kind(Value *v) {
@@ -339,6 +340,10 @@ static int compile_obj(Compile *C, Value *v) {
   }
   case K_SOFT:
     return compile_soft(C, v, pos);
+  case K_EMPTY:
+    return add_node(C, SC_EMPTY, pos);
+  case K_ALL:
+    return add_node(C, SC_ALL, pos);
   case K_COLOUR: {
     double c[3];
     force_vec3(C->I, a[0], pos, "the colour (r, g, b)", c);
@@ -401,6 +406,10 @@ int scene_inside(const Scene *s, int node, const double p[3]) {
     return scene_inside(s, n->a, p) && scene_inside(s, n->b, p);
   case SC_DIFF:
     return scene_inside(s, n->a, p) && !scene_inside(s, n->b, p);
+  case SC_EMPTY:
+    return 0;
+  case SC_ALL:
+    return 1;
   }
   return 0;
 }

@@ -37,7 +37,9 @@ typedef enum {
   SC_SOFT,      /* a soft object: inside where field > magic */
   SC_UNION,
   SC_INTER,
-  SC_DIFF       /* a - b */
+  SC_DIFF,      /* a - b */
+  SC_EMPTY,     /* nothing */
+  SC_ALL        /* everything */
 } ScKind;
 
 typedef struct ScNode {
