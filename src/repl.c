@@ -5,10 +5,13 @@
  * ":{ ... :}" block. The same feed_line() serves the terminal loop and the
  * plain loop for piped input; only where lines come from differs.
  *
- * Signals: the handlers only set flags (and, for SIGINT, ask the
- * interpreter to stop). They are blocked except inside pselect() while
- * waiting for a key, and unblocked while an entry runs, so a Ctrl-C at the
- * prompt is handled between keys and never inside readline. */
+ * Signals: the handlers only set flags (for SIGINT also asking the
+ * interpreter to stop) and write a byte to a pipe that the prompt loop
+ * select()s on beside the terminal. So a Ctrl-C at the prompt is handled
+ * between keys, never inside readline, whichever thread the kernel gave
+ * the signal to (main runs the interpreter on a thread of its own, and the
+ * collector has threads too: blocking signals in this thread and waiting
+ * in pselect() would miss them). */
 #include "repl.h"
 
 #include <errno.h>
@@ -42,11 +45,19 @@ static volatile sig_atomic_t got_sigint, got_sigwinch, got_sigcont;
 static volatile sig_atomic_t at_prompt;   /* waiting for a key */
 static volatile sig_atomic_t sigint_count; /* Ctrl-Cs during one entry */
 static int stderr_is_tty; /* set before the handler is installed */
+static int wake_pipe[2] = {-1, -1}; /* handlers -> prompt loop */
+
+static void wake(void) {
+  if (wake_pipe[1] >= 0 && write(wake_pipe[1], "", 1) < 0) {
+    /* full: the loop has a byte to wake on already */
+  }
+}
 
 static void on_sigint(int sig) {
   int saved = errno;
   got_sigint = 1;
   interp_request_interrupt();
+  wake();
   /* An evaluation stuck where the interpreter does not look at the flag
      must not hold the user hostage. */
   if (!at_prompt && stderr_is_tty) { /* the tty echoed "^C"; end its line */
@@ -60,16 +71,42 @@ static void on_sigint(int sig) {
   errno = saved;
 }
 
-static void on_sigwinch(int sig) { got_sigwinch = 1; }
-static void on_sigcont(int sig) { got_sigcont = 1; }
+static void on_sigwinch(int sig) {
+  int saved = errno;
+  got_sigwinch = 1;
+  wake();
+  errno = saved;
+}
+
+static void on_sigcont(int sig) {
+  int saved = errno;
+  got_sigcont = 1;
+  wake();
+  errno = saved;
+}
+
+static int open_wake_pipe(void) {
+  if (wake_pipe[0] >= 0) return 0;
+  if (pipe(wake_pipe) < 0) return -1;
+  for (int i = 0; i < 2; i++) {
+    fcntl(wake_pipe[i], F_SETFL, fcntl(wake_pipe[i], F_GETFL) | O_NONBLOCK);
+    fcntl(wake_pipe[i], F_SETFD, FD_CLOEXEC);
+  }
+  return 0;
+}
+
+static void drain_wake_pipe(void) {
+  char buf[64];
+  while (read(wake_pipe[0], buf, sizeof buf) > 0) continue;
+}
 
 static void set_handler(int sig, void (*fn)(int)) {
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = fn;
   sigemptyset(&sa.sa_mask);
-  /* SA_RESTART keeps the interpreter's stdio from failing with EINTR;
-     pselect() is never restarted, so the prompt loop still wakes up. */
+  /* SA_RESTART keeps the interpreter's stdio from failing with EINTR; the
+     prompt loop learns of signals through the pipe. */
   sa.sa_flags = SA_RESTART;
   sigaction(sig, &sa, NULL);
 }
@@ -666,20 +703,15 @@ static void abandon_line(void) {
 }
 
 static ReadResult read_line(const char *prompt, char **out) {
-  sigset_t block, old;
-  sigemptyset(&block);
-  sigaddset(&block, SIGINT);
-  sigaddset(&block, SIGWINCH);
-  sigaddset(&block, SIGCONT);
-  sigprocmask(SIG_BLOCK, &block, &old);
-
   fflush(stdout);
+  drain_wake_pipe();
   got_sigint = 0;
   read_done = 0;
   read_got = NULL;
   at_prompt = 1;
   rl_callback_handler_install(prompt, on_line);
   int fd = fileno(rl_instream ? rl_instream : stdin);
+  int maxfd = fd > wake_pipe[0] ? fd : wake_pipe[0];
   ReadResult r;
   for (;;) {
     if (got_sigint) {
@@ -705,18 +737,20 @@ static ReadResult read_line(const char *prompt, char **out) {
     fd_set fds;
     FD_ZERO(&fds);
     FD_SET(fd, &fds);
-    int n = pselect(fd + 1, &fds, NULL, NULL, NULL, &old);
+    FD_SET(wake_pipe[0], &fds);
+    int n = select(maxfd + 1, &fds, NULL, NULL, NULL);
     if (n < 0) {
       if (errno == EINTR) continue;
       rl_callback_handler_remove();
       r = READ_EOF;
       break;
     }
-    if (n > 0) rl_callback_read_char();
+    if (FD_ISSET(wake_pipe[0], &fds)) drain_wake_pipe();
+    /* a signal first: a key waiting behind a Ctrl-C is for the new line */
+    else if (FD_ISSET(fd, &fds)) rl_callback_read_char();
   }
   at_prompt = 0;
   interp_clear_interrupt(); /* a Ctrl-C at the prompt stops nothing later */
-  sigprocmask(SIG_SETMASK, &old, NULL);
   *out = read_got;
   return r;
 }
@@ -730,6 +764,10 @@ static int run_terminal(Repl *R) {
   rl_basic_word_break_characters = name_breaks;
   rl_completer_quote_characters = "\"";
   completion_interp = R->I;
+  if (open_wake_pipe() < 0) {
+    perror("qcs: pipe");
+    return 1;
+  }
   history_open(R);
   repl_install_sigint();
   set_handler(SIGWINCH, on_sigwinch);
