@@ -106,6 +106,8 @@ struct Interp {
   int ntrace;                /* entries in use (may exceed TRACE_MAX) */
   Forcing *forcing;
   int nforcing, capforcing;
+  Pos warned[64];            /* warnings already given (said once each) */
+  int nwarned;
   const char *run_name;      /* the file currently being run */
   int loading_prelude;
   Value *v_true, *v_false, *v_nil;
