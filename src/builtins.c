@@ -73,10 +73,10 @@ static Value *bi_isInfinite(Interp *I, Value **args, Pos pos) {
 static Value *bi_not(Interp *I, Value **args, Pos pos) {
   return val_bool(I, !force_bool(I, args[0], pos, "the argument of not"));
 }
+/* show v is v as it prints: a String comes back quoted, as in Haskell, so
+   that show (1, "a") and show "a" agree. */
 static Value *bi_show(Interp *I, Value **args, Pos pos) {
-  Value *v = force(I, args[0]);
-  if (v->kind == V_STR) return v;
-  return val_str(show_value(I, v));
+  return val_str(show_value(I, force(I, args[0])));
 }
 static Value *bi_error(Interp *I, Value **args, Pos pos) {
   qcs_error(pos, "%s", force_str(I, args[0], pos, "the message of error"));

@@ -178,7 +178,40 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
   }
 }
 
-void print_value(Interp *I, FILE *out, Value *v) { print_rec(I, out, v, 0); }
+/* Forces v completely, visiting at most *budget nodes; returns 0 when the
+   budget ran out first (a long or infinite value). */
+static int force_deep(Interp *I, Value *v, long *budget) {
+  for (;;) {
+    if (--*budget < 0) return 0;
+    eval_check(I, pos_none);
+    v = force(I, v);
+    switch (v->kind) {
+    case V_TUPLE:
+      for (int i = 0; i < v->u.tup.n; i++)
+        if (!force_deep(I, v->u.tup.items[i], budget)) return 0;
+      return 1;
+    case V_CON:
+      for (int i = 0; i < v->u.con.n; i++)
+        if (!force_deep(I, v->u.con.args[i], budget)) return 0;
+      return 1;
+    case V_CONS:
+      if (!force_deep(I, v->u.cons.head, budget)) return 0;
+      v = v->u.cons.tail; /* the spine iteratively */
+      continue;
+    default:
+      return 1;
+    }
+  }
+}
+
+/* A value is forced before any of it is printed, so that an error inside
+   it leaves no half-printed line; only a value too long to force first
+   (an infinite list, say) is printed as it is computed. */
+void print_value(Interp *I, FILE *out, Value *v) {
+  long budget = 1L << 20;
+  force_deep(I, v, &budget);
+  print_rec(I, out, v, 0);
+}
 
 const char *show_value(Interp *I, Value *v) {
   char *buf = NULL;
