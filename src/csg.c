@@ -360,6 +360,8 @@ static int plane_span(const csg_plane *p, int id, const double o[3],
   return 1;
 }
 
+/* Roth's ray casting: one span per halfspace, combined bottom-up with the
+ * span-list set operations. */
 int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
                   double s0, double s1, csg_span *out, int maxout,
                   csg_span *scratch, int nscratch) {

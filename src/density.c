@@ -315,6 +315,8 @@ double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
   return v[0];
 }
 
+/* Section 2.4 along a ray: rho(o + s d) and d rho/ds by the chain rule,
+ * d alpha/ds = (n.d)/r, so any length of d is handled exactly. */
 double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
                       double s, double *drho_ds) {
   double v[DT_STACK_MAX], dv[DT_STACK_MAX];

@@ -91,7 +91,12 @@ static void test_csg_spans(void) {
               fabs(s - out[j].t1) <= 1e-9 * s1)
             near = 1;
         }
-        if (!near && in != ref_in(&t, root, q)) { if (bad < 5) printf("# mismatch sc=%d k=%d m=%d in=%d n=%d len=%g s=%.17g\n", sc, k, m, in, n, len, s); bad++; }
+        if (!near && in != ref_in(&t, root, q)) {
+          if (bad < 5)
+            printf("# mismatch scene %d ray %d sample %d: span says %d\n", sc,
+                   k, m, in);
+          bad++;
+        }
       }
     }
     csg_tape_free(ct);
