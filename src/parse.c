@@ -503,7 +503,29 @@ static Expr *list_expr(Parser *P) {
   return e;
 }
 
-/* paren -> '(' ')' | '(' binop ')' | '(' expr ')' | '(' expr {',' expr} ')' */
+/* A section: (op e) is \%a -> %a op e, (e op) is \%b -> e op %b. */
+static Expr *section(Parser *P, TokKind op, Expr *left, Expr *right, Pos pos) {
+  Pat **pats = GC_MALLOC(sizeof(Pat *));
+  const char *v = left ? "%b" : "%a";
+  pats[0] = mk_pvar(P, pos, v);
+  Expr *a = left ? left : mk_var(P, pos, v);
+  Expr *b = right ? right : mk_var(P, pos, v);
+  Expr *body;
+  if (op == T_COMPOSE) {
+    body = compose(P, a, b, pos);
+  } else {
+    body = mk(E_BINOP, pos);
+    body->u.bin.op = op == T_KAND ? T_AND : op == T_KOR ? T_OR : op;
+    body->u.bin.a = a;
+    body->u.bin.b = b;
+  }
+  Clause *c = mk_clause(pos, 1, pats, body);
+  return mk_lambda(pos, 1, 1, &c);
+}
+
+/* paren -> '(' ')' | '(' binop ')' | '(' binop expr ')' | '(' expr binop ')'
+          | '(' expr ')' | '(' expr {',' expr} ')'
+   (- e) is negation, not a section. */
 static Expr *paren_expr(Parser *P) {
   Pos open = pos_here(P);
   next(P);
@@ -526,7 +548,21 @@ static Expr *paren_expr(Parser *P) {
     }
     return op_function(P, k == T_KAND ? T_AND : k == T_KOR ? T_OR : k, open);
   }
+  if (is_binop(k) && k != T_MINUS) { /* a right section (op e) */
+    Pos opos = pos_here(P);
+    next(P);
+    Expr *right = expr(P);
+    expect_close(P, T_RPAREN, open);
+    return section(P, k, NULL, right, opos);
+  }
   Expr *first = expr(P);
+  k = peek(P);
+  if (is_binop(k) && P->toks[P->i + 1].kind == T_RPAREN) { /* (e op) */
+    Pos opos = pos_here(P);
+    next(P);
+    next(P);
+    return section(P, k, first, NULL, opos);
+  }
   if (peek(P) != T_COMMA) {
     expect_close(P, T_RPAREN, open);
     return first;
@@ -709,6 +745,8 @@ static Expr *binary(Parser *P, int minprec) {
     int assoc;
     int p = prec(op, &assoc);
     if (p < 0 || p < minprec) return lhs;
+    /* (e op): a left section, finished by paren_expr */
+    if (P->toks[P->i + 1].kind == T_RPAREN && P->bracket > 0) return lhs;
     Pos opos = pos_here(P);
     next(P);
     Expr *rhs = binary(P, assoc == 1 ? p : p + 1);
