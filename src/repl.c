@@ -294,7 +294,7 @@ static void cmd_reload(Repl *R, const char *arg, int bang) {
     R->had_error = 1;
     return;
   }
-  for (size_t i = 0; i < R->nfiles && !R->quit; i++) {
+  for (size_t i = 0; i < R->nfiles; i++) { /* all, as :load ran them */
     RunStatus st;
     RUN_GUARDED(st, interp_run_file(R->I, R->files[i]));
     note_status(R, st);

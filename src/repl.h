@@ -4,7 +4,7 @@
  * that continue while the interpreter says RUN_INCOMPLETE, ":{ ... :}"
  * blocks, :commands, Tab completion, history in ~/.qcs_history and Ctrl-C
  * that stops an evaluation (or abandons the line being typed). Readline is
- * driven through its callback interface from a pselect() loop, so signals
+ * driven through its callback interface from a select() loop, so signals
  * are seen by this module, never inside readline.
  *
  * When stdin is not a terminal the same entries are read plainly, line by
