@@ -11,6 +11,9 @@
 #include "bounds.h"
 #include "density.h"
 #include "eval.h"
+#include "lg.h"
+#include "print.h"
+#include "ray.h"
 #include "scene.h"
 #include "soft.h"
 
@@ -184,6 +187,120 @@ static Value *pr_inner(Interp *I, Value **args, Pos pos) {
   return bounds_probe(I, args, pos, 0);
 }
 
+/* The direction of a ray: finite and not zero. */
+static void get_dir(Interp *I, Value *v, Pos pos, double d[3]) {
+  get_point(I, v, pos, "the ray direction", d);
+  if (d[0] == 0 && d[1] == 0 && d[2] == 0)
+    qcs_error(pos, "the ray direction cannot be zero");
+}
+
+/* The default root tolerance, as a distance in scene units. */
+#define PROBE_TOL 1e-10
+
+/* Every crossing of node's boundary along o + t d, t >= 0, into a list. */
+static Value *roots_list(Interp *I, const Scene *s, const double o[3],
+                         const double d[3], RayCtx *c, Pos pos) {
+  csg_span *sp;
+  int n = ray_spans(s, s->root, o, d, 0, INFINITY, c, &sp);
+  if (n < 0) qcs_error(pos, "out of memory tracing the ray");
+  Value *list = I->v_nil;
+  for (int i = n - 1; i >= 0; i--) {
+    if (sp[i].id1 >= 0 && isfinite(sp[i].t1))
+      list = val_cons(val_num(sp[i].t1), list);
+    if (sp[i].id0 >= 0 && sp[i].t0 >= 0) list = val_cons(val_num(sp[i].t0), list);
+  }
+  return list;
+}
+
+static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook) {
+  double o[3], d[3];
+  get_point(I, args[1], pos, "the ray origin", o);
+  get_dir(I, args[2], pos, d);
+  Scene *s = scene_compile(I, args[0], pos);
+  RayCtx *c = ray_ctx_new(s, PROBE_TOL);
+  if (!c) {
+    scene_free(s);
+    qcs_error(pos, "out of memory");
+  }
+  c->hook = hook;
+  Value *v = NULL;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    v = roots_list(I, s, o, d, c, pos);
+    err_pop(&f);
+    ray_ctx_free(c);
+    scene_free(s);
+  } else {
+    err_pop(&f);
+    ray_ctx_free(c);
+    scene_free(s);
+    ErrInfo e = *err_info();
+    qcs_error(e.pos, "%s", e.msg);
+  }
+  return v;
+}
+
+/* Roots obj o d: every t >= 0 where o + t d crosses obj's surface. */
+static Value *pr_roots(Interp *I, Value **args, Pos pos) {
+  return ray_probe(I, args, pos, NULL);
+}
+
+static const char *const decisions[] = {
+    [LG_SEG_EXCLUDED] = "range misses 0.5",
+    [LG_SEG_FLAT] = "flat (L = 0)",
+    [LG_SEG_NO_ROOT] = "eq.6 false: <= 1 root; no sign change",
+    [LG_SEG_ROOT] = "eq.6 false: <= 1 root; sign change -> regula falsi",
+    [LG_SEG_SPLIT] = "eq.6 true: may hold 2 roots -> split",
+    [LG_SEG_TINY] = "shorter than tolerance",
+};
+
+static void trace_event(void *ctx, const lg_trace_event *ev) {
+  FILE *out = ctx;
+  char a[32], b[32], L[32], G[32];
+  format_real(a, ev->t0);
+  format_real(b, ev->t1);
+  snprintf(L, sizeof L, "%.4g", ev->L);
+  snprintf(G, sizeof G, "%.4g", ev->G);
+  fprintf(out, "  %*s[%s, %s]  rho-0.5 = %.3g .. %.3g  L = %s  G = %s  "
+          "eq.6: %.4g vs %.4g  %s  (%d instr)%s\n",
+          2 * (ev->depth < 20 ? ev->depth : 20), "", a, b, ev->f0, ev->f1, L, G,
+          ev->lhs, ev->t1 - ev->t0,
+          ev->decision >= 0 && ev->decision <= LG_SEG_TINY
+              ? decisions[ev->decision] : "?",
+          ev->ncode, ev->nroots ? "  -> root" : "");
+}
+
+/* Trace obj o d: Roots, printing the root search of every rounded leaf
+   the ray meets (segments, L, G, the eq. (6) decision, roots). */
+static Value *pr_trace(Interp *I, Value **args, Pos pos) {
+  lg_hook hook = {trace_event, stdout};
+  printf("Trace: segments of the guaranteed root search (Figure 9), "
+         "indented by depth\n");
+  Value *v = ray_probe(I, args, pos, &hook);
+  fflush(stdout);
+  return v;
+}
+
+/* LG r tree o d (t0, t1): (M, L, G) over the segment (Section 3.4.1). */
+static Value *pr_lg(Interp *I, Value **args, Pos pos) {
+  double r = get_radius(I, args[0], pos), o[3], d[3];
+  get_point(I, args[2], pos, "the ray origin", o);
+  get_dir(I, args[3], pos, d);
+  Value *seg = force(I, args[4]);
+  if (seg->kind != V_TUPLE || seg->u.tup.n != 2)
+    qcs_error(pos, "the segment is a pair (t0, t1)");
+  double t0 = force_num(I, seg->u.tup.items[0], pos, "t0");
+  double t1 = force_num(I, seg->u.tup.items[1], pos, "t1");
+  if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
+    qcs_error(pos, "the segment (t0, t1) needs finite t0 <= t1");
+  dt_tape *t = scene_density_tape(I, args[1], r, pos);
+  lg_bounds b;
+  lg_eval_bounds(t, o, d, t0, t1, &b);
+  dt_tape_free(t);
+  double M = fmax(fabs(b.lo), fabs(b.hi));
+  return val_tuple3(M, b.L, b.G);
+}
+
 #define PROBES(X)                                                            \
   X("Density", 3, pr_density,                                                \
     "Density r p tree: the density of the tree smoothed with radius r at p") \
@@ -197,7 +314,13 @@ static Value *pr_inner(Interp *I, Value **args, Pos pos) {
   X("OuterBounds", 3, pr_outer,                                              \
     "OuterBounds r t tree: a sharp object outside which density <= t")       \
   X("InnerBounds", 3, pr_inner,                                              \
-    "InnerBounds r t tree: a sharp object inside which density >= t")
+    "InnerBounds r t tree: a sharp object inside which density >= t")       \
+  X("Roots", 3, pr_roots,                                                    \
+    "Roots obj o d: every t >= 0 where o + t d crosses obj's surface")       \
+  X("Trace", 3, pr_trace,                                                    \
+    "Trace obj o d: Roots, printing the root search step by step")           \
+  X("LG", 5, pr_lg,                                                          \
+    "LG r tree o d (t0, t1): (M, L, G) bounds over the ray segment")
 
 static const Builtin probes[] = {
 #define X(name, arity, fn, doc) {name, arity, fn, doc},

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bounds.h"
 #include "eval.h"
 
 /* The constructors a scene is made of, recognised by name. */
@@ -236,6 +237,18 @@ static int compile_sharp(Compile *C, Value *v) {
 
 static int all_sharp(const dt_tape *t) { return t->rmax == 0; }
 
+/* A warning, given once per source position in this interpreter. */
+static void warn_once(Compile *C, Pos pos, const char *msg) {
+  Interp *I = C->I;
+  for (int i = 0; i < I->nwarned; i++)
+    if (I->warned[i].src == pos.src && I->warned[i].line == pos.line &&
+        I->warned[i].col == pos.col)
+      return;
+  if (I->nwarned < (int)(sizeof I->warned / sizeof *I->warned))
+    I->warned[I->nwarned++] = pos;
+  qcs_warning(pos, "%s", msg);
+}
+
 static int compile_soft(Compile *C, Value *v, Pos pos) {
   Interp *I = C->I;
   double magic = force_num(I, v->u.con.args[0], pos, "the magic value of a "
@@ -333,9 +346,20 @@ static int compile_obj(Compile *C, Value *v) {
       return compile_sharp(C, a[1]);
     }
     int i = add_node(C, SC_ROUNDED, pos);
-    C->s->nodes[i].tape = t;
+    ScNode *nd = &C->s->nodes[i];
+    nd->tape = t;
+    int fo = 0, fi = 0;
+    nd->outer = bnd_outer(t, 0.5, &fo);
+    nd->inner = bnd_inner(t, 0.5, &fi);
+    if (!nd->outer || !nd->inner) qcs_error(pos, "out of memory");
+    nd->bound_flags = fo | fi;
     C->s->flags |= SCENE_HAS_ROUNDED;
-    if (dt_max(t) > 1) C->s->ill_formed = 1;
+    if (nd->bound_flags & BND_RANGE) {
+      C->s->ill_formed = 1;
+      warn_once(C, pos, "this density tree can exceed 1 (overlapping Sums, "
+                "as in the paper's Figure 15b): its seams may bulge; the "
+                "search bounds are widened so that no crossing is lost");
+    }
     return i;
   }
   case K_SOFT:
@@ -368,6 +392,8 @@ void scene_free(Scene *s) {
   if (!s) return;
   for (int i = 0; i < s->n; i++) {
     if (s->nodes[i].tape) dt_tape_free(s->nodes[i].tape);
+    if (s->nodes[i].outer) csg_tape_free(s->nodes[i].outer);
+    if (s->nodes[i].inner) csg_tape_free(s->nodes[i].inner);
     if (s->nodes[i].soft) soft_free(s->nodes[i].soft);
   }
   free(s->nodes);

@@ -48,6 +48,8 @@ typedef struct ScNode {
   int a, b;              /* children, for the set operations */
   double n[3], d;        /* SC_HALFSPACE: unit normal and offset */
   dt_tape *tape;         /* SC_ROUNDED */
+  csg_tape *outer, *inner; /* SC_ROUNDED: bounds of the 0.5 isosurface */
+  int bound_flags;       /* BND_RANGE, BND_FALLBACK (bounds.h) */
   soft_obj *soft;        /* SC_SOFT */
   int has_colour;
   double colour[3];      /* from a Colour wrapper, linear RGB */
