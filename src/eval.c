@@ -21,7 +21,7 @@ void eval_check(Interp *I, Pos pos) {
               "base case missing?)", I->stack_limit >> 20);
   if (I->max_steps && ++I->steps > I->max_steps)
     qcs_error(pos, "evaluation step limit reached (%llu steps; raise it with "
-              "--max-steps or :set max-steps)", I->max_steps);
+              "--max-steps N)", I->max_steps);
 }
 
 /* ---- trace ---- */
@@ -753,7 +753,10 @@ static Value *bi_range_k(Interp *I, Value **args, Pos pos) {
   double x = from + k * step;
   if (args[2]) {
     double to = args[2]->u.num;
-    double limit = to + step / 2;
+    /* Whole-number ranges stop at `to` exactly ([10, 8 .. 1] ends at 2);
+       others allow half a step of rounding, as Haskell's Double ranges. */
+    int whole = from == floor(from) && step == floor(step) && to == floor(to);
+    double limit = whole ? to : to + step / 2;
     if (step > 0 ? x > limit : x < limit) return I->v_nil;
   }
   Value **next = val_array(4);
