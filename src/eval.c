@@ -690,6 +690,11 @@ static Value *index_list(Interp *I, Value *xs, Value *nv, Pos pos) {
   if (n < 0 || n != floor(n))
     qcs_error(pos, "'!!' needs a whole index >= 0, not %.17g", n);
   Value *v = force(I, xs);
+  if (v->kind != V_CONS && v->kind != V_NIL) {
+    char b[120];
+    val_brief(v, b, sizeof b);
+    qcs_error(pos, "'!!' indexes a list, not %s: %s", val_describe(v), b);
+  }
   for (double i = 0; i < n; i++) {
     if (v->kind != V_CONS) break;
     eval_check(I, pos);

@@ -13,6 +13,7 @@ typedef struct Parser {
   int ntoks, i;
   int lay_col[LAYOUT_MAX], lay_br[LAYOUT_MAX], nlay;
   int bracket;   /* depth of open ( and [ */
+  Token *open_tok[LAYOUT_MAX]; /* the innermost open brackets */
   int sep_used;  /* index of the token whose virtual separator was used */
   RunMode mode;
 } Parser;
@@ -52,7 +53,10 @@ static Pos pos_here(Parser *P) { return cur(P)->pos; }
 
 static Token *next(Parser *P) {
   Token *t = cur(P);
-  if (t->kind == T_LPAREN || t->kind == T_LBRACK) P->bracket++;
+  if (t->kind == T_LPAREN || t->kind == T_LBRACK) {
+    if (P->bracket >= 0 && P->bracket < LAYOUT_MAX) P->open_tok[P->bracket] = t;
+    P->bracket++;
+  }
   if (t->kind == T_RPAREN || t->kind == T_RBRACK) P->bracket--;
   if (t->kind != T_EOF) P->i++;
   return t;
@@ -72,7 +76,17 @@ static _Noreturn void error_at_token(Parser *P, const char *fmt, ...) {
   vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
   Token *t = cur(P);
-  if (t->kind == T_EOF) qcs_error_incomplete(t->pos, "%s", buf);
+  if (t->kind == T_EOF) {
+    /* At the end of the text the likely mistake is an unclosed bracket. */
+    int b = P->bracket - 1;
+    if (b >= 0 && b < LAYOUT_MAX && !strstr(buf, "(to close")) {
+      Token *o = P->open_tok[b];
+      qcs_error_incomplete(t->pos, "%s (to close '%c' at %d:%d)", buf,
+                           o->kind == T_LPAREN ? '(' : '[', o->pos.line,
+                           o->pos.col);
+    }
+    qcs_error_incomplete(t->pos, "%s", buf);
+  }
   qcs_error(t->pos, "%s", buf);
 }
 
@@ -447,7 +461,7 @@ static Expr *finish_range(Parser *P, Expr *from, Expr *then, Pos pos,
   Expr *e = mk(E_RANGE, pos);
   e->u.range.from = from;
   e->u.range.then = then;
-  e->u.range.to = peek(P) == T_RBRACK ? NULL : expr(P);
+  e->u.range.to = peek(P) == T_RBRACK || peek(P) == T_EOF ? NULL : expr(P);
   expect_close(P, T_RBRACK, open);
   return e;
 }
