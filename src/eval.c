@@ -449,6 +449,8 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
   }
   char buf[400];
   brief_args(I, d->arity, args, buf, sizeof buf);
+  if (d->name && !strcmp(d->name->name, "case"))
+    qcs_error(pos, "no alternative of this case matches %s", buf);
   if (d->name)
     qcs_error(pos, "no clause of %s matches the argument%s %s", d->name->name,
               d->arity == 1 ? "" : "s", buf);

@@ -27,6 +27,7 @@
   X(WHERE, "'where'") X(LET, "'let'") X(IN, "'in'") X(IF, "'if'")      \
   X(THEN, "'then'") X(ELSE, "'else'") X(TRUE, "'True'")                \
   X(FALSE, "'False'") X(KAND, "'and'") X(KOR, "'or'")                  \
+  X(CASE, "'case'") X(OF, "'of'")                                     \
   X(VSEP, "end of definition") X(VEND, "end of block")
 
 typedef enum {

@@ -678,7 +678,71 @@ static Def *lambda_def(Parser *P, Pos pos) {
 /* Bindings of a where or let block, lined up in one column. */
 static void block_bindings(Parser *P, Vec *defs, int stop_at_in);
 
+/* alts -> alt {sep alt}, lined up in one column like bindings
+   alt -> pat '->' expr | pat {'|' expr '->' expr} */
+static void case_alts(Parser *P, Vec *alts, Pos casepos) {
+  TokKind k = peek(P);
+  if (k == T_EOF || k == T_VEND || k == T_VSEP)
+    error_at_token(P, "expected an alternative, indented, after 'of' (for "
+                   "'case' at %d:%d)", casepos.line, casepos.col);
+  int col = cur(P)->pos.col;
+  if (P->nlay > 0 && P->lay_br[P->nlay - 1] == P->bracket &&
+      col <= P->lay_col[P->nlay - 1])
+    error_at_token(P, "indent the alternatives of 'case' (right of column "
+                   "%d)", P->lay_col[P->nlay - 1]);
+  layout_push(P, col);
+  use_sep(P);
+  for (;;) {
+    Pos apos = pos_here(P);
+    Pat **pats = GC_MALLOC(sizeof(Pat *));
+    pats[0] = to_pat(P, expr(P));
+    Vec vars = {0};
+    pat_vars(pats[0], &vars);
+    Vec guards = {0}, bodies = {0};
+    if (peek(P) == T_BAR) {
+      while (peek(P) == T_BAR) {
+        next(P);
+        vec_push(&guards, expr(P));
+        expect(P, T_ARROW, "after the guard of a case alternative");
+        vec_push(&bodies, expr(P));
+      }
+    } else {
+      expect(P, T_ARROW, "after the pattern of a case alternative");
+      vec_push(&guards, NULL);
+      vec_push(&bodies, expr(P));
+    }
+    Clause *c = GC_MALLOC(sizeof *c);
+    c->pos = apos;
+    c->npats = 1;
+    c->pats = pats;
+    c->nbodies = bodies.n;
+    c->guards = (Expr **)guards.items;
+    c->bodies = (Expr **)bodies.items;
+    vec_push(alts, c);
+    k = peek(P);
+    if (k == T_SEMI) {
+      next(P);
+      k = peek(P);
+      if (k == T_VSEP) {
+        use_sep(P);
+        continue;
+      }
+      if (k == T_VEND || k == T_EOF || k == T_SEMI || k == T_RPAREN ||
+          k == T_RBRACK)
+        break;
+      continue;
+    }
+    if (k == T_VSEP) {
+      use_sep(P);
+      continue;
+    }
+    break;
+  }
+  layout_pop(P);
+}
+
 /* prefix -> '\' pats '->' expr | 'let' bindings 'in' expr
+           | 'case' expr 'of' alts
            | 'if' expr 'then' expr 'else' expr | '-' operand | app */
 static Expr *operand(Parser *P, int minprec) {
   Pos pos = pos_here(P);
@@ -702,6 +766,19 @@ static Expr *operand(Parser *P, int minprec) {
     e->u.let.defs = (Def **)defs.items;
     e->u.let.body = expr(P);
     return e;
+  }
+  case T_CASE: { /* case e of alts: a one-argument lambda applied to e */
+    next(P);
+    Expr *scrut = expr(P);
+    if (peek(P) != T_OF)
+      error_at_token(P, "expected 'of' (for 'case' at %d:%d), found %s",
+                     pos.line, pos.col, describe(P));
+    next(P);
+    Vec alts = {0};
+    case_alts(P, &alts, pos);
+    Expr *lam = mk_lambda(pos, 1, alts.n, (Clause **)alts.items);
+    lam->u.lambda->name = sym_intern(P->I, "case", 4);
+    return mk_app(pos, lam, 1, &scrut);
   }
   case T_IF: {
     next(P);
