@@ -16,6 +16,7 @@
 #include "parse.h"
 #include "print.h"
 #include "probes.h"
+#include "render_lang.h"
 
 #include "prelude.inc"
 
@@ -491,6 +492,11 @@ void interp_browse(Interp *I, FILE *out, int all) {
   }
 }
 
+int interp_has_global(Interp *I, const char *name) {
+  Sym *s = sym_intern(I, name, (int)strlen(name));
+  return s->global != NULL;
+}
+
 void interp_request_interrupt(void) { qcs_interrupted = 1; }
 void interp_clear_interrupt(void) { qcs_interrupted = 0; }
 
@@ -515,6 +521,7 @@ Interp *interp_new(void) {
   I->v_nil->kind = V_NIL;
   builtins_install(I);
   probes_install(I);
+  render_install(I);
   I->loading_prelude = 1;
   RunStatus st = interp_run_string(I, "<prelude>", qcs_prelude_source,
                                    MODE_SCRIPT);

@@ -70,6 +70,9 @@ void interp_set_max_steps(Interp *I, unsigned long long steps);
 
 const char *interp_version(void);
 
+/* Is there a top-level value called name? */
+int interp_has_global(Interp *I, const char *name);
+
 /* Ask a running evaluation to stop with "interrupted" at its next step.
    Async-signal-safe: meant to be called from a SIGINT handler. */
 void interp_request_interrupt(void);

@@ -106,6 +106,7 @@ struct Interp {
   int ntrace;                /* entries in use (may exceed TRACE_MAX) */
   Forcing *forcing;
   int nforcing, capforcing;
+  struct RenderOverrides *render_overrides; /* from the command line */
   Pos warned[64];            /* warnings already given (said once each) */
   int nwarned;
   const char *run_name;      /* the file currently being run */

@@ -1,0 +1,27 @@
+/* render_lang.h: the render builtins of the language (renderWith; the
+ * prelude defines render = renderWith []), and the command line's
+ * overrides of a script's own render settings. */
+#ifndef QCS_RENDER_LANG_H
+#define QCS_RENDER_LANG_H
+
+#include "value.h"
+
+typedef struct RenderOverrides {
+  const char *output;   /* -o FILE: replaces every render's file name */
+  int width, height;    /* --size WxH (0: the script's) */
+  int spp;              /* --spp N */
+  int threads;          /* --threads N */
+  double tol;           /* --tolerance T (0: the script's) */
+  int cost;             /* --cost: add the root-finder cost channel */
+  int float_pixels;     /* --float: EXR RGBA as 32-bit floats */
+  int renders;          /* renders done so far */
+} RenderOverrides;
+
+void render_install(Interp *I);
+/* The overrides stay owned by the caller and must outlive I's use. */
+void render_set_overrides(Interp *I, RenderOverrides *o);
+/* Render obj to path with settings (a qcs list, or NULL for none); the
+   value is the file name. Errors are raised with qcs_error at pos. */
+Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
+                    Pos pos);
+#endif
