@@ -1,0 +1,681 @@
+/* test_image.c: the image output layer (image.c, exr.c, png.c).
+ *
+ * EXR files are read back through the OpenEXR C library itself (header,
+ * channel list, types) and through img_read_exr (values): float channels
+ * must come back exactly, half channels within relative 2^-11 (round to
+ * nearest half, normal range; the test values stay above 2^-14). The PNG
+ * and PPM bytes are checked against an sRGB encoder written here in long
+ * double (powl), not the code under test, and the PNG bytes are read with
+ * libpng directly. The atomic-write tests make writes fail for real (no
+ * permission, no directory, a file size limit, a directory in the way) and
+ * check that no temporary is left and an existing target is untouched.
+ * Everything happens in a mkdtemp directory that is removed at the end. */
+#include "check.h"
+#include "image.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <openexr.h>
+#include <png.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdint.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static char dir[64];
+
+static const char *in_dir(const char *name, char *buf, size_t n) {
+  snprintf(buf, n, "%s/%s", dir, name);
+  return buf;
+}
+
+/* Remove path and, for a directory, everything under it. */
+static void rm_rf(const char *path) {
+  DIR *d = opendir(path);
+  if (d) {
+    struct dirent *e;
+    while ((e = readdir(d))) {
+      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+      char sub[1024];
+      snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
+      rm_rf(sub);
+    }
+    closedir(d);
+    chmod(path, 0700);
+    rmdir(path);
+  } else {
+    unlink(path);
+  }
+}
+
+/* Names in directory d containing ".tmp." (leftover temporaries). */
+static int temps_in(const char *d) {
+  DIR *dd = opendir(d);
+  int n = 0;
+  struct dirent *e;
+  while (dd && (e = readdir(dd)))
+    if (strstr(e->d_name, ".tmp.")) n++;
+  if (dd) closedir(dd);
+  return n;
+}
+
+static int entries_in(const char *d) {
+  DIR *dd = opendir(d);
+  int n = 0;
+  struct dirent *e;
+  while (dd && (e = readdir(dd)))
+    if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) n++;
+  if (dd) closedir(dd);
+  return n;
+}
+
+static unsigned char *slurp(const char *path, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  size_t cap = 1 << 16, n = 0;
+  unsigned char *buf = malloc(cap);
+  size_t got;
+  while (buf && (got = fread(buf + n, 1, cap - n, f)) > 0) {
+    n += got;
+    if (n == cap) buf = realloc(buf, cap *= 2);
+  }
+  fclose(f);
+  *len = n;
+  return buf;
+}
+
+static int exists(const char *path) {
+  struct stat st;
+  return lstat(path, &st) == 0;
+}
+
+/* ---- independent sRGB reference (long double) ---------------------------- */
+
+static long double ref_encode(long double x) {
+  return x <= 0.0031308L ? 12.92L * x : 1.055L * powl(x, 1.0L / 2.4L) - 0.055L;
+}
+
+static long double ref_decode(long double s) {
+  return s <= 0.04045L ? s / 12.92L : powl((s + 0.055L) / 1.055L, 2.4L);
+}
+
+/* The 8-bit code of linear v; *tie set when 255 * encode(v) is within
+ * 1e-9 of a rounding boundary (where float rounding may legitimately go
+ * either way). */
+static int ref_code(float v, int *tie) {
+  *tie = 0;
+  if (!(v > 0)) return 0;
+  if (v >= 1) return 255;
+  long double t = ref_encode(v) * 255.0L;
+  *tie = fabsl(t - floorl(t) - 0.5L) < 1e-9L;
+  return (int)floorl(t + 0.5L);
+}
+
+/* ---- size limits and format names ---------------------------------------- */
+
+static void test_sizes(void) {
+  char err[200] = "";
+  CHECK("1x1 allowed", img_check_size(1, 1, err, sizeof err) == 0);
+  CHECK("8192x8192 allowed", img_check_size(8192, 8192, err, sizeof err) == 0);
+  CHECK("65536x1 allowed", img_check_size(65536, 1, err, sizeof err) == 0);
+  CHECK("0 wide refused", img_check_size(0, 10, err, sizeof err) == -1 &&
+                              strstr(err, "at least 1"));
+  CHECK("negative refused", img_check_size(10, -3, err, sizeof err) == -1);
+  CHECK("too many pixels", img_check_size(8193, 8192, err, sizeof err) == -1 &&
+                               strstr(err, "too large"));
+  CHECK("too wide", img_check_size(65537, 1, err, sizeof err) == -1);
+  CHECK("huge sides, no overflow",
+        img_check_size(0x7fffffffL, 0x7fffffffL, err, sizeof err) == -1);
+  CHECK("img_new refuses 0x5", img_new(0, 5, 0) == NULL);
+  Image *im = img_new(3, 2, IMG_Z | IMG_N | IMG_COST);
+  CHECK("img_new planes", im && im->rgba && im->z && im->n && im->cost &&
+                              im->width == 3 && im->height == 2);
+  CHECK("img_new Z is +inf, rest 0",
+        im && isinf(im->z[5]) && im->z[5] > 0 && im->n[17] == 0 &&
+            im->cost[5] == 0 && im->rgba[23] == 0);
+  img_free(im);
+  im = img_new(2, 2, 0);
+  CHECK("img_new without planes", im && !im->z && !im->n && !im->cost);
+  img_free(im);
+  img_free(NULL);
+
+  CHECK("format .exr", img_format("a/b.exr", err, sizeof err) == IMG_FMT_EXR);
+  CHECK("format .PNG", img_format("B.PNG", err, sizeof err) == IMG_FMT_PNG);
+  CHECK("format .Ppm", img_format("x.y.Ppm", err, sizeof err) == IMG_FMT_PPM);
+  CHECK("format .jpg refused",
+        img_format("out.jpg", err, sizeof err) == -1 &&
+            !strcmp(err, "unknown image format '.jpg' (use .exr, .png or .ppm)"));
+  CHECK("no extension refused",
+        img_format("dir.png/out", err, sizeof err) == -1 &&
+            strstr(err, "use .exr, .png or .ppm"));
+  CHECK("dot file is no extension", img_format(".png", err, sizeof err) == -1);
+}
+
+/* ---- EXR ------------------------------------------------------------------ */
+
+/* 37 x 21: two full ZIP chunks of 16 lines and a short one. */
+static Image *test_pattern(int w, int h) {
+  Image *im = img_new(w, h, IMG_Z | IMG_N | IMG_COST);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      size_t i = img_index(im, x, y);
+      float *p = im->rgba + 4 * i;
+      p[0] = 0.001f + (float)x / 7.0f;              /* up to ~5.1 */
+      p[1] = 1.0f / (1.0f + (float)(x * y));       /* (0, 1] */
+      p[2] = (float)(y + 1) * 3.3333f;             /* up to 70 */
+      p[3] = (x + y) % 3 ? 1.0f : 0.5f;
+      im->z[i] = (x + 2 * y) % 5 == 0 ? INFINITY : 0.125f + 1.37f * (float)x;
+      double a = 0.3 * x + 0.1 * y;
+      im->n[3 * i + 0] = (float)(cos(a) * 0.6);
+      im->n[3 * i + 1] = (float)(sin(a) * 0.6);
+      im->n[3 * i + 2] = 0.8f;
+      im->cost[i] = (float)(x * 31 + y * 7);
+    }
+  return im;
+}
+
+/* Header of an EXR file as the OpenEXR library itself reads it. */
+static void check_exr_header(const char *path, const char *what,
+                             int w, int h, int aovs, exr_pixel_type_t col,
+                             exr_compression_t comp) {
+  char name[160];
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  exr_context_t ctxt = NULL;
+  int ok = exr_start_read(&ctxt, path, &init) == EXR_ERR_SUCCESS;
+  snprintf(name, sizeof name, "%s: OpenEXR opens it", what);
+  CHECK(name, ok);
+  if (!ok) return;
+  int parts = 0;
+  exr_storage_t st;
+  exr_attr_box2i_t dw;
+  exr_compression_t c;
+  exr_get_count(ctxt, &parts);
+  exr_get_storage(ctxt, 0, &st);
+  exr_get_data_window(ctxt, 0, &dw);
+  exr_get_compression(ctxt, 0, &c);
+  snprintf(name, sizeof name, "%s: one scanline part, %dx%d", what, w, h);
+  CHECK(name, parts == 1 && st == EXR_STORAGE_SCANLINE && dw.min.x == 0 &&
+                  dw.min.y == 0 && dw.max.x == w - 1 && dw.max.y == h - 1);
+  snprintf(name, sizeof name, "%s: compression", what);
+  CHECK(name, c == comp);
+  static const char *const all[] = {"A", "B", "G", "N.X", "N.Y", "N.Z",
+                                    "R", "Z", IMG_EXR_COST_CHANNEL};
+  static const char *const rgba[] = {"A", "B", "G", "R"};
+  const char *const *want = aovs ? all : rgba;
+  int nwant = aovs ? 9 : 4;
+  const exr_attr_chlist_t *cl = NULL;
+  exr_get_channels(ctxt, 0, &cl);
+  int names_ok = cl && cl->num_channels == nwant, types_ok = names_ok;
+  for (int i = 0; names_ok && i < nwant; i++) {
+    names_ok = !strcmp(cl->entries[i].name.str, want[i]);
+    int colour = strlen(want[i]) == 1 && strchr("RGBA", want[i][0]);
+    types_ok = types_ok && cl->entries[i].pixel_type ==
+                               (colour ? col : EXR_PIXEL_FLOAT) &&
+               cl->entries[i].x_sampling == 1;
+  }
+  snprintf(name, sizeof name, "%s: channels %s in sorted order", what,
+           aovs ? "A B G N.X N.Y N.Z R Z qcs.steps" : "A B G R");
+  CHECK(name, names_ok);
+  snprintf(name, sizeof name, "%s: channel types", what);
+  CHECK(name, types_ok);
+  exr_finish(&ctxt);
+}
+
+/* |got - want| within relative 2^-11 (half) or exactly (float). */
+static int close_to(float got, float want, int half) {
+  if (isinf(want)) return got == want;
+  if (!half) return got == want;
+  return fabs((double)got - want) <= ldexp(fabs(want), -11);
+}
+
+static void test_exr(void) {
+  char path[256], err[300], name[160];
+  Image *im = test_pattern(37, 21);
+  for (int mode = 0; mode < 4; mode++) {
+    ImgWriteOptions opt = {.float_pixels = mode & 1,
+                           .no_compression = (mode & 2) != 0};
+    const char *what = (const char *[]){"EXR half zip", "EXR float zip",
+                                        "EXR half raw", "EXR float raw"}[mode];
+    in_dir(mode & 2 ? "all.EXR" : "all.exr", path, sizeof path);
+    int rc = img_write(im, path, &opt, err, sizeof err);
+    snprintf(name, sizeof name, "%s: written", what);
+    CHECK(name, rc == 0);
+    if (rc != 0) { printf("  %s\n", err); continue; }
+    check_exr_header(path, what, 37, 21, 1,
+                     opt.float_pixels ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF,
+                     opt.no_compression ? EXR_COMPRESSION_NONE
+                                        : EXR_COMPRESSION_ZIP);
+    Image *back = img_read_exr(path, err, sizeof err);
+    snprintf(name, sizeof name, "%s: read back with every plane", what);
+    CHECK(name, back && back->width == 37 && back->height == 21 &&
+                    back->flags == (IMG_Z | IMG_N | IMG_COST));
+    if (!back) { printf("  %s\n", err); continue; }
+    size_t np = 37 * 21;
+    int rgba_ok = 1, z_ok = 1, n_ok = 1, cost_ok = 1;
+    for (size_t i = 0; i < 4 * np; i++)
+      rgba_ok &= close_to(back->rgba[i], im->rgba[i], !opt.float_pixels);
+    for (size_t i = 0; i < np; i++) {
+      z_ok &= back->z[i] == im->z[i];
+      cost_ok &= back->cost[i] == im->cost[i];
+    }
+    for (size_t i = 0; i < 3 * np; i++) n_ok &= back->n[i] == im->n[i];
+    snprintf(name, sizeof name, "%s: RGBA values (%s)", what,
+             opt.float_pixels ? "exact" : "relative 2^-11");
+    CHECK(name, rgba_ok);
+    snprintf(name, sizeof name, "%s: Z exact, +inf kept", what);
+    CHECK(name, z_ok && isinf(back->z[0]));
+    snprintf(name, sizeof name, "%s: N exact", what);
+    CHECK(name, n_ok);
+    snprintf(name, sizeof name, "%s: cost exact", what);
+    CHECK(name, cost_ok);
+    img_free(back);
+  }
+  img_free(im);
+
+  /* no AOV planes: only the colour channels */
+  im = img_new(5, 40, 0);
+  for (size_t i = 0; i < 4 * 200; i++) im->rgba[i] = (float)(i % 17) * 0.25f;
+  in_dir("plain.exr", path, sizeof path);
+  CHECK("EXR RGBA only: written", img_write(im, path, NULL, err, sizeof err) == 0);
+  check_exr_header(path, "EXR RGBA only", 5, 40, 0, EXR_PIXEL_HALF,
+                   EXR_COMPRESSION_ZIP);
+  Image *back = img_read_exr(path, err, sizeof err);
+  int same = back && back->flags == 0 && !back->z && !back->n;
+  for (size_t i = 0; same && i < 800; i++) same = back->rgba[i] == im->rgba[i];
+  CHECK("EXR RGBA only: values (exact: quarters are halves)", same);
+  img_free(back);
+  img_free(im);
+
+  CHECK("EXR read of a missing file",
+        !img_read_exr(in_dir("none.exr", path, sizeof path), err, sizeof err) &&
+            strstr(err, "cannot read") && strstr(err, "No such file"));
+  FILE *f = fopen(in_dir("junk.exr", path, sizeof path), "wb");
+  fputs("this is not an OpenEXR file at all, not even close", f);
+  fclose(f);
+  CHECK("EXR read of a non-EXR file fails cleanly",
+        !img_read_exr(path, err, sizeof err) && strstr(err, "cannot read"));
+  unlink(path);
+}
+
+/* ---- PNG and PPM ------------------------------------------------------------ */
+
+/* Read a PNG's 8-bit rows with libpng directly: w * h * channels bytes. */
+static unsigned char *png_bytes(const char *path, int *w, int *h, int *nc,
+                                int *srgb) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL,
+                                           NULL);
+  png_infop info = png_create_info_struct(png);
+  unsigned char *volatile out = NULL;
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, NULL);
+    fclose(f);
+    free(out);
+    return NULL;
+  }
+  png_init_io(png, f);
+  png_read_info(png, info);
+  *w = (int)png_get_image_width(png, info);
+  *h = (int)png_get_image_height(png, info);
+  *nc = png_get_channels(png, info);
+  int srgb_intent = -1;
+  *srgb = png_get_sRGB(png, info, &srgb_intent) != 0;
+  if (png_get_bit_depth(png, info) != 8) png_error(png, "not 8 bits");
+  size_t rb = png_get_rowbytes(png, info);
+  out = malloc(rb * (size_t)*h);
+  for (int y = 0; y < *h; y++) png_read_row(png, out + rb * (size_t)y, NULL);
+  png_read_end(png, NULL);
+  png_destroy_read_struct(&png, &info, NULL);
+  fclose(f);
+  return out;
+}
+
+/* Linear values that probe the encoder: an even sweep, both sides of every
+ * rounding boundary (relative 1e-5 away from it), the linear segment's end,
+ * and the out-of-range ones (clamped) and NaN. */
+static int probe_values(float *v, int cap) {
+  int n = 0;
+  for (int i = 0; i < 2048; i++) v[n++] = (float)i / 2047.0f;
+  for (int k = 0; k < 255; k++) {
+    long double b = ref_decode((k + 0.5L) / 255.0L);
+    v[n++] = (float)(b * (1 - 1e-5L));
+    v[n++] = (float)(b * (1 + 1e-5L));
+  }
+  float special[] = {0.0031308f, 0.0031307f, 0.0031309f, -0.5f, -0.0f, 1.5f,
+                     1e30f, INFINITY, -INFINITY, NAN, 1e-30f, 0.99999f};
+  for (size_t i = 0; i < sizeof special / sizeof *special; i++)
+    v[n++] = special[i];
+  (void)cap;
+  return n;
+}
+
+static void test_png(void) {
+  char path[256], err[300];
+  float v[4096];
+  int n = probe_values(v, 4096);
+  /* 3 rows: R G B carry the probe values in three different orders */
+  Image *im = img_new(n, 3, 0);
+  for (int y = 0; y < 3; y++)
+    for (int x = 0; x < n; x++) {
+      float *p = im->rgba + 4 * img_index(im, x, y);
+      p[0] = v[(x + y) % n];
+      p[1] = v[(x + 7 * y + 1) % n];
+      p[2] = v[(n - 1 - x + y) % n];
+      p[3] = 1.0f;
+    }
+  in_dir("probe.png", path, sizeof path);
+  CHECK("PNG written", img_write(im, path, NULL, err, sizeof err) == 0);
+  int w = 0, h = 0, nc = 0, srgb = 0;
+  unsigned char *b = png_bytes(path, &w, &h, &nc, &srgb);
+  CHECK("PNG size and RGB", b && w == n && h == 3 && nc == 3);
+  CHECK("PNG has an sRGB chunk", b && srgb);
+  int wrong = 0, ties = 0;
+  for (int i = 0; b && i < 3 * n; i++)
+    for (int c = 0; c < 3; c++) {
+      int tie, want = ref_code(im->rgba[4 * i + c], &tie);
+      if (tie) ties++;
+      else if (b[3 * i + c] != want) {
+        if (wrong++ < 5)
+          printf("  value %.9g: code %d, reference %d\n",
+                 (double)im->rgba[4 * i + c], b[3 * i + c], want);
+      }
+    }
+  CHECK("PNG codes equal the long double sRGB reference, rounded to nearest",
+        b && wrong == 0);
+  CHECK("no probe value sits on a rounding tie", ties == 0);
+  free(b);
+
+  /* read back: linear values from the codes, by the reference decoder */
+  Image *back = img_read_png(path, err, sizeof err);
+  CHECK("PNG read back", back && back->width == n && back->height == 3);
+  int far = 0, tie;
+  for (int i = 0; back && i < 3 * n; i++)
+    for (int c = 0; c < 3; c++) {
+      long double want =
+          ref_decode(ref_code(im->rgba[4 * i + c], &tie) / 255.0L);
+      if (fabsl(back->rgba[4 * i + c] - want) > 1e-6L * want + 1e-9L) far++;
+    }
+  CHECK("PNG read decodes sRGB to linear (relative 1e-6)", back && far == 0);
+  CHECK("PNG without alpha reads as A = 1", back && back->rgba[3] == 1.0f);
+  img_free(back);
+  img_free(im);
+
+  int round_trip = 1;
+  for (int k = 0; k < 256; k++)
+    round_trip &= img_srgb8((float)img_srgb_decode(k / 255.0)) == k;
+  CHECK("every code survives decode then encode", round_trip);
+
+  /* alpha: premultiplied colour is divided out, alpha written linearly */
+  im = img_new(2, 1, 0);
+  float px[8] = {0.25f, 0.1f, 0.0f, 0.5f, 0.8f, 0.2f, 0.05f, 1.0f};
+  memcpy(im->rgba, px, sizeof px);
+  ImgWriteOptions opt = {.alpha = 1};
+  in_dir("alpha.png", path, sizeof path);
+  CHECK("PNG RGBA written", img_write(im, path, &opt, err, sizeof err) == 0);
+  b = png_bytes(path, &w, &h, &nc, &srgb);
+  CHECK("PNG RGBA has 4 channels", b && nc == 4 && w == 2 && h == 1);
+  CHECK("PNG RGBA unpremultiplied",
+        b && b[0] == ref_code(0.5f, &tie) && b[1] == ref_code(0.2f, &tie) &&
+            b[2] == 0 && b[3] == 128 && b[4] == ref_code(0.8f, &tie) &&
+            b[7] == 255);
+  free(b);
+  back = img_read_png(path, err, sizeof err);
+  CHECK("PNG RGBA read back premultiplied",
+        back && fabs(back->rgba[3] - 128 / 255.0) < 1e-7 &&
+            fabsl(back->rgba[0] - ref_decode(ref_code(0.5f, &tie) / 255.0L) *
+                                      (128 / 255.0L)) < 1e-6L);
+  img_free(back);
+  img_free(im);
+
+  CHECK("PNG read of a missing file",
+        !img_read_png(in_dir("none.png", path, sizeof path), err, sizeof err) &&
+            strstr(err, "No such file"));
+  FILE *f = fopen(in_dir("junk.png", path, sizeof path), "wb");
+  fputs("GIF89a not a png", f);
+  fclose(f);
+  CHECK("PNG read of a non-PNG fails cleanly",
+        !img_read_png(path, err, sizeof err) && strstr(err, "cannot read"));
+  unlink(path);
+}
+
+static void test_ppm(void) {
+  char path[256], err[300];
+  Image *im = img_new(3, 2, 0);
+  float vals[6][3] = {{0, 0.5f, 1}, {0.2f, 2.0f, -1}, {0.0031308f, 0.04f, 0.7f},
+                      {1, 1, 1},    {0.001f, 0.01f, 0.1f}, {NAN, 0.3f, 0.9f}};
+  for (int i = 0; i < 6; i++) {
+    memcpy(im->rgba + 4 * i, vals[i], sizeof vals[i]);
+    im->rgba[4 * i + 3] = 1;
+  }
+  in_dir("small.ppm", path, sizeof path);
+  CHECK("PPM written", img_write(im, path, NULL, err, sizeof err) == 0);
+  size_t len = 0;
+  unsigned char *b = slurp(path, &len);
+  const char *hdr = "P6\n3 2\n255\n";
+  size_t hl = strlen(hdr);
+  CHECK("PPM header P6 3 2 255", b && len == hl + 18 && !memcmp(b, hdr, hl));
+  int same = b && len == hl + 18, tie;
+  for (int i = 0; same && i < 18; i++)
+    same = b[hl + i] == ref_code(vals[i / 3][i % 3], &tie);
+  CHECK("PPM bytes are the reference sRGB codes, row by row", same);
+  free(b);
+  img_free(im);
+}
+
+/* ---- atomic writes -------------------------------------------------------- */
+
+/* Run img_write in a child process (so a resource limit or a changed user
+ * stays there); its return code and message come back through a pipe. */
+typedef struct {
+  const Image *im;
+  const char *path;
+  int as_nobody;   /* drop root to uid/gid 65534 first */
+  long fsize_max;  /* RLIMIT_FSIZE in the child if > 0 */
+} ChildWrite;
+
+static int write_in_child(const ChildWrite *cw, char *err, size_t errlen) {
+  int fds[2];
+  if (pipe(fds) != 0) return -2;
+  fflush(stdout);
+  pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    char msg[300] = "";
+    int rc;
+    if (cw->as_nobody && (setgid(65534) != 0 || setuid(65534) != 0)) {
+      rc = -3;
+    } else {
+      if (cw->fsize_max > 0) {
+        signal(SIGXFSZ, SIG_IGN);  /* let write() fail with EFBIG instead */
+        struct rlimit rl;
+        getrlimit(RLIMIT_FSIZE, &rl);
+        rl.rlim_cur = (rlim_t)cw->fsize_max;
+        setrlimit(RLIMIT_FSIZE, &rl);
+      }
+      rc = img_write(cw->im, cw->path, NULL, msg, sizeof msg);
+    }
+    if (write(fds[1], msg, strlen(msg) + 1) < 0) rc = -4;
+    _exit(rc == 0 ? 0 : rc == -1 ? 1 : rc == -3 ? 3 : 4);
+  }
+  close(fds[1]);
+  size_t got = 0;
+  ssize_t r;
+  while (got + 1 < errlen && (r = read(fds[0], err + got, errlen - 1 - got)) > 0)
+    got += (size_t)r;
+  err[got] = 0;
+  close(fds[0]);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  if (!WIFEXITED(st)) return -2;
+  int code = WEXITSTATUS(st);
+  return code == 0 ? 0 : code == 1 ? -1 : -code;
+}
+
+static void test_atomic(void) {
+  char path[320], sub[256], err[400], want[600];
+  Image *im = test_pattern(37, 21);
+
+  CHECK("no temporary left by the successful writes",
+        temps_in(dir) == 0 && entries_in(dir) == 6);
+
+  /* unknown extension: nothing created */
+  int before = entries_in(dir);
+  CHECK("unknown extension refused",
+        img_write(im, in_dir("out.jpg", path, sizeof path), NULL, err,
+                  sizeof err) == -1 &&
+            !strcmp(err, "unknown image format '.jpg' (use .exr, .png or .ppm)"));
+  CHECK("unknown extension creates nothing", entries_in(dir) == before);
+
+  /* a directory that does not exist */
+  in_dir("nowhere/out.png", path, sizeof path);
+  snprintf(want, sizeof want, "cannot write %s: No such file or directory",
+           path);
+  CHECK("missing directory: clear message",
+        img_write(im, path, NULL, err, sizeof err) == -1 && !strcmp(err, want));
+
+  /* a read-only directory (as root, permissions bind only another user) */
+  in_dir("ro", sub, sizeof sub);
+  mkdir(sub, 0755);
+  chmod(dir, 0755);
+  chmod(sub, 0555);
+  snprintf(path, sizeof path, "%s/out.png", sub);
+  ChildWrite cw = {im, path, geteuid() == 0, 0};
+  int rc = write_in_child(&cw, err, sizeof err);
+  if (rc == -3) {
+    printf("skip image: read-only directory (cannot drop root)\n");
+  } else {
+    snprintf(want, sizeof want, "cannot write %s: Permission denied", path);
+    CHECK("read-only directory: fails", rc == -1);
+    CHECK("read-only directory: 'cannot write PATH: Permission denied'",
+          !strcmp(err, want));
+    if (strcmp(err, want)) printf("  got: %s\n", err);
+    CHECK("read-only directory: left empty", entries_in(sub) == 0);
+  }
+  chmod(dir, 0700);
+
+  /* a failing write (file size limit) leaves the existing target as it was
+   * and no temporary, in every format */
+  Image *big = test_pattern(300, 200);
+  uint32_t seed = 12111;  /* noise, so that no format compresses it small */
+  for (size_t i = 0; i < 4 * 300 * 200; i++) {
+    seed = seed * 1664525u + 1013904223u;
+    big->rgba[i] = (float)(seed >> 8) * 0x1p-24f;
+  }
+  static const char *const names[] = {"keep.exr", "keep.png", "keep.ppm"};
+  for (int k = 0; k < 3; k++) {
+    char name[160];
+    in_dir(names[k], path, sizeof path);
+    FILE *f = fopen(path, "wb");
+    fputs("the previous image", f);
+    fclose(f);
+    ChildWrite fw = {big, path, 0, 4096};
+    rc = write_in_child(&fw, err, sizeof err);
+    snprintf(want, sizeof want, "cannot write %s: File too large", path);
+    snprintf(name, sizeof name, "%s: write past the size limit fails", names[k]);
+    CHECK(name, rc == -1 && !strcmp(err, want));
+    if (strcmp(err, want)) printf("  got: %s\n", err);
+    size_t len = 0;
+    unsigned char *b = slurp(path, &len);
+    snprintf(name, sizeof name, "%s: existing target untouched", names[k]);
+    CHECK(name, b && len == 18 && !memcmp(b, "the previous image", 18));
+    free(b);
+    snprintf(name, sizeof name, "%s: temporary removed", names[k]);
+    CHECK(name, temps_in(dir) == 0);
+    /* and without the limit the same write replaces it */
+    fw.fsize_max = 0;
+    snprintf(name, sizeof name, "%s: replaced when the write succeeds",
+             names[k]);
+    CHECK(name, write_in_child(&fw, err, sizeof err) == 0 &&
+                    (b = slurp(path, &len)) && len > 18 &&
+                    memcmp(b, "the previous image", 18));
+    free(b);
+  }
+  img_free(big);
+
+  /* a directory where the file should go: rename fails, temporary goes */
+  in_dir("adir.ppm", path, sizeof path);
+  mkdir(path, 0755);
+  snprintf(want, sizeof want, "cannot write %s: Is a directory", path);
+  CHECK("directory in the way: fails with its reason",
+        img_write(im, path, NULL, err, sizeof err) == -1 && !strcmp(err, want));
+  CHECK("directory in the way: temporary removed", temps_in(dir) == 0);
+
+  /* a stale temporary with our very name is not clobbered */
+  char stale[300];
+  snprintf(stale, sizeof stale, "%s/.fresh.ppm.tmp.%ld", dir, (long)getpid());
+  FILE *f = fopen(stale, "wb");
+  fputs("stale", f);
+  fclose(f);
+  in_dir("fresh.ppm", path, sizeof path);
+  CHECK("stale temporary: write succeeds beside it",
+        img_write(im, path, NULL, err, sizeof err) == 0 && exists(path));
+  size_t len = 0;
+  unsigned char *b = slurp(stale, &len);
+  CHECK("stale temporary: left as it was", b && len == 5 && !memcmp(b, "stale", 5));
+  free(b);
+  unlink(stale);
+  CHECK("stale temporary: no other temporary left", temps_in(dir) == 0);
+
+  CHECK("NULL image refused",
+        img_write(NULL, in_dir("n.png", path, sizeof path), NULL, err,
+                  sizeof err) == -1 && strstr(err, "no image"));
+  img_free(im);
+}
+
+/* ---- comparison ------------------------------------------------------------ */
+
+static void test_compare(void) {
+  Image *a = test_pattern(10, 8), *b = test_pattern(10, 8);
+  Image *c = img_new(8, 10, 0);
+  double rms = -1, share = -1;
+  CHECK("identical images", img_compare(a, b, &rms, &share, 0) == 0 &&
+                                rms == 0 && share == 0);
+  b->rgba[4 * img_index(b, 3, 4) + 1] += 0.1f;
+  b->rgba[4 * img_index(b, 5, 5) + 2] += 0.001f;
+  img_compare(a, b, &rms, &share, 0.01);
+  double d1 = (double)b->rgba[4 * img_index(b, 3, 4) + 1] -
+              a->rgba[4 * img_index(a, 3, 4) + 1];
+  double d2 = (double)b->rgba[4 * img_index(b, 5, 5) + 2] -
+              a->rgba[4 * img_index(a, 5, 5) + 2];
+  CHECK_NEAR("rms over the 240 RGB values", rms,
+             sqrt((d1 * d1 + d2 * d2) / 240), 1e-15);
+  CHECK_NEAR("share above threshold 0.01: 1 pixel of 80", share, 1.0 / 80, 0);
+  img_compare(a, b, &rms, &share, 0.0001);
+  CHECK_NEAR("share above threshold 0.0001: 2 of 80", share, 2.0 / 80, 0);
+  b->rgba[0] = a->rgba[0] = INFINITY;
+  img_compare(a, b, &rms, &share, 0.01);
+  CHECK("equal infinities do not differ", isfinite(rms) && share == 1.0 / 80);
+  b->rgba[0] = NAN;
+  img_compare(a, b, &rms, &share, 0.01);
+  CHECK("NaN against a number differs infinitely", isinf(rms) &&
+                                                       share == 2.0 / 80);
+  rms = 7;
+  CHECK("size mismatch refused", img_compare(a, c, &rms, &share, 0) == -1 &&
+                                     rms == 7);
+  img_free(a);
+  img_free(b);
+  img_free(c);
+}
+
+int main(void) {
+  check_prefix = "image";
+  snprintf(dir, sizeof dir, "/tmp/qcs-image-XXXXXX");
+  if (!mkdtemp(dir)) {
+    printf("FAIL image: mkdtemp: %s\n", strerror(errno));
+    return 1;
+  }
+  test_sizes();
+  test_exr();
+  test_png();
+  test_ppm();
+  test_atomic();
+  test_compare();
+  rm_rf(dir);
+  CHECK("test directory removed", !exists(dir));
+  CHECK_DONE();
+}
