@@ -14,7 +14,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "image.h"
 #include "interp.h"
+#include "render_lang.h"
 #include "repl.h"
 
 #define STACK_SIZE ((size_t)512 << 20) /* reserved, touched only as used */
@@ -31,6 +33,7 @@ typedef struct Options {
   unsigned long long max_steps;
   int status;
   size_t stack_use;
+  RenderOverrides render;
 } Options;
 
 static void usage(FILE *out) {
@@ -45,6 +48,14 @@ static void usage(FILE *out) {
           "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
           "  --set NAME=VALUE    replace the top-level definition NAME before\n"
           "                      the scripts run (VALUE is a qcs expression)\n"
+          "  -o FILE             render to FILE (.exr, .png or .ppm): what the\n"
+          "                      scripts render, or else their `scene`\n"
+          "  --size WxH          image size, overriding the scripts' own\n"
+          "  --spp N             samples per pixel (1, 4, 9, ...: n x n strata)\n"
+          "  --threads N         render threads (default: all cores)\n"
+          "  --tolerance T       root tolerance, a distance (default 1e-9)\n"
+          "  --cost              add the root-finder cost channel to an EXR\n"
+          "  --float             EXR colour as 32-bit floats (default half)\n"
           "  --max-steps N       stop an evaluation after N steps\n"
           "  -h, --help          this help\n"
           "  -V, --version       the version\n"
@@ -55,6 +66,7 @@ static void usage(FILE *out) {
 static void *run(void *arg) {
   Options *o = arg;
   Interp *I = interp_new();
+  render_set_overrides(I, &o->render);
   char probe;
   interp_set_stack(I, &probe, o->stack_use);
   if (o->max_steps) interp_set_max_steps(I, o->max_steps);
@@ -80,6 +92,19 @@ static void *run(void *arg) {
       o->status = 1;
       return NULL;
     }
+  /* -o with scripts that render nothing: render their `scene`. */
+  if (o->render.output && o->render.renders == 0) {
+    if (!interp_has_global(I, "scene")) {
+      fprintf(stderr, "qcs: error: -o %s: the scripts render nothing and "
+              "define no `scene` to render\n", o->render.output);
+      o->status = 1;
+      return NULL;
+    }
+    if (interp_eval_print(I, "renderWith [] \"-o\" scene") != RUN_OK) {
+      o->status = 1;
+      return NULL;
+    }
+  }
   if (o->nfiles == 0 && o->nexprs == 0) o->status = repl_run(I);
   return NULL;
 }
@@ -124,6 +149,46 @@ int main(int argc, char **argv) {
         return 1;
       }
       i++;
+    } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "qcs: error: %s needs a file name\n", a);
+        return 1;
+      }
+      o.render.output = argv[++i];
+    } else if (!strcmp(a, "--size")) {
+      int w, h;
+      char c;
+      if (i + 1 >= argc || sscanf(argv[i + 1], "%dx%d%c", &w, &h, &c) != 2 ||
+          w < 1 || h < 1) {
+        fprintf(stderr, "qcs: error: --size needs WxH, like 600x380\n");
+        return 1;
+      }
+      o.render.width = w;
+      o.render.height = h;
+      i++;
+    } else if (!strcmp(a, "--spp") || !strcmp(a, "--threads")) {
+      char *end;
+      long n = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : -1;
+      if (i + 1 >= argc || *end || n < (a[2] == 's' ? 1 : 1) || n > 256) {
+        fprintf(stderr, "qcs: error: %s needs a whole number from 1 to 256\n", a);
+        return 1;
+      }
+      if (a[2] == 's') o.render.spp = (int)n;
+      else o.render.threads = (int)n;
+      i++;
+    } else if (!strcmp(a, "--tolerance")) {
+      char *end;
+      double t = i + 1 < argc ? strtod(argv[i + 1], &end) : 0;
+      if (i + 1 >= argc || *end || !(t > 0) || t > 1e300) {
+        fprintf(stderr, "qcs: error: --tolerance needs a distance > 0\n");
+        return 1;
+      }
+      o.render.tol = t;
+      i++;
+    } else if (!strcmp(a, "--cost")) {
+      o.render.cost = 1;
+    } else if (!strcmp(a, "--float")) {
+      o.render.float_pixels = 1;
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "qcs: error: unknown option '%s' (see qcs --help)\n", a);
       return 1;
@@ -131,8 +196,22 @@ int main(int argc, char **argv) {
       o.files[o.nfiles++] = argv[i];
     }
   }
+  if (o.render.output && o.nfiles == 0 && o.nexprs == 0) {
+    fprintf(stderr, "qcs: error: -o needs a scene file to render\n");
+    return 1;
+  }
+  if (o.render.output) {
+    char err[300];
+    if (img_format(o.render.output, err, sizeof err) < 0) {
+      fprintf(stderr, "qcs: error: -o: %s\n", err);
+      return 1;
+    }
+  }
   GC_INIT();
   GC_allow_register_threads();
+  /* Ctrl-C ends a script's evaluation or render with "interrupted" (no
+     partial image is ever left); the REPL installs its own handling. */
+  if (o.nfiles || o.nexprs) repl_install_sigint();
   pthread_attr_t attr;
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, STACK_SIZE);
