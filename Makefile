@@ -35,7 +35,7 @@ LIBOBJS := $(filter-out $(BUILD)/main.o,$(OBJS))
 UNIT_SRCS := $(sort $(wildcard tests/unit/test_*.c))
 UNIT_BINS := $(UNIT_SRCS:tests/unit/%.c=$(BUILD)/tests/%)
 
-.PHONY: all units deps demo test check sanitize install uninstall clean bench
+.PHONY: all units deps demo test check sanitize install uninstall clean bench update-references
 
 BIN ?= qcs
 
@@ -76,14 +76,24 @@ deps:
 	fi
 
 demo: deps
-	$(MAKE) qcs
+	@$(MAKE) -s qcs
 	./qcs examples/demo.qcs
+	@mkdir -p gallery
+	./qcs -o gallery/figure12.png examples/figure12.qcs
+	./qcs -o gallery/figure12.exr examples/figure12.qcs
+	@echo "pictures: gallery/figure12.png and gallery/figure12.exr"
+
 
 test: deps
 	@$(MAKE) -s $(BIN) units
 	@sh tests/run-all.sh
 
 check: test
+
+# After a deliberate change to the pictures: look at them, then refresh.
+update-references: qcs units
+	@mkdir -p tests/images
+	QCS_UPDATE_REFERENCES=1 build/tests/test_render
 
 SAN_FLAGS := -g -fsanitize=address,undefined -fno-sanitize-recover=all
 sanitize: deps

@@ -1,0 +1,225 @@
+/* test_render.c: the tracer end to end, through the interpreter: small
+ * renders of the canonical scenes against stored reference images, the
+ * EXR read back through the OpenEXR library, shading checked against an
+ * independent long double computation, determinism across thread counts,
+ * and an interrupted render leaving no file.
+ *
+ * Reference images live in tests/images/NAME.png (150 x 95). After a
+ * deliberate change to the pictures, look at the new ones and refresh the
+ * references with `make update-references`. QCS_UPDATE_REFERENCES=1 makes
+ * this program write them instead of comparing. */
+#include <gc.h>
+#include <math.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "image.h"
+#include "interp.h"
+#include "render_lang.h"
+#include "value.h"
+
+static Interp *I;
+static char tmpdir[] = "/tmp/qcs-test-render-XXXXXX";
+
+/* Render FILE (an example) with the given overrides; 0 on success. */
+static int render_file(const char *file, const char *out, int w, int h,
+                       int threads, int cost) {
+  RenderOverrides o = {0};
+  o.output = out;
+  o.width = w;
+  o.height = h;
+  o.threads = threads;
+  o.cost = cost;
+  render_set_overrides(I, &o);
+  int st = interp_run_file(I, file);
+  render_set_overrides(I, NULL);
+  return st == RUN_OK && o.renders > 0 ? 0 : -1;
+}
+
+static void reference_test(const char *name) {
+  char ex[256], out[512], ref[256], err[300], label[300];
+  snprintf(ex, sizeof ex, "examples/%s.qcs", name);
+  snprintf(ref, sizeof ref, "tests/images/%s.png", name);
+  snprintf(out, sizeof out, "%s/%s.png", tmpdir, name);
+  snprintf(label, sizeof label, "reference image %s", name);
+  if (access(ex, R_OK) != 0) {
+    printf("skip render: %s: no %s yet\n", label, ex);
+    return;
+  }
+  if (render_file(ex, out, 150, 95, 0, 0)) {
+    CHECK(label, 0);
+    return;
+  }
+  if (getenv("QCS_UPDATE_REFERENCES")) {
+    Image *im = img_read_png(out, err, sizeof err);
+    if (im && img_write(im, ref, NULL, err, sizeof err) == 0)
+      printf("ok render: %s written\n", ref);
+    img_free(im);
+    return;
+  }
+  Image *a = img_read_png(out, err, sizeof err);
+  Image *b = img_read_png(ref, err, sizeof err);
+  if (!a || !b) {
+    printf("FAIL render: %s: %s (make update-references makes it)\n", label, err);
+    check_failed_count++;
+  } else {
+    double rms, share;
+    int ok = img_compare(a, b, &rms, &share, 0.1) == 0;
+    /* Tolerances: RMS 0.01 of full scale, and at most 0.5% of the pixels
+       off by more than 0.1 (an edge moving by a pixel). */
+    if (ok && rms <= 0.01 && share <= 0.005) {
+      printf("ok render: %s (rms %.4f, %.2f%% pixels differ)\n", label, rms,
+             100 * share);
+    } else {
+      printf("FAIL render: %s: rms %.4f, %.2f%% pixels differ by > 0.1\n",
+             label, rms, 100 * share);
+      check_failed_count++;
+    }
+  }
+  img_free(a);
+  img_free(b);
+}
+
+/* The floor pixel at (x, y) of figure12 lit by the light, computed in long
+   double from the scene conventions: camera, plane y = 0, grey 0.5,
+   ambient 0.15, Lambert, Blinn-Phong 0.3 with exponent 32. */
+static long double floor_radiance(int x, int y, int w, int h) {
+  long double eye[3] = {2.25L, 3.2L, 5.0L}, at[3] = {2.25L, 0.5L, -0.4L};
+  long double f[3], r[3], u[3], up[3] = {0, 1, 0};
+  long double fl = 0;
+  for (int i = 0; i < 3; i++) f[i] = at[i] - eye[i], fl += f[i] * f[i];
+  fl = sqrtl(fl);
+  for (int i = 0; i < 3; i++) f[i] /= fl;
+  r[0] = f[1] * up[2] - f[2] * up[1];
+  r[1] = f[2] * up[0] - f[0] * up[2];
+  r[2] = f[0] * up[1] - f[1] * up[0];
+  long double rl = sqrtl(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+  for (int i = 0; i < 3; i++) r[i] /= rl;
+  u[0] = r[1] * f[2] - r[2] * f[1];
+  u[1] = r[2] * f[0] - r[0] * f[2];
+  u[2] = r[0] * f[1] - r[1] * f[0];
+  long double th = tanl(35.0L * 3.14159265358979323846L / 360);
+  long double px = (2 * (x + 0.5L) / w - 1) * th * w / h;
+  long double py = (1 - 2 * (y + 0.5L) / h) * th;
+  long double d[3], dl = 0;
+  for (int i = 0; i < 3; i++) d[i] = f[i] + px * r[i] + py * u[i], dl += d[i] * d[i];
+  dl = sqrtl(dl);
+  for (int i = 0; i < 3; i++) d[i] /= dl;
+  long double t = -eye[1] / d[1];
+  long double p[3], L[3], ll = 0, light[3] = {-3, 8, 6};
+  for (int i = 0; i < 3; i++) p[i] = eye[i] + t * d[i];
+  for (int i = 0; i < 3; i++) L[i] = light[i] - p[i], ll += L[i] * L[i];
+  ll = sqrtl(ll);
+  for (int i = 0; i < 3; i++) L[i] /= ll;
+  long double H[3], hl = 0;
+  for (int i = 0; i < 3; i++) H[i] = L[i] - d[i], hl += H[i] * H[i];
+  hl = sqrtl(hl);
+  long double ndh = H[1] / hl;
+  return 0.5L * 0.15L + 0.5L * L[1] + 0.3L * powl(ndh, 32);
+}
+
+static void exr_test(void) {
+  char out[512], err[300];
+  snprintf(out, sizeof out, "%s/figure12.exr", tmpdir);
+  int w = 120, h = 76;
+  if (render_file("examples/figure12.qcs", out, w, h, 0, 1)) {
+    CHECK("render: figure12 to EXR", 0);
+    return;
+  }
+  Image *im = img_read_exr(out, err, sizeof err);
+  CHECK("exr: reads back through OpenEXR", im != NULL);
+  if (!im) return;
+  CHECK("exr: size", im->width == w && im->height == h);
+  CHECK("exr: Z, N and cost channels", (im->flags & (IMG_Z | IMG_N | IMG_COST)) ==
+                                           (IMG_Z | IMG_N | IMG_COST));
+  int sky = 0, hits = 0, unit = 0, cost = 0, floor_ok = 0, floor_n = 0;
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      size_t k = img_index(im, x, y);
+      float *c = &im->rgba[4 * k];
+      if (isinf(im->z[k])) {
+        /* The sky: the background colour, to half precision (2^-11). */
+        if (fabsf(c[0] - 0.55f) < 1e-3f && fabsf(c[1] - 0.65f) < 1e-3f &&
+            fabsf(c[2] - 0.85f) < 1e-3f)
+          sky++;
+        continue;
+      }
+      hits++;
+      float *n = &im->n[3 * k];
+      if (fabsf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1) < 1e-4f) unit++;
+      if (im->cost[k] >= 0) cost++;
+      /* Floor pixels (normal straight up, well below the objects). */
+      if (y > h - 8 && n[1] > 0.9999f) {
+        long double want = floor_radiance(x, y, w, h);
+        floor_n++;
+        /* Half precision colour: relative 2^-11; the floor may be in a
+           shadow only where the objects are, not in the bottom rows. */
+        if (fabsl(c[0] - want) <= 1e-3L * want + 1e-6L) floor_ok++;
+      }
+    }
+  int sky_total = w * h - hits;
+  /* (figure12 looks down at its floor: there may be no sky at all.) */
+  CHECK("exr: every sky pixel has the background colour", sky == sky_total);
+  CHECK("exr: every hit has a unit normal", hits > 0 && unit == hits);
+  CHECK("exr: cost channel is a count", cost == hits);
+  CHECK("exr: floor shading matches a long double computation",
+        floor_n > 0 && floor_ok == floor_n);
+  img_free(im);
+}
+
+static void determinism_test(void) {
+  char a[512], b[512], err[300];
+  snprintf(a, sizeof a, "%s/t1.exr", tmpdir);
+  snprintf(b, sizeof b, "%s/t3.exr", tmpdir);
+  int ra = render_file("examples/figure12.qcs", a, 97, 61, 1, 1);
+  int rb = render_file("examples/figure12.qcs", b, 97, 61, 3, 1);
+  Image *ia = ra ? NULL : img_read_exr(a, err, sizeof err);
+  Image *ib = rb ? NULL : img_read_exr(b, err, sizeof err);
+  int same = ia && ib;
+  if (same) {
+    size_t n = (size_t)ia->width * ia->height;
+    same = !memcmp(ia->rgba, ib->rgba, n * 4 * sizeof(float)) &&
+           !memcmp(ia->z, ib->z, n * sizeof(float)) &&
+           !memcmp(ia->n, ib->n, n * 3 * sizeof(float)) &&
+           !memcmp(ia->cost, ib->cost, n * sizeof(float));
+  }
+  CHECK("render: 1 and 3 threads give the same image, bit for bit", same);
+  img_free(ia);
+  img_free(ib);
+}
+
+static void interrupt_test(void) {
+  char out[512];
+  snprintf(out, sizeof out, "%s/interrupted.png", tmpdir);
+  qcs_interrupted = 1; /* as if Ctrl-C came before the first tile */
+  int r = render_file("examples/figure12.qcs", out, 150, 95, 2, 0);
+  qcs_interrupted = 0;
+  CHECK("render: an interrupted render fails", r != 0);
+  CHECK("render: an interrupted render leaves no file", access(out, F_OK) != 0);
+  /* Nor does it leave a temporary in the folder. */
+  char cmd[600];
+  snprintf(cmd, sizeof cmd, "ls -A %s | grep -q tmp", tmpdir);
+  CHECK("render: no temporary file left behind", system(cmd) != 0);
+}
+
+int main(void) {
+  check_prefix = "render";
+  if (!mkdtemp(tmpdir)) return 1;
+  I = interp_new();
+  char probe;
+  interp_set_stack(I, &probe, 4u << 20);
+  static const char *const scenes[] = {
+      "figure12", "figure12-sharp", "figure13", "figure15a",
+      "figure15b", "soft-cloud", "teapot", "mould", "staplers"};
+  for (size_t i = 0; i < sizeof scenes / sizeof *scenes; i++)
+    reference_test(scenes[i]);
+  if (!getenv("QCS_UPDATE_REFERENCES")) {
+    exr_test();
+    determinism_test();
+    interrupt_test();
+  }
+  char cmd[600];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+  if (system(cmd) != 0) return 1;
+  CHECK_DONE();
+}
