@@ -461,6 +461,19 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
 
 /* ---- application ---- */
 
+/* A position in the user's code for something the prelude builds: the
+   innermost call from outside the prelude (a Rounded rebuilt by Shift is
+   reported where the user wrote Shift). */
+static Pos user_pos(Interp *I, Pos pos) {
+  if (!pos.src || strcmp(pos.src->name, "<prelude>")) return pos;
+  int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
+  for (int i = n - 1; i >= 0; i--) {
+    const Pos *t = &I->trace[i].pos;
+    if (t->src && strcmp(t->src->name, "<prelude>")) return *t;
+  }
+  return pos;
+}
+
 /* Apply f to n arguments. Returns 1 with (*body, *benv) set when the result
    is a function body to evaluate in tail position, or 0 with *result. */
 static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
@@ -504,7 +517,7 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
       *result = val_con(c, a, cargs);
       if (pos.src) { /* scene errors found later point back here */
         Pos *p = GC_MALLOC(sizeof *p);
-        *p = pos;
+        *p = user_pos(I, pos);
         (*result)->u.con.pos = p;
       }
       return 0;

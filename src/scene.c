@@ -356,9 +356,9 @@ static int compile_obj(Compile *C, Value *v) {
     C->s->flags |= SCENE_HAS_ROUNDED;
     if (nd->bound_flags & BND_RANGE) {
       C->s->ill_formed = 1;
-      warn_once(C, pos, "this density tree can exceed 1 (overlapping Sums, "
-                "as in the paper's Figure 15b): its seams may bulge; the "
-                "search bounds are widened so that no crossing is lost");
+      warn_once(C, pos, "a Sum in this density tree may exceed 1 where its "
+                "parts overlap (the paper's Figure 15b): such seams bulge; "
+                "the search bounds allow for it, so no crossing is lost");
     }
     return i;
   }
