@@ -220,9 +220,9 @@ static int compile_sharp(Compile *C, Value *v) {
   case K_DIFFERENCE: case K_SETDIFF:
     return set_node(C, SC_DIFF, pos, compile_sharp(C, a[0]),
                     compile_sharp(C, a[1]));
-  case K_DHALFSPACE: case K_HALFSPACE: {
+  case K_DHALFSPACE: case K_HALFSPACE: case K_RHALFSPACE: {
     double n[3], d;
-    get_plane(C, a[0], pos, n, &d);
+    get_plane(C, a[k == K_RHALFSPACE ? 1 : 0], pos, n, &d);
     int i = add_node(C, SC_HALFSPACE, pos);
     double len = hypot(hypot(n[0], n[1]), n[2]);
     for (int j = 0; j < 3; j++) C->s->nodes[i].n[j] = n[j] / len;
@@ -323,6 +323,34 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   return i;
 }
 
+static int compile_obj(Compile *C, Value *v);
+
+/* Rounded r tree (also a density tree used as an object: r = 0, so that
+   only its RoundedHalfspace leaves are smoothed). */
+static int compile_rounded(Compile *C, Value *tree, double r, Pos pos) {
+  dt_tape *t = density_tape(C, tree, r, pos);
+  if (all_sharp(t)) { /* Rounded 0 t: exactly the sharp polyhedron */
+    dt_tape_free(t);
+    return compile_sharp(C, tree);
+  }
+  int i = add_node(C, SC_ROUNDED, pos);
+  ScNode *nd = &C->s->nodes[i];
+  nd->tape = t;
+  int fo = 0, fi = 0;
+  nd->outer = bnd_outer(t, 0.5, &fo);
+  nd->inner = bnd_inner(t, 0.5, &fi);
+  if (!nd->outer || !nd->inner) qcs_error(pos, "out of memory");
+  nd->bound_flags = fo | fi;
+  C->s->flags |= SCENE_HAS_ROUNDED;
+  if (nd->bound_flags & BND_RANGE) {
+    C->s->ill_formed = 1;
+    warn_once(C, pos, "a Sum in this density tree may exceed 1 where its "
+              "parts overlap (the paper's Figure 15b): such seams bulge; "
+              "the search bounds allow for it, so no crossing is lost");
+  }
+  return i;
+}
+
 static int compile_obj(Compile *C, Value *v) {
   eval_check(C->I, C->pos);
   v = force(C->I, v);
@@ -338,30 +366,8 @@ static int compile_obj(Compile *C, Value *v) {
     return set_node(C, SC_DIFF, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
   case K_HALFSPACE:
     return compile_sharp(C, v);
-  case K_ROUNDED: {
-    double r = get_radius(C, a[0], pos);
-    dt_tape *t = density_tape(C, a[1], r, pos);
-    if (all_sharp(t)) { /* Rounded 0 t: exactly the sharp polyhedron */
-      dt_tape_free(t);
-      return compile_sharp(C, a[1]);
-    }
-    int i = add_node(C, SC_ROUNDED, pos);
-    ScNode *nd = &C->s->nodes[i];
-    nd->tape = t;
-    int fo = 0, fi = 0;
-    nd->outer = bnd_outer(t, 0.5, &fo);
-    nd->inner = bnd_inner(t, 0.5, &fi);
-    if (!nd->outer || !nd->inner) qcs_error(pos, "out of memory");
-    nd->bound_flags = fo | fi;
-    C->s->flags |= SCENE_HAS_ROUNDED;
-    if (nd->bound_flags & BND_RANGE) {
-      C->s->ill_formed = 1;
-      warn_once(C, pos, "a Sum in this density tree may exceed 1 where its "
-                "parts overlap (the paper's Figure 15b): such seams bulge; "
-                "the search bounds allow for it, so no crossing is lost");
-    }
-    return i;
-  }
+  case K_ROUNDED:
+    return compile_rounded(C, a[1], get_radius(C, a[0], pos), pos);
   case K_SOFT:
     return compile_soft(C, v, pos);
   case K_EMPTY:
@@ -382,7 +388,7 @@ static int compile_obj(Compile *C, Value *v) {
     return i;
   }
   default:
-    if (is_density_kind(k)) return compile_sharp(C, v);
+    if (is_density_kind(k)) return compile_rounded(C, v, 0, pos);
     not_a(C, v, "a scene object (Union, Intersection, SetDifference, "
           "Rounded, Halfspace, SoftObject, or a density tree)");
   }
