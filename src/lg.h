@@ -28,7 +28,8 @@
  *
  * The search (Figure 9) is iterative with an explicit stack, left half
  * first, so roots come out in ascending order; a short segment with a sign
- * change is solved by Illinois regula falsi interleaved with bisection to
+ * change is solved within its bracket by Newton steps interleaved with
+ * bisection (safeguarded like rtsafe; the paper uses regula falsi) to
  * max(1e-3 tol, 4 ulp).  Segments shorter than tol are not split further
  * ("l negligibly small"): with a sign change they give one root (several
  * crossings closer than tol may merge); without one, the density is
@@ -57,7 +58,7 @@
 typedef struct lg_stats {
   long evals;        /* density (+ derivative) evaluations */
   long segments;     /* segments visited */
-  long rf_steps;     /* regula falsi / bisection steps */
+  long rf_steps;     /* root polishing steps (Newton or bisection) */
   long touches;      /* LG_TOUCH roots reported */
   long overflows;    /* segments left unsplit because the stack was full */
 } lg_stats;

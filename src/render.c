@@ -879,7 +879,7 @@ void render_report_print(FILE *out, const RenderReport *r, const char *path) {
   fprintf(out, "  rays: %ld primary, %ld shadow (%.2f M rays/s)\n", r->primary,
           r->shadow, r->seconds > 0 ? rays / r->seconds / 1e6 : 0.0);
   if (r->evals || r->segments)
-    fprintf(out, "  density: %ld evaluations, %ld segments, %ld regula falsi "
+    fprintf(out, "  density: %ld evaluations, %ld segments, %ld polishing "
             "steps; %.2f steps per ray (most in one ray: %ld)\n",
             r->evals, r->segments, r->steps,
             rays ? (double)(r->segments + r->steps) / rays : 0.0,
