@@ -156,12 +156,12 @@ static Value *bounds_probe(Interp *I, Value **args, Pos pos, int outer) {
   dt_tape_free(tape);
   if (!b) qcs_error(pos, "out of memory");
   if (flags & BND_RANGE)
-    qcs_warning(pos, "this density tree can exceed 1 (overlapping Sums, as in "
-                "the paper's Figure 15b): the bounds hold by interval "
-                "arithmetic, but seams may bulge");
+    scene_warn_once(I, pos, "a Sum in this density tree may exceed 1 where "
+                    "its parts overlap (the paper's Figure 15b): the bounds "
+                    "hold by interval arithmetic, but seams may bulge");
   if (flags & BND_FALLBACK)
-    qcs_warning(pos, "no theorem applies to part of this tree: a looser, "
-                "still safe bound was used there");
+    scene_warn_once(I, pos, "no theorem applies to part of this tree: a "
+                    "looser, still safe bound was used there");
   ErrFrame f;
   Value *v = NULL;
   if (ERR_TRY(f)) {

@@ -237,9 +237,7 @@ static int compile_sharp(Compile *C, Value *v) {
 
 static int all_sharp(const dt_tape *t) { return t->rmax == 0; }
 
-/* A warning, given once per source position in this interpreter. */
-static void warn_once(Compile *C, Pos pos, const char *msg) {
-  Interp *I = C->I;
+void scene_warn_once(Interp *I, Pos pos, const char *msg) {
   for (int i = 0; i < I->nwarned; i++)
     if (I->warned[i].src == pos.src && I->warned[i].line == pos.line &&
         I->warned[i].col == pos.col)
@@ -344,7 +342,7 @@ static int compile_rounded(Compile *C, Value *tree, double r, Pos pos) {
   C->s->flags |= SCENE_HAS_ROUNDED;
   if (nd->bound_flags & BND_RANGE) {
     C->s->ill_formed = 1;
-    warn_once(C, pos, "a Sum in this density tree may exceed 1 where its "
+    scene_warn_once(C->I, pos, "a Sum in this density tree may exceed 1 where its "
               "parts overlap (the paper's Figure 15b): such seams bulge; "
               "the search bounds allow for it, so no crossing is lost");
   }

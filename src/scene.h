@@ -75,6 +75,9 @@ void scene_free(Scene *s);
    dt_tape_free. */
 dt_tape *scene_density_tape(Interp *I, Value *tree, double r, Pos pos);
 
+/* A warning at pos, given once per source position per interpreter. */
+void scene_warn_once(Interp *I, Pos pos, const char *msg);
+
 /* Figure 4, PointInObject: 1 if p is inside the compiled object. */
 int scene_inside(const Scene *s, int node, const double p[3]);
 #endif
