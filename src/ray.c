@@ -164,9 +164,19 @@ static int soft_spans(const ScNode *n, int id, const double o[3],
   int nr = soft_roots(n->soft, o, d, t0, t1, t, MAX_LEAF_ROOTS, c->soft,
                       &c->stats.soft);
   if (nr < 0) return -1;
-  double p[3] = {o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2]};
-  int inside = isfinite(t0) && soft_field(n->soft, p) > soft_magic(n->soft);
-  return crossings_to_spans(t, NULL, nr, inside, id, t0, t1, out);
+  /* The state before the first crossing, sampled halfway to it; a
+     crossing reported at t0 itself (the origin on the surface, or within
+     rounding of it) is dropped and the state after it sampled instead. */
+  double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  double near = 1e-12 * (1 + fabs(t0) * len) / len;
+  int skip = 0;
+  while (skip < nr && isfinite(t0) && t[skip] - t0 <= near) skip++;
+  double end = skip < nr ? t[skip] : (isfinite(t1) ? t1 : t0 + 1 / len);
+  double tm = isfinite(t0) ? 0.5 * (t0 + end) : end - 1 / len;
+  double p[3] = {o[0] + tm * d[0], o[1] + tm * d[1], o[2] + tm * d[2]};
+  int inside = soft_field(n->soft, p) > soft_magic(n->soft);
+  return crossings_to_spans(t + skip, NULL, nr - skip, inside, id, t0, t1,
+                            out);
 }
 
 int ray_spans(const Scene *s, int node, const double o[3], const double d[3],

@@ -625,8 +625,10 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
         prev_h = h;
         if (nout >= maxout) break;
       }
-    } else if (na == 0) {
-      state = 0;  /* no key acts: field 0 < magic */
+    } else if (na == 0 && tnext > cur) {
+      state = 0;  /* no key acts on a stretch: field 0 < magic (not at an
+                     empty [cur, cur], where keys holding the origin are
+                     about to be opened) */
     }
     cur = tnext;
     if (cur >= r.tb) break;
