@@ -43,11 +43,12 @@ static void report_error(Interp *I) {
            I->trace[i - same].pos.col == t->pos.col &&
            I->trace[i - same].pos.src == t->pos.src)
       same++;
+    const char *name = t->name[0] == '%' ? "a list comprehension" : t->name;
     if (t->pos.src && t->pos.line)
-      fprintf(stderr, "  in %s, called at %s:%d:%d", t->name,
+      fprintf(stderr, "  in %s, called at %s:%d:%d", name,
               t->pos.src->name, t->pos.line, t->pos.col);
     else
-      fprintf(stderr, "  in %s", t->name);
+      fprintf(stderr, "  in %s", name);
     if (same > 1) fprintf(stderr, " (%d times)", same);
     fputc('\n', stderr);
     i -= same;
