@@ -194,10 +194,10 @@ static int kind_of(double df) {
  * safeguarded Newton of Numerical Recipes' rtsafe, in place of the paper's
  * regula falsi; both keep the bracket, this one converges quadratically
  * and uses the derivative every evaluation computes anyway). Stops when a
- * step is below max(1e-3 tol, 4 ulp). */
+ * step is below max(tol, 4 ulp). */
 static double polish(search *s, const dt_tape *t, double a, double b,
                      double fa, double fb, double dfa, double dfb) {
-  double rtol = fmax(1e-3 * s->tol, 4 * DBL_EPSILON * fmax(fabs(a), fabs(b)));
+  double rtol = fmax(s->tol, 4 * DBL_EPSILON * fmax(fabs(a), fabs(b)));
   double x, f, df;
   if (fabs(fa) < fabs(fb)) x = a, f = fa, df = dfa;
   else x = b, f = fb, df = dfb;

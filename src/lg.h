@@ -29,8 +29,9 @@
  * The search (Figure 9) is iterative with an explicit stack, left half
  * first, so roots come out in ascending order; a short segment with a sign
  * change is solved within its bracket by Newton steps interleaved with
- * bisection (safeguarded like rtsafe; the paper uses regula falsi) to
- * max(1e-3 tol, 4 ulp).  Segments shorter than tol are not split further
+ * bisection (safeguarded like rtsafe; the paper uses regula falsi) until
+ * a step is below max(tol, 4 ulp): with quadratic convergence the root is
+ * then far closer than tol.  Segments shorter than tol are not split further
  * ("l negligibly small"): with a sign change they give one root (several
  * crossings closer than tol may merge); without one, the density is
  * sampled at the extremum the end derivatives predict, and
