@@ -22,6 +22,17 @@ void eval_check(Interp *I, Pos pos) {
   if (I->max_steps && ++I->steps > I->max_steps)
     qcs_error(pos, "evaluation step limit reached (%llu steps; raise it with "
               "--max-steps N)", I->max_steps);
+  if (I->max_memory && ++I->memcheck >= 4096) {
+    I->memcheck = 0;
+    size_t used = GC_get_heap_size() - GC_get_free_bytes();
+    if (used > I->max_memory) {
+      GC_gcollect();
+      used = GC_get_heap_size() - GC_get_free_bytes();
+      if (used > I->max_memory)
+        qcs_error(pos, "memory limit reached (%zu MB of values; raise it with "
+                  "--max-memory MB)", I->max_memory >> 20);
+    }
+  }
 }
 
 /* ---- trace ---- */

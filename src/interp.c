@@ -513,6 +513,7 @@ Interp *interp_new(void) {
   char probe;
   I->stack_base = &probe;
   I->stack_limit = 6u << 20;
+  I->max_memory = (size_t)8 << 30; /* 8 GB of values unless told otherwise */
   I->v_true = GC_MALLOC(sizeof(Value));
   I->v_true->kind = V_BOOL;
   I->v_true->u.b = 1;
@@ -538,6 +539,8 @@ void interp_set_stack(Interp *I, char *base, size_t limit) {
   I->stack_base = base;
   I->stack_limit = limit;
 }
+
+void interp_set_max_memory(Interp *I, size_t bytes) { I->max_memory = bytes; }
 
 void interp_set_max_steps(Interp *I, unsigned long long steps) {
   I->max_steps = steps;

@@ -68,6 +68,10 @@ void interp_set_stack(Interp *I, char *base, size_t limit);
 /* Stop evaluations after this many steps with a clear error (0: never). */
 void interp_set_max_steps(Interp *I, unsigned long long steps);
 
+/* Stop evaluations with a clear error when the values in memory exceed
+   this many bytes (0: no limit; the default is 8 GB). */
+void interp_set_max_memory(Interp *I, size_t bytes);
+
 const char *interp_version(void);
 
 /* Is there a top-level value called name? */

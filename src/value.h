@@ -102,6 +102,8 @@ struct Interp {
   size_t stack_limit;        /* bytes of C stack evaluation may use */
   unsigned long long steps;  /* evaluation steps so far */
   unsigned long long max_steps; /* 0 = no limit */
+  size_t max_memory;         /* bytes of values allowed (0 = no limit) */
+  unsigned memcheck;         /* steps since the memory was last checked */
   TraceEntry trace[TRACE_MAX];
   int ntrace;                /* entries in use (may exceed TRACE_MAX) */
   Forcing *forcing;
