@@ -3,6 +3,8 @@
  *   qcs                  the REPL
  *   qcs FILE...          run scripts in order, stopping at the first error
  *   qcs -e EXPR          evaluate EXPR (prelude loaded), print it, exit
+ *   qcs tradeoff FILE    error against run time over root tolerances
+ *   qcs convolution      the quasi-convolution against the true one
  *
  * The interpreter runs on a thread of its own with a large stack, so that
  * deep (non-tail) recursion in user programs is limited by a clear
@@ -18,6 +20,7 @@
 #include "interp.h"
 #include "render_lang.h"
 #include "repl.h"
+#include "tradeoff.h"
 
 #define STACK_SIZE ((size_t)512 << 20) /* reserved, touched only as used */
 #define STACK_USE ((size_t)256 << 20)  /* ~350000 nested calls */
@@ -34,6 +37,8 @@ typedef struct Options {
   int status;
   size_t stack_use;
   RenderOverrides render;
+  int tradeoff;            /* qcs tradeoff: files[0] is the script */
+  TradeoffOptions topt;
 } Options;
 
 static void usage(FILE *out) {
@@ -82,6 +87,10 @@ static void *run(void *arg) {
       return NULL;
     }
   }
+  if (o->tradeoff) {
+    o->status = tradeoff_file(I, o->files[0], &o->topt);
+    return NULL;
+  }
   for (int i = 0; i < o->nfiles; i++)
     if (interp_run_file(I, o->files[i]) != RUN_OK) {
       o->status = 1;
@@ -109,10 +118,81 @@ static void *run(void *arg) {
   return NULL;
 }
 
+/* ---- qcs tradeoff / qcs convolution (issue 6) ---- */
+
+static void tradeoff_usage(FILE *out) {
+  fputs("usage: qcs tradeoff [--size WxH] [--threads N] [--repeats N] "
+        "[-o PLOT.svg] FILE.qcs\n"
+        "       qcs convolution\n"
+        "\n"
+        "tradeoff: render what FILE renders (or its `scene`) at root "
+        "tolerances\n1e-2 ... 1e-12, best of --repeats runs (default 3) "
+        "each; print time,\nevaluations and error against the 1e-12 rung; "
+        "plot error against time\n(default tradeoff.svg).\n"
+        "convolution: the quasi-convolutional surface against the true\n"
+        "convolution of the polyhedron with the ball, on canonical "
+        "objects.\n", out);
+}
+
+/* Parses the subcommand's arguments into o; -1: exit with status 1,
+   1: exit with status 0, 0: run. */
+static int tradeoff_args(int argc, char **argv, Options *o) {
+  o->tradeoff = 1;
+  for (int i = 2; i < argc; i++) {
+    const char *a = argv[i];
+    int w, h;
+    long n;
+    char c, *end;
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      tradeoff_usage(stdout);
+      return 1;
+    } else if (!strcmp(a, "--size") && i + 1 < argc &&
+               sscanf(argv[i + 1], "%dx%d%c", &w, &h, &c) == 2 && w > 0 &&
+               h > 0) {
+      o->topt.width = w;
+      o->topt.height = h;
+      i++;
+    } else if ((!strcmp(a, "--threads") || !strcmp(a, "--repeats")) &&
+               i + 1 < argc && (n = strtol(argv[i + 1], &end, 10)) >= 1 &&
+               n <= 256 && !*end) {
+      if (a[2] == 't') o->topt.threads = (int)n;
+      else o->topt.repeats = (int)n;
+      i++;
+    } else if (!strcmp(a, "-o") && i + 1 < argc) {
+      o->topt.svg = argv[++i];
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "qcs: error: tradeoff: bad option or argument '%s'\n", a);
+      tradeoff_usage(stderr);
+      return -1;
+    } else {
+      o->files[o->nfiles++] = argv[i];
+    }
+  }
+  if (o->nfiles != 1) {
+    fprintf(stderr, "qcs: error: tradeoff needs one scene file\n");
+    tradeoff_usage(stderr);
+    return -1;
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static Options o;
   o.files = calloc((size_t)argc + 1, sizeof(char *));
-  for (int i = 1; i < argc; i++) {
+  if (argc > 1 && !strcmp(argv[1], "convolution")) {
+    int help = argc == 3 && !strcmp(argv[2], "--help");
+    if (argc > 2) {
+      tradeoff_usage(help ? stdout : stderr);
+      return help ? 0 : 1;
+    }
+    return conv_report(stdout) ? 1 : 0;
+  }
+  int sub = argc > 1 && !strcmp(argv[1], "tradeoff");
+  if (sub) {
+    int rc = tradeoff_args(argc, argv, &o);
+    if (rc) return rc < 0 ? 1 : 0;
+  }
+  for (int i = 1; i < argc && !sub; i++) {
     const char *a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
       usage(stdout);
@@ -211,7 +291,7 @@ int main(int argc, char **argv) {
   GC_allow_register_threads();
   /* Ctrl-C ends a script's evaluation or render with "interrupted" (no
      partial image is ever left); the REPL installs its own handling. */
-  if (o.nfiles || o.nexprs) repl_install_sigint();
+  if (o.nfiles || o.nexprs || o.tradeoff) repl_install_sigint();
   pthread_attr_t attr;
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, STACK_SIZE);

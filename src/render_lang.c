@@ -140,6 +140,13 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
     ov->renders++;
   }
   char err[512];
+  if (ov && ov->capture) {
+    Scene *cs = scene_compile(I, obj, pos);
+    int rc = ov->capture(ov->capture_ctx, cs, &rs, path, err, sizeof err);
+    scene_free(cs);
+    if (rc) qcs_error(pos, "%s", err);
+    return val_str(path);
+  }
   if (img_format(path, err, sizeof err) < 0) qcs_error(pos, "%s", err);
   Scene *s = scene_compile(I, obj, pos);
   RenderReport rep;

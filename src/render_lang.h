@@ -6,6 +6,17 @@
 
 #include "value.h"
 
+struct Scene;
+struct RenderSettings;
+
+/* A capture hook (see RenderOverrides.capture): called with the compiled
+   scene and the settings in force instead of rendering and writing. The
+   scene and settings are only borrowed for the call. Returns 0, or -1
+   with a message in err (raised as a qcs error at the render). */
+typedef int (*RenderCapture)(void *ctx, const struct Scene *s,
+                             const struct RenderSettings *rs,
+                             const char *path, char *err, size_t errlen);
+
 typedef struct RenderOverrides {
   const char *output;   /* -o FILE: replaces every render's file name */
   int width, height;    /* --size WxH (0: the script's) */
@@ -15,6 +26,9 @@ typedef struct RenderOverrides {
   int cost;             /* --cost: add the root-finder cost channel */
   int float_pixels;     /* --float: EXR RGBA as 32-bit floats */
   int renders;          /* renders done so far */
+  RenderCapture capture;  /* non-NULL: renders call this instead (qcs
+                             tradeoff); nothing is written */
+  void *capture_ctx;
 } RenderOverrides;
 
 void render_install(Interp *I);

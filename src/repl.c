@@ -13,6 +13,7 @@
  * collector has threads too: blocking signals in this thread and waiting
  * in pselect() would miss them). */
 #include "repl.h"
+#include "tradeoff.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -216,6 +217,7 @@ static void cmd_load(Repl *R, const char *arg, int bang);
 static void cmd_reload(Repl *R, const char *arg, int bang);
 static void cmd_browse(Repl *R, const char *arg, int bang);
 static void cmd_quit(Repl *R, const char *arg, int bang);
+static void cmd_tradeoff(Repl *R, const char *arg, int bang);
 
 /* Sorted by name; a command may be abbreviated to any unique prefix. */
 static const Command commands[] = {
@@ -226,6 +228,8 @@ static const Command commands[] = {
    "run a qcs file and remember it for :reload"},
   {"quit", ARG_NONE, 0, cmd_quit, ":quit", "leave qcs (so does Ctrl-D)"},
   {"reload", ARG_NONE, 0, cmd_reload, ":reload", "run the loaded files again"},
+  {"tradeoff", ARG_FILE, 0, cmd_tradeoff, ":tradeoff FILE",
+   "error against run time over root tolerances (writes tradeoff.svg)"},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 
@@ -286,6 +290,18 @@ static void cmd_load(Repl *R, const char *arg, int bang) {
     if (st == RUN_OK && R->interactive) printf("loaded %s\n", path.s);
   }
   free(path.s);
+}
+
+/* :tradeoff FILE (issue 6): the file's render captured and measured over
+   the tolerance ladder; see tradeoff.h. */
+static void cmd_tradeoff(Repl *R, const char *arg, int bang) {
+  TradeoffOptions o;
+  memset(&o, 0, sizeof o);
+  int st;
+  interp_clear_interrupt();
+  st = tradeoff_file(R->I, arg, &o);
+  fflush(stdout);
+  if (st) R->had_error = 1;
 }
 
 static void cmd_reload(Repl *R, const char *arg, int bang) {

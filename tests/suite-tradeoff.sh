@@ -1,0 +1,42 @@
+#!/bin/sh
+# suite-tradeoff.sh: `qcs tradeoff` on a small figure12: one table row per
+# rung (1e-2 ... 1e-12), the plot written, and errors bounded by each
+# rung's tolerance and falling from the loose rungs to the tight ones (a
+# property, no hard-coded numbers). One line per check: "ok NAME" or
+# "FAIL NAME: why".   QCS  the binary under test (default ./qcs)
+cd "$(dirname "$0")/.." || exit 1
+QCS=${QCS:-./qcs}
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+if ! "$QCS" tradeoff --size 60x38 --repeats 2 -o "$tmp/t.svg" \
+     examples/figure12.qcs >"$tmp/out" 2>"$tmp/err"; then
+  echo "FAIL tradeoff-runs: exit status $? ($(head -c 300 "$tmp/err"))"
+  exit 1
+fi
+echo "ok tradeoff-runs"
+rows=$(grep -c '^| 1e-' "$tmp/out")
+[ "$rows" -eq 11 ] && echo "ok tradeoff-one-row-per-rung" ||
+  echo "FAIL tradeoff-one-row-per-rung: $rows rows"
+grep -q 'best wall time' "$tmp/out" && echo "ok tradeoff-says-best-of" ||
+  echo "FAIL tradeoff-says-best-of"
+grep -q '<svg' "$tmp/t.svg" 2>/dev/null && grep -q 'wall time' "$tmp/t.svg" &&
+  grep -q '1e-05' "$tmp/t.svg" && echo "ok tradeoff-plot" ||
+  echo "FAIL tradeoff-plot: no labelled SVG"
+# columns: | tol | time | evals | steps | maxdZ | rmsdZ | rgb | changed |
+awk -F'|' '/^\| 1e-/ && $6 !~ /ref/ {
+    tol = $2 + 0; mx = $6 + 0; rms = $7 + 0;
+    if (mx > tol) bad = bad " max dZ " mx " > tol " tol;
+    if (rms > mx) bad = bad " rms > max at " tol;
+    if (tol >= 1e-6 && mx > loose) loose = mx;
+    if (tol <= 1e-9 && mx > tight) tight = mx;
+    n++
+  }
+  END {
+    if (n != 10) bad = bad " " n " compared rungs";
+    if (!(tight < loose)) bad = bad " tight rungs (" tight ") not below loose (" loose ")";
+    if (bad) { print "FAIL tradeoff-errors-fall:" bad; exit }
+    print "ok tradeoff-errors-fall"
+  }' "$tmp/out"
+# the evaluation count rises as the tolerance tightens, end to end
+awk -F'|' '/^\| 1e-0[2]/ {a = $4 + 0} /^\| 1e-12/ {b = $4 + 0}
+  END { if (b > a) print "ok tradeoff-evals-rise"; else print "FAIL tradeoff-evals-rise: " a " then " b }' "$tmp/out"
