@@ -34,6 +34,7 @@ typedef struct Options {
   char **files;
   int nfiles;
   unsigned long long max_steps;
+  long long max_memory_mb; /* -1: the default */
   int status;
   size_t stack_use;
   RenderOverrides render;
@@ -62,6 +63,8 @@ static void usage(FILE *out) {
           "  --cost              add the root-finder cost channel to an EXR\n"
           "  --float             EXR colour as 32-bit floats (default half)\n"
           "  --max-steps N       stop an evaluation after N steps\n"
+          "  --max-memory MB     stop an evaluation whose values pass MB megabytes\n"
+          "                      (default 8192; 0 for no limit)\n"
           "  -h, --help          this help\n"
           "  -V, --version       the version\n"
           "\n"
@@ -75,6 +78,8 @@ static void *run(void *arg) {
   char probe;
   interp_set_stack(I, &probe, o->stack_use);
   if (o->max_steps) interp_set_max_steps(I, o->max_steps);
+  if (o->max_memory_mb >= 0)
+    interp_set_max_memory(I, (size_t)o->max_memory_mb << 20);
   for (int i = 0; i < o->nsets; i++) {
     const char *eq = strchr(o->sets[i], '=');
     char name[256];
@@ -178,6 +183,7 @@ static int tradeoff_args(int argc, char **argv, Options *o) {
 
 int main(int argc, char **argv) {
   static Options o;
+  o.max_memory_mb = -1;
   o.files = calloc((size_t)argc + 1, sizeof(char *));
   if (argc > 1 && !strcmp(argv[1], "convolution")) {
     int help = argc == 3 && !strcmp(argv[2], "--help");
@@ -220,6 +226,16 @@ int main(int argc, char **argv) {
         return 1;
       }
       o.sets[o.nsets++] = argv[++i];
+    } else if (!strcmp(a, "--max-memory")) {
+      char *end;
+      long long mb = i + 1 < argc ? strtoll(argv[i + 1], &end, 10) : -1;
+      if (i + 1 >= argc || *end || mb < 0 || mb > (1LL << 40)) {
+        fprintf(stderr, "qcs: error: --max-memory needs megabytes, a whole "
+                "number >= 0\n");
+        return 1;
+      }
+      o.max_memory_mb = mb;
+      i++;
     } else if (!strcmp(a, "--max-steps")) {
       char *end;
       if (i + 1 >= argc || !(o.max_steps = strtoull(argv[i + 1], &end, 10)) ||
