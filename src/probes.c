@@ -249,7 +249,7 @@ static const char *const decisions[] = {
     [LG_SEG_EXCLUDED] = "range misses 0.5",
     [LG_SEG_FLAT] = "flat (L = 0)",
     [LG_SEG_NO_ROOT] = "eq.6 false: <= 1 root; no sign change",
-    [LG_SEG_ROOT] = "eq.6 false: <= 1 root; sign change -> regula falsi",
+    [LG_SEG_ROOT] = "eq.6 false: <= 1 root; sign change -> polish (Newton/bisection)",
     [LG_SEG_SPLIT] = "eq.6 true: may hold 2 roots -> split",
     [LG_SEG_TINY] = "shorter than tolerance",
 };
@@ -261,7 +261,7 @@ static void trace_event(void *ctx, const lg_trace_event *ev) {
   format_real(b, ev->t1);
   snprintf(L, sizeof L, "%.4g", ev->L);
   snprintf(G, sizeof G, "%.4g", ev->G);
-  fprintf(out, "  %*s[%s, %s]  rho-0.5 = %.3g .. %.3g  L = %s  G = %s  "
+  fprintf(out, "  %*s[%s, %s]  rho-0.5 at the ends: %.3g, %.3g  L = %s  G = %s  "
           "eq.6: %.4g vs %.4g  %s  (%d instr)%s\n",
           2 * (ev->depth < 20 ? ev->depth : 20), "", a, b, ev->f0, ev->f1, L, G,
           ev->lhs, ev->t1 - ev->t0,
