@@ -17,7 +17,7 @@ OPT     ?= -O2
 
 # Debian packages the build and the tests need.
 DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
-            libmpfr-dev libgmp-dev tmux
+            libmpfr-dev libgmp-dev tmux clang
 PC_PKGS  := readline bdw-gc libpng OpenEXR
 
 WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
