@@ -35,7 +35,7 @@ LIBOBJS := $(filter-out $(BUILD)/main.o,$(OBJS))
 UNIT_SRCS := $(sort $(wildcard tests/unit/test_*.c))
 UNIT_BINS := $(UNIT_SRCS:tests/unit/%.c=$(BUILD)/tests/%)
 
-.PHONY: all units deps demo test check sanitize install uninstall clean bench update-references
+.PHONY: all units deps demo test check sanitize install uninstall clean bench update-references gallery
 
 BIN ?= qcs
 
@@ -89,6 +89,19 @@ test: deps
 	@sh tests/run-all.sh
 
 check: test
+
+# Every rendering example to gallery/NAME.png and gallery/NAME.exr.
+gallery: deps
+	@$(MAKE) -s qcs
+	@mkdir -p gallery
+	@for f in examples/*.qcs; do \
+	  grep -q -E '^[^/]*render(With)? ' $$f || continue; \
+	  n=$$(basename $$f .qcs); \
+	  ./qcs -o gallery/$$n.png $$f > /dev/null 2> gallery/$$n.log && \
+	  ./qcs -o gallery/$$n.exr $$f > /dev/null 2>> gallery/$$n.log && \
+	  echo "gallery/$$n.png gallery/$$n.exr: $$(grep -m1 " sample" gallery/$$n.log | sed 's/^[^:]*: //')" || \
+	  { echo "error: $$f:"; cat gallery/$$n.log; exit 1; }; \
+	done
 
 # After a deliberate change to the pictures: look at them, then refresh.
 update-references: qcs units

@@ -321,6 +321,70 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   return i;
 }
 
+
+/* ---- do summed parts overlap? ---- */
+
+/* The axis-aligned box of the sharp polyhedron of a density tree:
+   conservative (axis-aligned planes bound it, others do not). */
+static void tree_box(Compile *C, Value *v, double lo[3], double hi[3]) {
+  v = force(C->I, v);
+  ConKind k = con_kind(v);
+  Value **a = v->kind == V_CON ? v->u.con.args : NULL;
+  for (int i = 0; i < 3; i++) lo[i] = -INFINITY, hi[i] = INFINITY;
+  double la[3], ha[3], lb[3], hb[3];
+  switch (k) {
+  case K_PRODUCT: case K_INTER:
+    tree_box(C, a[0], la, ha);
+    tree_box(C, a[1], lb, hb);
+    for (int i = 0; i < 3; i++) lo[i] = fmax(la[i], lb[i]), hi[i] = fmin(ha[i], hb[i]);
+    return;
+  case K_SUM: case K_DUNION: case K_UNION:
+    tree_box(C, a[0], la, ha);
+    tree_box(C, a[1], lb, hb);
+    for (int i = 0; i < 3; i++) lo[i] = fmin(la[i], lb[i]), hi[i] = fmax(ha[i], hb[i]);
+    return;
+  case K_DIFFERENCE: case K_SETDIFF:
+    tree_box(C, a[0], lo, hi);
+    return;
+  case K_DHALFSPACE: case K_HALFSPACE: case K_RHALFSPACE: {
+    double n[3], d;
+    get_plane(C, a[k == K_RHALFSPACE ? 1 : 0], C->pos, n, &d);
+    int axis = -1, zeros = 0;
+    for (int i = 0; i < 3; i++) {
+      if (n[i] == 0) zeros++;
+      else axis = i;
+    }
+    if (zeros != 2) return;
+    if (n[axis] > 0) hi[axis] = d / n[axis];
+    else lo[axis] = d / n[axis];
+    return;
+  }
+  default:
+    return;
+  }
+}
+
+/* 1 if the two parts of some Sum in the tree may overlap with positive
+   volume (so the density may exceed 1 there, as in Figure 15b); parts
+   that only touch, like the cube and box3 of Figure 11's obj6, do not. */
+static int sum_overlaps(Compile *C, Value *v) {
+  v = force(C->I, v);
+  ConKind k = con_kind(v);
+  if (v->kind != V_CON || v->u.con.n != 2 || k == K_RHALFSPACE) return 0;
+  Value **a = v->u.con.args;
+  if (sum_overlaps(C, a[0]) || sum_overlaps(C, a[1])) return 1;
+  if (k != K_SUM) return 0;
+  double la[3], ha[3], lb[3], hb[3];
+  tree_box(C, a[0], la, ha);
+  tree_box(C, a[1], lb, hb);
+  for (int i = 0; i < 3; i++) {
+    double lo = fmax(la[i], lb[i]), hi = fmin(ha[i], hb[i]);
+    double scale = 1e-12 * (1 + fabs(lo) + fabs(hi));
+    if (!(hi - lo > scale)) return 0; /* no common volume */
+  }
+  return 1;
+}
+
 static int compile_obj(Compile *C, Value *v);
 
 /* Rounded r tree (also a density tree used as an object: r = 0, so that
@@ -340,7 +404,7 @@ static int compile_rounded(Compile *C, Value *tree, double r, Pos pos) {
   if (!nd->outer || !nd->inner) qcs_error(pos, "out of memory");
   nd->bound_flags = fo | fi;
   C->s->flags |= SCENE_HAS_ROUNDED;
-  if (nd->bound_flags & BND_RANGE) {
+  if ((nd->bound_flags & BND_RANGE) && sum_overlaps(C, tree)) {
     C->s->ill_formed = 1;
     scene_warn_once(C->I, pos, "a Sum in this density tree may exceed 1 where its "
               "parts overlap (the paper's Figure 15b): such seams bulge; "
