@@ -86,6 +86,10 @@ static Value *lookup(Interp *I, Sym *s, Env *env, Pos pos) {
     for (int i = e->n - 1; i >= 0; i--)
       if (e->names[i] == s) return e->vals[i];
   if (s->con_arity >= 0) return eval_con_value(I, s);
+  /* The prelude's code sees the prelude's definitions, so a user's own
+     `floor` (the scenes' name for the ground plane) cannot break fract. */
+  if (pos.src == I->prelude_src && pos.src && s->prelude_value)
+    return s->prelude_value;
   if (s->global) return s->global;
   unknown_name(I, s, env, pos);
 }

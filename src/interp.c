@@ -317,6 +317,7 @@ RunStatus interp_run_string(Interp *I, const char *name, const char *text,
   memcpy(tx, text, len + 1);
   src->name = nm;
   src->text = tx;
+  if (I->loading_prelude) I->prelude_src = src;
   int nforcing = I->nforcing;
   ErrFrame f;
   if (ERR_TRY(f)) {
@@ -532,6 +533,8 @@ Interp *interp_new(void) {
     fprintf(stderr, "qcs: internal error: the prelude does not load\n");
     exit(2);
   }
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next) s->prelude_value = s->global;
   return I;
 }
 

@@ -24,6 +24,8 @@ struct Sym {
   const char *name;
   Sym *next;           /* hash chain */
   Value *global;       /* top-level value, or NULL */
+  Value *prelude_value;/* its value as the prelude defined it: what the
+                          prelude's own code sees, whatever users define */
   Def *def;            /* its definition (for :browse), or NULL */
   int con_arity;       /* >= 0: a constructor of this arity; -1: not one */
   Sym *con_type;       /* the type a constructor belongs to */
@@ -112,6 +114,7 @@ struct Interp {
   Pos warned[64];            /* warnings already given (said once each) */
   int nwarned;
   const char *run_name;      /* the file currently being run */
+  const Src *prelude_src;    /* the prelude's source, for its own scope */
   int loading_prelude;
   Value *v_true, *v_false, *v_nil;
   /* Shared symbols the evaluator looks for. */
