@@ -66,6 +66,11 @@ typedef struct {
 
 static void sb_printf(sbuf *b, const char *fmt, ...) {
   va_list ap;
+  if (!b->p) { /* never offset a null pointer */
+    b->cap = 256;
+    b->p = malloc(b->cap);
+    b->n = 0;
+  }
   for (;;) {
     va_start(ap, fmt);
     int k = vsnprintf(b->p + b->n, b->cap - b->n, fmt, ap);
