@@ -30,6 +30,8 @@ static _Noreturn void err_throw(void) {
   longjmp(f->jb, 1);
 }
 
+_Noreturn void err_rethrow(void) { err_throw(); }
+
 _Noreturn void qcs_verror(Pos pos, const char *fmt, va_list ap) {
   err_current.pos = pos;
   err_current.incomplete = 0;

@@ -55,6 +55,10 @@ _Noreturn void qcs_verror(Pos pos, const char *fmt, va_list ap);
 _Noreturn void qcs_error_incomplete(Pos pos, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
+/* Raise the error just caught again, unchanged, to the next handler out
+   (after a handler has freed what it owned). */
+_Noreturn void err_rethrow(void);
+
 /* Print "NAME:LINE:COL: KIND: MSG", the source line and a caret. */
 void err_report(FILE *out, const char *kind, Pos pos, const char *msg);
 /* A warning at a position, printed at once to stderr. */

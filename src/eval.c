@@ -184,6 +184,13 @@ static void forcing_push(Interp *I, Value *v) {
 
 static int match(Interp *I, Pat *p, Value *v, Env *frame);
 
+void eval_restore(Interp *I, int nforcing) {
+  while (I->nforcing > nforcing) {
+    I->nforcing--;
+    *I->forcing[I->nforcing].v = I->forcing[I->nforcing].saved;
+  }
+}
+
 static Value *force_patsel(Interp *I, Value *v) {
   Pat *pat = v->u.patsel.pat;
   Sym *var = v->u.patsel.var;
@@ -411,10 +418,7 @@ static void force_some(Interp *I, Value *v, int depth) {
     err_pop(&f);
   } else {
     err_pop(&f);
-    while (I->nforcing > nforcing) {
-      I->nforcing--;
-      *I->forcing[I->nforcing].v = I->forcing[I->nforcing].saved;
-    }
+    eval_restore(I, nforcing);
     I->ntrace = ntrace;
     *err_info() = saved;
     return;

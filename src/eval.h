@@ -34,6 +34,11 @@ Value *eval_global_value(Interp *I, Def *d);
 /* The constructor `s` as a value (a function of its arity, or itself). */
 Value *eval_con_value(Interp *I, Sym *s);
 
+/* After an error: put back every thunk that was being forced (above
+   nforcing entries), so a later evaluation retries it instead of seeing a
+   false "depends on itself". */
+void eval_restore(Interp *I, int nforcing);
+
 /* Recursion-depth, step and interrupt checks (also used by builtins that
    loop). */
 void eval_check(Interp *I, Pos pos);

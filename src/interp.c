@@ -60,10 +60,7 @@ static void report_error(Interp *I) {
 /* Put back every thunk that was being forced when the error struck, so
    a later evaluation retries it instead of seeing a false loop. */
 static void unwind(Interp *I, int nforcing) {
-  while (I->nforcing > nforcing) {
-    I->nforcing--;
-    *I->forcing[I->nforcing].v = I->forcing[I->nforcing].saved;
-  }
+  eval_restore(I, nforcing);
   I->ntrace = 0;
   qcs_interrupted = 0;
 }

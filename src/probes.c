@@ -32,22 +32,6 @@ static double get_radius(Interp *I, Value *v, Pos pos) {
   return r;
 }
 
-/* Runs body on a compiled tape/scene and frees it even if body raises. */
-#define WITH_CLEANUP(cleanup, body)          \
-  do {                                       \
-    ErrFrame f_;                             \
-    if (ERR_TRY(f_)) {                       \
-      body;                                  \
-      err_pop(&f_);                          \
-      cleanup;                               \
-    } else {                                 \
-      err_pop(&f_);                          \
-      cleanup;                               \
-      ErrInfo e_ = *err_info();              \
-      qcs_error(e_.pos, "%s", e_.msg);       \
-    }                                        \
-  } while (0)
-
 /* Density r p tree: Figure 4. */
 static Value *pr_density(Interp *I, Value **args, Pos pos) {
   double r = get_radius(I, args[0], pos), p[3];
@@ -171,8 +155,7 @@ static Value *bounds_probe(Interp *I, Value **args, Pos pos, int outer) {
   } else {
     err_pop(&f);
     csg_tape_free(b);
-    ErrInfo e = *err_info();
-    qcs_error(e.pos, "%s", e.msg);
+    err_rethrow();
   }
   return v;
 }
@@ -234,8 +217,7 @@ static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook) {
     err_pop(&f);
     ray_ctx_free(c);
     scene_free(s);
-    ErrInfo e = *err_info();
-    qcs_error(e.pos, "%s", e.msg);
+    err_rethrow();
   }
   return v;
 }

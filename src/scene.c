@@ -158,8 +158,7 @@ static dt_tape *density_tape(Compile *C, Value *tree, double r, Pos pos) {
     err_pop(&f);
     dt_builder_free(C->db);
     C->db = NULL;
-    ErrInfo e = *err_info();
-    qcs_error(e.pos, "%s", e.msg);
+    err_rethrow();
   }
   int err = 0;
   dt_tape *t = dt_builder_finish(C->db, &err);
@@ -301,8 +300,7 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   } else {
     err_pop(&f);
     free(keys);
-    ErrInfo e = *err_info();
-    qcs_error(e.pos, "%s", e.msg);
+    err_rethrow();
   }
   soft_obj *obj = NULL;
   size_t bad = 0;
@@ -479,8 +477,7 @@ Scene *scene_compile(Interp *I, Value *obj, Pos pos) {
   } else {
     err_pop(&f);
     scene_free(s);
-    ErrInfo e = *err_info();
-    qcs_error(e.pos, "%s", e.msg);
+    err_rethrow();
   }
   return s;
 }

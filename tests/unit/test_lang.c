@@ -129,10 +129,7 @@ static const char *ev(const char *text) {
     static char buf[1200];
     snprintf(buf, sizeof buf, "error: %s", err_info()->msg);
     out = buf;
-    while (I->nforcing > nforcing) {
-      I->nforcing--;
-      *I->forcing[I->nforcing].v = I->forcing[I->nforcing].saved;
-    }
+    eval_restore(I, nforcing);
     I->ntrace = 0;
   }
   return out;
