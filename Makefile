@@ -103,6 +103,14 @@ gallery: deps
 	  { echo "error: $$f:"; cat gallery/$$n.log; exit 1; }; \
 	done
 
+# Timings side by side with POV-Ray (installed here if missing, as root).
+bench: deps
+	@$(MAKE) -s qcs
+	@for p in povray bc; do dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || \
+	  { [ "$$(id -u)" = 0 ] && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$p > /dev/null; } || \
+	  echo "note: $$p is not installed and could not be: see bench/run.sh"; done
+	bash bench/run.sh
+
 # After a deliberate change to the pictures: look at them, then refresh.
 update-references: qcs units
 	@mkdir -p tests/images
