@@ -3,7 +3,7 @@
 # canonical scene at a small size (150x95), one thread, under
 # valgrind --tool=callgrind. Instruction counts are repeatable on a noisy
 # machine, so a regression shows as a larger count. Writes bench/callgrind.csv
-# (and keeps the previous file as bench/callgrind.prev.csv to compare).
+# and prints each count against the one in the previous bench/callgrind.csv.
 # Environment: QCS (./qcs), CG_SIZE (150x95), OUT (/tmp/qcs-bench).
 set -u
 cd "$(dirname "$0")/.." || exit 1
@@ -12,10 +12,9 @@ mkdir -p "$OUT"
 command -v valgrind >/dev/null || { echo "callgrind: valgrind is not installed (Debian package valgrind): skipped"; exit 1; }
 [ $# -eq 0 ] && set -- figure12 figure12-sharp figure13 figure15a figure15b \
   soft-cloud-10 soft-cloud-100 soft-cloud-1000 soft-cloud-10000 soft-cloud-100000
-[ -f bench/callgrind.csv ] && cp bench/callgrind.csv bench/callgrind.prev.csv
 declare -A PREV
-if [ -f bench/callgrind.prev.csv ]; then
-  while IFS=, read -r s n _; do PREV[$s]=$n; done < bench/callgrind.prev.csv
+if [ -f bench/callgrind.csv ]; then
+  while IFS=, read -r s n _; do PREV[$s]=$n; done < bench/callgrind.csv
 fi
 echo "scene,instructions,size,threads,commit" > bench/callgrind.csv.tmp
 commit=$(git rev-parse --short HEAD 2>/dev/null)
