@@ -678,6 +678,26 @@ static Def *lambda_def(Parser *P, Pos pos) {
 /* Bindings of a where or let block, lined up in one column. */
 static void block_bindings(Parser *P, Vec *defs, int stop_at_in);
 
+/* After an entry of a where, let or case block: consumes the separator
+   (';' or a new line in the block's column) and says whether another
+   entry follows. */
+static int block_more(Parser *P) {
+  TokKind k = peek(P);
+  if (k == T_VSEP) {
+    use_sep(P);
+    return 1;
+  }
+  if (k != T_SEMI) return 0;
+  next(P);
+  k = peek(P);
+  if (k == T_VSEP) {
+    use_sep(P);
+    return 1;
+  }
+  return !(k == T_VEND || k == T_EOF || k == T_SEMI || k == T_IN ||
+           k == T_RPAREN || k == T_RBRACK);
+}
+
 /* alts -> alt {sep alt}, lined up in one column like bindings
    alt -> pat '->' expr | pat {'|' expr '->' expr} */
 static void case_alts(Parser *P, Vec *alts, Pos casepos) {
@@ -719,24 +739,7 @@ static void case_alts(Parser *P, Vec *alts, Pos casepos) {
     c->guards = (Expr **)guards.items;
     c->bodies = (Expr **)bodies.items;
     vec_push(alts, c);
-    k = peek(P);
-    if (k == T_SEMI) {
-      next(P);
-      k = peek(P);
-      if (k == T_VSEP) {
-        use_sep(P);
-        continue;
-      }
-      if (k == T_VEND || k == T_EOF || k == T_SEMI || k == T_RPAREN ||
-          k == T_RBRACK)
-        break;
-      continue;
-    }
-    if (k == T_VSEP) {
-      use_sep(P);
-      continue;
-    }
-    break;
+    if (!block_more(P)) break;
   }
   layout_pop(P);
 }
@@ -989,22 +992,7 @@ static void block_bindings(Parser *P, Vec *defs, int stop_at_in) {
   for (;;) {
     Def *d = binding(P, 0, NULL, NULL);
     if (!merge_clause(defs, d)) vec_push(defs, d);
-    k = peek(P);
-    if (k == T_SEMI) {
-      next(P);
-      k = peek(P);
-      if (k == T_VSEP) {
-        use_sep(P);
-        continue;
-      }
-      if (k == T_VEND || k == T_EOF || k == T_IN || k == T_SEMI) break;
-      continue;
-    }
-    if (k == T_VSEP) {
-      use_sep(P);
-      continue;
-    }
-    break;
+    if (!block_more(P)) break;
   }
   layout_pop(P);
   (void)stop_at_in;
