@@ -34,6 +34,9 @@ OBJS    := $(SRCS:src/%.c=$(BUILD)/%.o)
 LIBOBJS := $(filter-out $(BUILD)/main.o,$(OBJS))
 UNIT_SRCS := $(sort $(wildcard tests/unit/test_*.c))
 UNIT_BINS := $(UNIT_SRCS:tests/unit/%.c=$(BUILD)/tests/%)
+# The numerical stability suite (issue 6): same harness, MPFR references.
+STAB_SRCS := $(sort $(wildcard tests/stability/test_*.c))
+UNIT_BINS += $(STAB_SRCS:tests/stability/%.c=$(BUILD)/tests/%)
 
 .PHONY: all units deps demo test check sanitize install uninstall clean bench update-references gallery
 
@@ -58,6 +61,10 @@ $(BUILD)/prelude.inc: stdlib/prelude.qcs tools/embed.sh
 $(BUILD)/tests/%: tests/unit/%.c $(LIBOBJS) tests/unit/check.h
 	@mkdir -p $(BUILD)/tests
 	$(CC) $(ALL_CFLAGS) -Itests/unit -o $@ $< $(LIBOBJS) $(LIBS) -lmpfr -lgmp
+
+$(BUILD)/tests/%: tests/stability/%.c $(LIBOBJS) tests/unit/check.h
+	@mkdir -p $(BUILD)/tests
+	$(CC) $(ALL_CFLAGS) -Itests/unit -Itests/stability -o $@ $< $(LIBOBJS) $(LIBS) -lmpfr -lgmp
 
 # deps: install (as root) or name the missing Debian packages.
 deps:
