@@ -4,6 +4,7 @@
 #   make demo       install what is missing, build, run the bundled example
 #   make test       install what is missing, build, run every test suite
 #   make sanitize   the test suite under ASan + UBSan (clang)
+#   make fuzz       the libFuzzer targets, FUZZ_TIME seconds each
 #   make install    PREFIX=/usr/local DESTDIR=
 #
 # System packages are installed through apt-get when make runs as root and
@@ -37,6 +38,8 @@ UNIT_BINS := $(UNIT_SRCS:tests/unit/%.c=$(BUILD)/tests/%)
 # The numerical stability suite (issue 6): same harness, MPFR references.
 STAB_SRCS := $(sort $(wildcard tests/stability/test_*.c))
 UNIT_BINS += $(STAB_SRCS:tests/stability/%.c=$(BUILD)/tests/%)
+# The fuzz targets of fuzz/ as plain programs that replay fuzz/corpus/.
+REPLAY_BINS := $(patsubst %,$(BUILD)/fuzz/replay_%,parse eval probes image)
 
 .PHONY: all units deps demo test check sanitize install uninstall clean bench update-references gallery
 
@@ -47,7 +50,7 @@ all: $(BIN)
 $(BIN): $(OBJS)
 	$(CC) $(ALL_CFLAGS) -o $@ $(OBJS) $(LIBS)
 
-units: $(UNIT_BINS)
+units: $(UNIT_BINS) $(REPLAY_BINS)
 
 $(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc
 	@mkdir -p $(BUILD)
@@ -148,6 +151,30 @@ sanitize: deps
 	@QCS=build-san/qcs QCS_UNIT_DIR=build-san/tests \
 	  ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 sh tests/run-all.sh
 
+# fuzz: the libFuzzer targets of fuzz/ (clang, ASan + UBSan), each run for
+# FUZZ_TIME seconds; see fuzz/README.md. FUZZ_TARGETS picks some of them.
+FUZZ_TARGETS ?= parse eval probes image
+FUZZ_TIME    ?= 60
+FUZZ_FLAGS   := -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
+.PHONY: fuzz fuzz-build fuzz-bins
+fuzz: fuzz-build
+	@FUZZ_TIME=$(FUZZ_TIME) sh fuzz/run.sh $(FUZZ_TARGETS)
+
+fuzz-build: deps
+	@$(MAKE) -s BUILD=build-fuzz CC=clang OPT="-O1 -fno-omit-frame-pointer" \
+	  CFLAGS="$(FUZZ_FLAGS)" fuzz-bins
+
+fuzz-bins: $(FUZZ_TARGETS:%=$(BUILD)/fuzz/fuzz_%)
+
+# The same targets without libFuzzer, to replay fuzz/corpus/ in make test.
+$(BUILD)/fuzz/replay_%: fuzz/fuzz_%.c fuzz/replay.c fuzz/fuzz.h $(LIBOBJS)
+	@mkdir -p $(BUILD)/fuzz
+	$(CC) $(ALL_CFLAGS) -Ifuzz -o $@ $< fuzz/replay.c $(LIBOBJS) $(LIBS)
+
+$(BUILD)/fuzz/fuzz_%: fuzz/fuzz_%.c fuzz/fuzz.h $(LIBOBJS)
+	@mkdir -p $(BUILD)/fuzz
+	$(CC) $(ALL_CFLAGS) -fsanitize=fuzzer -Ifuzz -o $@ $< $(LIBOBJS) $(LIBS)
+
 install: qcs
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/qcs \
 	  $(DESTDIR)$(PREFIX)/share/man/man1
@@ -160,6 +187,6 @@ uninstall:
 	rm -rf $(DESTDIR)$(PREFIX)/share/qcs
 
 clean:
-	rm -rf $(BUILD) build-san qcs
+	rm -rf $(BUILD) build-san build-fuzz qcs
 
 -include $(OBJS:.o=.d)
