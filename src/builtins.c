@@ -117,19 +117,21 @@ static Value *list_next(Interp *I, Value *v, Pos pos, const char *what) {
 }
 
 static Value *bi_length(Interp *I, Value **args, Pos pos) {
-  double n = 0;
+  unsigned long long n = 0;
   for (Value *v = list_next(I, args[0], pos, "the argument of length");
        v->kind == V_CONS; v = list_next(I, v->u.cons.tail, pos, "a list tail")) {
     eval_check(I, pos);
-    n++;
+    eval_list_count(I, pos, ++n);
   }
-  return val_num(n);
+  return val_num((double)n);
 }
 static Value *bi_sum(Interp *I, Value **args, Pos pos) {
   Value *acc = NULL;
+  unsigned long long n = 0;
   for (Value *v = list_next(I, args[0], pos, "the argument of sum");
        v->kind == V_CONS; v = list_next(I, v->u.cons.tail, pos, "a list tail")) {
     eval_check(I, pos);
+    eval_list_count(I, pos, ++n);
     Value *x = force(I, v->u.cons.head);
     if (!acc) {
       acc = x;
@@ -151,9 +153,11 @@ static Value *bi_sum(Interp *I, Value **args, Pos pos) {
 }
 static Value *bi_product(Interp *I, Value **args, Pos pos) {
   double p = 1;
+  unsigned long long n = 0;
   for (Value *v = list_next(I, args[0], pos, "the argument of product");
        v->kind == V_CONS; v = list_next(I, v->u.cons.tail, pos, "a list tail")) {
     eval_check(I, pos);
+    eval_list_count(I, pos, ++n);
     p *= force_num(I, v->u.cons.head, pos, "an element of product");
   }
   return val_num(p);
@@ -161,8 +165,10 @@ static Value *bi_product(Interp *I, Value **args, Pos pos) {
 /* foldl f z xs, strict in the accumulator (so long lists need no stack). */
 static Value *bi_foldl(Interp *I, Value **args, Pos pos) {
   Value *acc = args[1];
+  unsigned long long n = 0;
   for (Value *v = list_next(I, args[2], pos, "the list of foldl");
        v->kind == V_CONS; v = list_next(I, v->u.cons.tail, pos, "a list tail")) {
+    eval_list_count(I, pos, ++n);
     Value **a = val_array(2);
     a[0] = acc;
     a[1] = v->u.cons.head;
@@ -189,6 +195,7 @@ static Value *bi_append(Interp *I, Value **args, Pos pos) {
 
 /* concatMap f xs, lazily: list comprehensions are built on it. */
 static Value *bi_concatMap(Interp *I, Value **args, Pos pos) {
+  unsigned long long skipped = 0;
   for (Value *v = list_next(I, args[1], pos, "the list of a generator");;) {
     if (v->kind == V_NIL) return v;
     Value **a = val_array(1);
@@ -197,6 +204,7 @@ static Value *bi_concatMap(Interp *I, Value **args, Pos pos) {
                           "the result of concatMap's function");
     if (ys->kind == V_NIL) { /* skip empty results without recursion */
       eval_check(I, pos);
+      eval_list_count(I, pos, ++skipped);
       v = list_next(I, v->u.cons.tail, pos, "a list tail");
       continue;
     }

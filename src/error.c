@@ -75,18 +75,31 @@ void err_report(FILE *out, const char *kind, Pos pos, const char *msg) {
     if (pos.src->text) {
       int len;
       const char *l = line_start(pos.src, pos.line, &len);
-      if (len > 200) len = 200;
-      fprintf(out, "  %.*s\n  ", len, l);
+      /* b: the byte of the column (columns count UTF-8 sequences and tabs
+         to the next multiple of 8, as the lexer does). */
+      int b = 0, col = 1;
+      while (b < len && col < pos.col) {
+        if (l[b] == '\t') col = ((col - 1) / 8 + 1) * 8 + 1;
+        else if (((unsigned char)l[b] & 0xC0) != 0x80) col++;
+        b++;
+      }
+      while (b < len && ((unsigned char)l[b] & 0xC0) == 0x80) b++;
+      /* A long line is shown as a window of 200 bytes around the column. */
+      int start = 0;
+      if (b > 150) {
+        start = b - 60;
+        while (start < b && ((unsigned char)l[start] & 0xC0) == 0x80) start++;
+      }
+      int end = len - start > 200 ? start + 200 : len;
+      while (end > start && end < len &&
+             ((unsigned char)l[end] & 0xC0) == 0x80)
+        end--;
+      fprintf(out, "  %s%.*s%s\n  %s", start ? "..." : "", end - start,
+              l + start, end < len ? "..." : "", start ? "   " : "");
       /* The caret under the column, keeping the line's own tabs. */
-      int col = 1;
-      for (int i = 0; i < len && col < pos.col; i++) {
-        if (l[i] == '\t') {
-          fputc('\t', out);
-          col = ((col - 1) / 8 + 1) * 8 + 1;
-        } else {
-          fputc(' ', out);
-          col++;
-        }
+      for (int i = start; i < b && i < end; i++) {
+        if (l[i] == '\t') fputc('\t', out);
+        else if (((unsigned char)l[i] & 0xC0) != 0x80) fputc(' ', out);
       }
       fputs("^\n", out);
     }

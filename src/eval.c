@@ -3,6 +3,8 @@
 
 #include <gc.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "parse.h"
@@ -10,29 +12,60 @@
 
 /* ---- checks ---- */
 
+_Noreturn void eval_limit_error(Interp *I, Pos pos, const char *limit,
+                                const char *fmt, ...) {
+  char msg[700];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  const char *arg =
+      !strcmp(limit, "max-stack") || !strcmp(limit, "max-memory") ? "SIZE"
+                                                                  : "N";
+  qcs_error(pos.line ? pos : I->item_pos, "%s (limit %s; raise it with :set "
+            "%s %s or --%s %s)", msg, limit, limit, arg, limit, arg);
+}
+
+void eval_stack_error(Interp *I, Pos pos, const char *what,
+                      const char *after) {
+  char sz[32];
+  interp_format_size(sz, sizeof sz, I->stack_limit);
+  eval_limit_error(I, pos, "max-stack", "%s more than %s of stack%s", what, sz,
+                   after);
+}
+
+/* Runs at every evaluation step: no system calls, no allocation. */
 void eval_check(Interp *I, Pos pos) {
   char probe;
   if (qcs_interrupted) {
     qcs_interrupted = 0;
-    qcs_error(pos, "interrupted");
+    qcs_error(pos.line ? pos : I->item_pos, "interrupted");
   }
   if ((size_t)(I->stack_base - &probe) > I->stack_limit)
-    qcs_error(pos, "recursion too deep (over %zu MB of nested calls; is a "
-              "base case missing?)", I->stack_limit >> 20);
-  if (I->max_steps && ++I->steps > I->max_steps)
-    qcs_error(pos, "evaluation step limit reached (%llu steps; raise it with "
-              "--max-steps N)", I->max_steps);
+    eval_stack_error(I, pos, "recursion too deep: nested calls use",
+                     "; is a base case missing?");
+  if (++I->steps > I->max_steps && I->max_steps)
+    eval_limit_error(I, pos, "max-steps", "evaluation stopped after %llu steps",
+                     I->max_steps);
   if (I->max_memory && ++I->memcheck >= 4096) {
     I->memcheck = 0;
     size_t used = GC_get_heap_size() - GC_get_free_bytes();
     if (used > I->max_memory) {
       GC_gcollect();
       used = GC_get_heap_size() - GC_get_free_bytes();
-      if (used > I->max_memory)
-        qcs_error(pos, "memory limit reached (%zu MB of values; raise it with "
-                  "--max-memory MB)", I->max_memory >> 20);
+      if (used > I->max_memory) {
+        char sz[32];
+        interp_format_size(sz, sizeof sz, I->max_memory);
+        eval_limit_error(I, pos, "max-memory", "evaluation stopped: values "
+                         "use more than %s of memory", sz);
+      }
     }
   }
+}
+
+void eval_list_limit(Interp *I, Pos pos, unsigned long long n) {
+  eval_limit_error(I, pos, "max-list", "a list longer than %llu elements",
+                   n - 1);
 }
 
 /* ---- trace ---- */
@@ -110,6 +143,8 @@ static Value *mk_thunk(Expr *e, Env *env) {
    such as `count (n - 1) (acc + 1)` stays a number instead of growing a
    chain of a million thunks that would then be forced recursively. */
 static int known_num(Interp *I, Expr *e, Env *env, double *out) {
+  char probe; /* a chain of a million '+' is left to eval, which checks */
+  if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
   switch (e->kind) {
   case E_NUM:
     *out = e->u.num;
@@ -639,11 +674,14 @@ static Value *arith(Interp *I, TokKind op, Value *a, Value *b, Pos pos) {
 }
 
 static int values_equal(Interp *I, Value *a, Value *b, Pos pos) {
+  eval_check(I, pos);
   a = force(I, a);
   b = force(I, b);
   if (a->kind == V_NIL || a->kind == V_CONS) {
+    unsigned long long n = 0;
     while (a->kind == V_CONS && b->kind == V_CONS) {
       eval_check(I, pos);
+      eval_list_count(I, pos, ++n);
       if (!values_equal(I, a->u.cons.head, b->u.cons.head, pos)) return 0;
       a = force(I, a->u.cons.tail);
       b = force(I, b->u.cons.tail);
@@ -732,6 +770,7 @@ static Value *index_list(Interp *I, Value *xs, Value *nv, Pos pos) {
   for (double i = 0; i < n; i++) {
     if (v->kind != V_CONS) break;
     eval_check(I, pos);
+    eval_list_count(I, pos, (unsigned long long)i + 1);
     v = force(I, v->u.cons.tail);
   }
   if (v->kind != V_CONS)
@@ -786,6 +825,9 @@ static Value *binop(Interp *I, Expr *e, Env *env) {
 
 /* [from, from+step .. to]: element k is from + k*step (no drift); a Real
    range stops past to + step/2, as Haskell's does. */
+/* args: from, step, to (NULL: no end), k, and the range's position (a
+   foreign Pos, for max-list errors found when a later element is
+   forced). */
 static Value *bi_range_k(Interp *I, Value **args, Pos pos) {
   double from = args[0]->u.num, step = args[1]->u.num;
   double k = args[3]->u.num;
@@ -798,14 +840,17 @@ static Value *bi_range_k(Interp *I, Value **args, Pos pos) {
     double limit = whole ? to : to + step / 2;
     if (step > 0 ? x > limit : x < limit) return I->v_nil;
   }
-  Value **next = val_array(4);
+  const Pos *rpos = args[4]->u.foreign.ptr;
+  eval_list_count(I, *rpos, (unsigned long long)k + 1);
+  Value **next = val_array(5);
   next[0] = args[0];
   next[1] = args[1];
   next[2] = args[2];
   next[3] = val_num(k + 1);
-  static const Builtin range_builtin = {"enumFromThenTo", 4, bi_range_k, NULL};
+  next[4] = args[4];
+  static const Builtin range_builtin = {"enumFromThenTo", 5, bi_range_k, NULL};
   (void)pos;
-  return val_cons(val_num(x), delay_apply(val_builtin(&range_builtin), 4, next));
+  return val_cons(val_num(x), delay_apply(val_builtin(&range_builtin), 5, next));
 }
 
 static Value *range(Interp *I, Expr *e, Env *env) {
@@ -816,7 +861,7 @@ static Value *range(Interp *I, Expr *e, Env *env) {
   if (e->u.range.then)
     step = force_num(I, eval(I, e->u.range.then, env), pos,
                      "the second element of a range") - from;
-  Value **args = val_array(4);
+  Value **args = val_array(5);
   args[0] = val_num(from);
   args[1] = val_num(step);
   if (e->u.range.to) {
@@ -827,6 +872,9 @@ static Value *range(Interp *I, Expr *e, Env *env) {
   if (!isfinite(from) || !isfinite(step))
     qcs_error(pos, "a range needs finite bounds");
   args[3] = val_num(0);
+  Pos *rpos = GC_MALLOC(sizeof *rpos);
+  *rpos = pos;
+  args[4] = val_foreign(rpos, "position");
   return bi_range_k(I, args, pos);
 }
 

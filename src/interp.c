@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "builtins.h"
+#include "image.h"
 #include "eval.h"
 #include "parse.h"
 #include "print.h"
@@ -30,6 +31,10 @@ static int run_counter;
 
 static void report_error(Interp *I) {
   ErrInfo *e = err_info();
+  /* Found where no position was at hand (a lazy list's tail, printing):
+     the top-level expression being run. */
+  if (!e->pos.line && I->item_pos.line) e->pos = I->item_pos;
+  I->item_pos = pos_none;
   err_report(stderr, "error", e->pos, e->msg);
   int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
   int lines = 0, i = n - 1;
@@ -181,9 +186,8 @@ static void check_defs(Check *C, int n, Def **defs, Scope *sc) {
 }
 
 static void check_expr(Check *C, Expr *e, Scope *sc) {
-  char probe;
-  if ((size_t)(C->I->stack_base - &probe) > C->I->stack_limit)
-    qcs_error(e->pos, "expression nested too deeply");
+  eval_stack_check(C->I, e->pos,
+                   "expression nested too deeply: checking it needs");
   switch (e->kind) {
   case E_VAR: check_var(C, e->u.var, sc, e->pos); break;
   case E_WILD: qcs_error(e->pos, "'_' stands only in patterns");
@@ -296,6 +300,9 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
   if (redefined && mode == MODE_REPL) refresh_values(I);
   for (int i = 0; i < n; i++) {
     if (items[i]->kind != ITEM_EXPR) continue;
+    /* max-steps counts per top-level expression */
+    I->steps = 0;
+    I->item_pos = items[i]->expr->pos;
     Value *v = eval(I, items[i]->expr, NULL);
     print_value(I, stdout, v);
     fputc('\n', stdout);
@@ -315,6 +322,7 @@ RunStatus interp_run_string(Interp *I, const char *name, const char *text,
   src->name = nm;
   src->text = tx;
   if (I->loading_prelude) I->prelude_src = src;
+  I->item_pos = pos_none;
   int nforcing = I->nforcing;
   ErrFrame f;
   if (ERR_TRY(f)) {
@@ -398,6 +406,7 @@ RunStatus interp_eval_print(Interp *I, const char *text) {
   char *tx = GC_MALLOC_ATOMIC(strlen(text) + 1);
   strcpy(tx, text);
   src->text = tx;
+  I->item_pos = pos_none;
   int nforcing = I->nforcing;
   ErrFrame f;
   if (ERR_TRY(f)) {
@@ -505,13 +514,20 @@ Interp *interp_new(void) {
   static int gc_ready;
   if (!gc_ready) {
     GC_INIT();
+    /* The collector's own warnings ("repeated allocation of very large
+       block") mean nothing to a user; limits say what went wrong. */
+    GC_set_warn_proc(GC_ignore_warn_proc);
     gc_ready = 1;
   }
   Interp *I = GC_MALLOC_UNCOLLECTABLE(sizeof *I);
   char probe;
   I->stack_base = &probe;
-  I->stack_limit = 6u << 20;
+  I->stack_limit = I->stack_reserved = 6u << 20;
   I->max_memory = (size_t)8 << 30; /* 8 GB of values unless told otherwise */
+  I->max_steps = QCS_DEFAULT_MAX_STEPS;
+  I->max_list = QCS_DEFAULT_MAX_LIST;
+  I->max_pixels = QCS_DEFAULT_MAX_PIXELS;
+  I->max_spp = QCS_DEFAULT_MAX_SPP;
   I->v_true = GC_MALLOC(sizeof(Value));
   I->v_true->kind = V_BOOL;
   I->v_true->u.b = 1;
@@ -538,6 +554,11 @@ Interp *interp_new(void) {
 void interp_set_stack(Interp *I, char *base, size_t limit) {
   I->stack_base = base;
   I->stack_limit = limit;
+  I->stack_reserved = limit;
+}
+
+void interp_set_stack_reserved(Interp *I, size_t reserved) {
+  if (reserved > I->stack_reserved) I->stack_reserved = reserved;
 }
 
 void interp_set_max_memory(Interp *I, size_t bytes) { I->max_memory = bytes; }
@@ -545,6 +566,194 @@ void interp_set_max_memory(Interp *I, size_t bytes) { I->max_memory = bytes; }
 void interp_set_max_steps(Interp *I, unsigned long long steps) {
   I->max_steps = steps;
   I->steps = 0;
+}
+
+/* ---- resource limits ---- */
+
+typedef enum { LIM_SIZE, LIM_COUNT, LIM_PIXELS, LIM_SPP } LimitKind;
+
+static const struct {
+  const char *name;
+  LimitKind kind;
+  int zero_ok;          /* 0 switches the limit off */
+  unsigned long long min, max;
+  const char *what;
+} limits[] = {
+  {"max-stack", LIM_SIZE, 0, 1ULL << 20, 1ULL << 40,
+   "C stack for nested calls and parsing (recursion depth)"},
+  {"max-steps", LIM_COUNT, 1, 1, ~0ULL,
+   "evaluation steps of one top-level expression"},
+  {"max-list", LIM_COUNT, 1, 1, ~0ULL,
+   "elements of one list (ranges, length, sum, printing, ...)"},
+  {"max-memory", LIM_SIZE, 1, 1ULL << 20, 1ULL << 50, "memory for values"},
+  {"max-pixels", LIM_PIXELS, 0, 1, (unsigned long long)IMG_MAX_PIXELS,
+   "pixels of one rendered image"},
+  {"max-spp", LIM_SPP, 0, 1, 256, "samples per pixel of a render"},
+};
+#define NLIMITS (sizeof limits / sizeof limits[0])
+
+const char *const interp_limit_names[] = {
+  "max-stack", "max-steps", "max-list", "max-memory", "max-pixels", "max-spp",
+  NULL};
+
+/* "256M", "8G", or bytes when not a whole number of K. */
+void interp_format_size(char *buf, size_t n, unsigned long long bytes) {
+  static const char units[] = "KMGT";
+  int u = -1;
+  while (u < 3 && bytes >= 1024 && bytes % 1024 == 0) bytes /= 1024, u++;
+  if (u < 0) snprintf(buf, n, "%llu", bytes);
+  else snprintf(buf, n, "%llu%c", bytes, units[u]);
+}
+
+static int limit_index(const char *name) {
+  for (size_t i = 0; i < NLIMITS; i++)
+    if (!strcmp(limits[i].name, name)) return (int)i;
+  return -1;
+}
+
+/* A whole number of decimal digits (no sign, no blanks); 0 on success. */
+static int parse_whole(const char **p, unsigned long long *out) {
+  const char *s = *p;
+  unsigned long long v = 0;
+  if (*s < '0' || *s > '9') return -1;
+  for (; *s >= '0' && *s <= '9'; s++) {
+    if (v > (~0ULL - 9) / 10) return -1;
+    v = v * 10 + (unsigned long long)(*s - '0');
+  }
+  *p = s;
+  *out = v;
+  return 0;
+}
+
+int interp_limit_parse(const char *name, const char *text,
+                       unsigned long long *out, char *err, size_t errlen) {
+  int i = limit_index(name);
+  if (i < 0) {
+    const char *best = NULL;
+    int bestd = 4;
+    for (size_t j = 0; j < NLIMITS; j++) {
+      int d = edit_distance(name, limits[j].name);
+      if (d < bestd) bestd = d, best = limits[j].name;
+    }
+    if (best)
+      snprintf(err, errlen, "unknown limit '%s' (did you mean %s?)", name,
+               best);
+    else
+      snprintf(err, errlen, "unknown limit '%s'; the limits are max-stack, "
+               "max-steps, max-list, max-memory, max-pixels and max-spp",
+               name);
+    return -1;
+  }
+  const char *p = text;
+  unsigned long long v = 0, h;
+  int ok = parse_whole(&p, &v) == 0;
+  const char *want = "a whole number";
+  switch (limits[i].kind) {
+  case LIM_SIZE: {
+    want = "a size such as 512M or 2G (a bare number is megabytes)";
+    unsigned shift = 20;
+    if (ok && *p) {
+      const char *u = strchr("KkMmGgTt", *p);
+      if (u && *p) {
+        shift = 10 * (unsigned)((u - "KkMmGgTt") / 2 + 1);
+        p++;
+        if (*p == 'B' || *p == 'b') p++;
+      } else {
+        ok = 0;
+      }
+    }
+    if (ok && v > (~0ULL >> shift)) ok = 0;
+    v <<= shift;
+    break;
+  }
+  case LIM_PIXELS:
+    want = "a number of pixels, or WxH such as 4096x4096";
+    if (ok && (*p == 'x' || *p == 'X')) {
+      p++;
+      if (parse_whole(&p, &h) || (h && v > ~0ULL / h)) ok = 0;
+      else v *= h;
+    }
+    break;
+  case LIM_COUNT:
+    want = "a whole number (0 for no limit)";
+    break;
+  case LIM_SPP:
+    break;
+  }
+  if (!ok || *p) {
+    snprintf(err, errlen, "%s needs %s, not '%s'", name, want, text);
+    return -1;
+  }
+  if (v == 0 && limits[i].zero_ok) {
+    *out = 0;
+    return 0;
+  }
+  if (v < limits[i].min || v > limits[i].max) {
+    char lo[32], hi[32];
+    if (limits[i].kind == LIM_SIZE) {
+      interp_format_size(lo, sizeof lo, limits[i].min);
+      interp_format_size(hi, sizeof hi, limits[i].max);
+    } else {
+      snprintf(lo, sizeof lo, "%llu", limits[i].min);
+      snprintf(hi, sizeof hi, "%llu", limits[i].max);
+    }
+    snprintf(err, errlen, "%s must be from %s to %s%s, not '%s'", name, lo, hi,
+             limits[i].zero_ok ? " (or 0 for no limit)" : "", text);
+    return -1;
+  }
+  *out = v;
+  return 0;
+}
+
+/* The most max-stack may be: the thread's stack, less a quarter kept for
+   what runs below the checks (scene compilation, the C library). */
+static size_t stack_cap(Interp *I) {
+  size_t cap = I->stack_reserved / 4 * 3;
+  return cap > I->stack_limit ? cap : I->stack_limit;
+}
+
+int interp_set_limit(Interp *I, const char *name, const char *text,
+                     char *err, size_t errlen) {
+  unsigned long long v;
+  if (interp_limit_parse(name, text, &v, err, errlen)) return -1;
+  switch (limit_index(name)) {
+  case 0:
+    if (v > stack_cap(I)) {
+      char cap[32];
+      interp_format_size(cap, sizeof cap, stack_cap(I));
+      snprintf(err, errlen, "max-stack can be at most %s here (the stack "
+               "reserved at start-up); start qcs with --max-stack SIZE for "
+               "more", cap);
+      return -1;
+    }
+    I->stack_limit = (size_t)v;
+    break;
+  case 1: I->max_steps = v; break;
+  case 2: I->max_list = v; break;
+  case 3: I->max_memory = (size_t)v; break;
+  case 4: I->max_pixels = v; break;
+  case 5: I->max_spp = (int)v; break;
+  }
+  return 0;
+}
+
+void interp_list_limits(Interp *I, FILE *out) {
+  for (size_t i = 0; i < NLIMITS; i++) {
+    unsigned long long v = 0;
+    switch (i) {
+    case 0: v = I->stack_limit; break;
+    case 1: v = I->max_steps; break;
+    case 2: v = I->max_list; break;
+    case 3: v = I->max_memory; break;
+    case 4: v = I->max_pixels; break;
+    case 5: v = (unsigned long long)I->max_spp; break;
+    }
+    char buf[40];
+    if (v == 0) snprintf(buf, sizeof buf, "none");
+    else if (limits[i].kind == LIM_SIZE) interp_format_size(buf, sizeof buf, v);
+    else snprintf(buf, sizeof buf, "%llu", v);
+    fprintf(out, "%-11s %-12s %s\n", limits[i].name, buf, limits[i].what);
+  }
 }
 
 const char *interp_version(void) { return QCS_VERSION; }

@@ -62,8 +62,12 @@ void interp_complete(Interp *I, const char *prefix,
 void interp_browse(Interp *I, FILE *out, int all);
 
 /* Where the C stack of the thread running the interpreter begins and how
-   much of it evaluation may use before "recursion too deep". */
+   much of it evaluation may use before "recursion too deep" (the limit
+   max-stack; this also makes limit the most :set max-stack may give). */
 void interp_set_stack(Interp *I, char *base, size_t limit);
+/* The stack the thread really has, when more than the limit in force:
+   :set max-stack may then raise the limit up to it, less a margin. */
+void interp_set_stack_reserved(Interp *I, size_t reserved);
 
 /* Stop evaluations after this many steps with a clear error (0: never). */
 void interp_set_max_steps(Interp *I, unsigned long long steps);
@@ -71,6 +75,48 @@ void interp_set_max_steps(Interp *I, unsigned long long steps);
 /* Stop evaluations with a clear error when the values in memory exceed
    this many bytes (0: no limit; the default is 8 GB). */
 void interp_set_max_memory(Interp *I, size_t bytes);
+
+/* ---- resource limits, by name ----
+ *
+ *   max-stack   SIZE  C stack for nested evaluation and parsing (recursion
+ *                     depth); default 256M
+ *   max-steps   N     evaluation steps of one top-level expression;
+ *                     default 10000000000, 0 for none
+ *   max-list    N     elements of one list built by a range or forced by
+ *                     length, sum, printing, ...; default 10000000, 0 none
+ *   max-memory  SIZE  memory for values; default 8G, 0 for none
+ *   max-pixels  N     pixels of one rendered image (N or WxH); default
+ *                     4096x4096, at most 8192x8192
+ *   max-spp     N     samples per pixel of a render; default 64, at most 256
+ *
+ * SIZE is a whole number with K, M, G or T (binary: 1K = 1024 bytes); a
+ * bare number is megabytes. A limit that is hit stops the evaluation or
+ * render with an error naming the limit and how to raise it. */
+
+#define QCS_DEFAULT_MAX_STEPS 10000000000ULL
+#define QCS_DEFAULT_MAX_LIST 10000000ULL
+#define QCS_DEFAULT_MAX_PIXELS (4096ULL * 4096ULL)
+#define QCS_DEFAULT_MAX_SPP 64
+
+/* The names of the limits, NULL-terminated. */
+extern const char *const interp_limit_names[];
+
+/* Checks text as a value for the limit name (the command line checks its
+   options before an interpreter exists): 0 with *out set, or -1 with a
+   message in err. The stack's cap is not checked here. */
+int interp_limit_parse(const char *name, const char *text,
+                       unsigned long long *out, char *err, size_t errlen);
+
+/* Sets a limit from text (":set max-steps 1000000", --max-steps): 0, or -1
+   with a message in err naming what is wrong. */
+int interp_set_limit(Interp *I, const char *name, const char *text,
+                     char *err, size_t errlen);
+
+/* bytes as "256M", "8G", or a plain number when not whole K. */
+void interp_format_size(char *buf, size_t n, unsigned long long bytes);
+
+/* One line per limit: name, value, what it bounds (":set"). */
+void interp_list_limits(Interp *I, FILE *out);
 
 const char *interp_version(void);
 

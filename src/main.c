@@ -23,7 +23,7 @@
 #include "tradeoff.h"
 
 #define STACK_SIZE ((size_t)512 << 20) /* reserved, touched only as used */
-#define STACK_USE ((size_t)256 << 20)  /* ~350000 nested calls */
+#define STACK_USE ((size_t)256 << 20)  /* ~350000 nested calls: max-stack */
 #define FALLBACK_STACK_USE ((size_t)6 << 20)
 
 typedef struct Options {
@@ -33,10 +33,12 @@ typedef struct Options {
   int nsets;
   char **files;
   int nfiles;
-  unsigned long long max_steps;
-  long long max_memory_mb; /* -1: the default */
+  const char *limit_names[16]; /* --max-NAME VALUE, checked, in order */
+  const char *limit_values[16];
+  int nlimits;
+  unsigned long long max_spp, max_pixels; /* as given, or the defaults */
   int status;
-  size_t stack_use;
+  size_t stack_use, stack_reserved;
   RenderOverrides render;
   int tradeoff;            /* qcs tradeoff: files[0] is the script */
   TradeoffOptions topt;
@@ -62,9 +64,18 @@ static void usage(FILE *out) {
           "  --tolerance T       root tolerance, a distance (default 1e-9)\n"
           "  --cost              add the root-finder cost channel to an EXR\n"
           "  --float             EXR colour as 32-bit floats (default half)\n"
-          "  --max-steps N       stop an evaluation after N steps\n"
-          "  --max-memory MB     stop an evaluation whose values pass MB megabytes\n"
-          "                      (default 8192; 0 for no limit)\n"
+          "\n"
+          "limits (an evaluation or render that passes one stops with an error;\n"
+          "in the REPL, :set lists and changes them):\n"
+          "  --max-stack SIZE    stack for nested calls, i.e. recursion depth\n"
+          "                      (default 256M; SIZE is a number with K, M, G)\n"
+          "  --max-steps N       evaluation steps of one top-level expression\n"
+          "                      (default 10000000000; 0 for no limit)\n"
+          "  --max-list N        elements of one list (default 10000000; 0: none)\n"
+          "  --max-memory SIZE   memory for values (default 8G; a bare number is\n"
+          "                      megabytes; 0 for no limit)\n"
+          "  --max-pixels N|WxH  pixels of one image (default 4096x4096)\n"
+          "  --max-spp N         samples per pixel (default 64, at most 256)\n"
           "  -h, --help          this help\n"
           "  -V, --version       the version\n"
           "\n"
@@ -77,9 +88,17 @@ static void *run(void *arg) {
   render_set_overrides(I, &o->render);
   char probe;
   interp_set_stack(I, &probe, o->stack_use);
-  if (o->max_steps) interp_set_max_steps(I, o->max_steps);
-  if (o->max_memory_mb >= 0)
-    interp_set_max_memory(I, (size_t)o->max_memory_mb << 20);
+  interp_set_stack_reserved(I, o->stack_reserved);
+  for (int i = 0; i < o->nlimits; i++) {
+    char err[300];
+    if (strcmp(o->limit_names[i], "max-stack") &&
+        interp_set_limit(I, o->limit_names[i], o->limit_values[i], err,
+                         sizeof err)) {
+      fprintf(stderr, "qcs: error: --%s\n", err);
+      o->status = 1;
+      return NULL;
+    }
+  }
   for (int i = 0; i < o->nsets; i++) {
     const char *eq = strchr(o->sets[i], '=');
     char name[256];
@@ -183,7 +202,8 @@ static int tradeoff_args(int argc, char **argv, Options *o) {
 
 int main(int argc, char **argv) {
   static Options o;
-  o.max_memory_mb = -1;
+  o.max_spp = QCS_DEFAULT_MAX_SPP;
+  o.max_pixels = QCS_DEFAULT_MAX_PIXELS;
   o.files = calloc((size_t)argc + 1, sizeof(char *));
   if (argc > 1 && !strcmp(argv[1], "convolution")) {
     int help = argc == 3 && !strcmp(argv[2], "--help");
@@ -226,25 +246,47 @@ int main(int argc, char **argv) {
         return 1;
       }
       o.sets[o.nsets++] = argv[++i];
-    } else if (!strcmp(a, "--max-memory")) {
-      char *end;
-      long long mb = i + 1 < argc ? strtoll(argv[i + 1], &end, 10) : -1;
-      if (i + 1 >= argc || *end || mb < 0 || mb > (1LL << 40)) {
-        fprintf(stderr, "qcs: error: --max-memory needs megabytes, a whole "
-                "number >= 0\n");
+    } else if (!strncmp(a, "--max-", 6)) {
+      /* --max-NAME VALUE or --max-NAME=VALUE */
+      char name[32], err[300];
+      const char *eq = strchr(a, '='), *val;
+      size_t n = eq ? (size_t)(eq - a - 2) : strlen(a + 2);
+      if (n >= sizeof name) n = sizeof name - 1;
+      memcpy(name, a + 2, n);
+      name[n] = 0;
+      if (eq) val = eq + 1;
+      else if (i + 1 < argc) val = argv[++i];
+      else val = NULL;
+      unsigned long long v;
+      if (interp_limit_parse(name, val ? val : "", &v, err, sizeof err)) {
+        if (!strncmp(err, "unknown", 7)) {
+          const char *dym = strstr(err, "(did you mean ");
+          if (dym)
+            fprintf(stderr, "qcs: error: unknown option '%.*s' (did you "
+                    "mean --%s\n", (int)(eq ? eq - a : (int)strlen(a)), a,
+                    dym + 14);
+          else
+            fprintf(stderr, "qcs: error: unknown option '%.*s' (see qcs "
+                    "--help)\n", (int)(eq ? eq - a : (int)strlen(a)), a);
+        } else if (!val) {
+          fprintf(stderr, "qcs: error: --%s needs a value\n", name);
+        } else {
+          fprintf(stderr, "qcs: error: --%s\n", err);
+        }
         return 1;
       }
-      o.max_memory_mb = mb;
-      i++;
-    } else if (!strcmp(a, "--max-steps")) {
-      char *end;
-      if (i + 1 >= argc || !(o.max_steps = strtoull(argv[i + 1], &end, 10)) ||
-          *end) {
-        fprintf(stderr, "qcs: error: --max-steps needs a positive whole "
-                "number\n");
+      if (o.nlimits == 16) {
+        fprintf(stderr, "qcs: error: too many --max options\n");
         return 1;
       }
-      i++;
+      if (!strcmp(name, "max-stack")) o.stack_use = (size_t)v;
+      if (!strcmp(name, "max-spp")) o.max_spp = v;
+      if (!strcmp(name, "max-pixels")) o.max_pixels = v;
+      char *keep = malloc(strlen(name) + 1);
+      if (!keep) return 1;
+      strcpy(keep, name);
+      o.limit_names[o.nlimits] = keep;
+      o.limit_values[o.nlimits++] = val;
     } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
       if (i + 1 >= argc) {
         fprintf(stderr, "qcs: error: %s needs a file name\n", a);
@@ -303,6 +345,23 @@ int main(int argc, char **argv) {
       return 1;
     }
   }
+  /* Options that pass a limit are refused before anything runs. */
+  if (o.render.spp && (unsigned long long)o.render.spp > o.max_spp) {
+    fprintf(stderr, "qcs: error: --spp %d is over %llu samples per pixel "
+            "(limit max-spp; raise it with --max-spp N)\n", o.render.spp,
+            o.max_spp);
+    return 1;
+  }
+  if (o.render.width && (unsigned long long)o.render.width *
+                                (unsigned long long)o.render.height >
+                            o.max_pixels) {
+    fprintf(stderr, "qcs: error: --size %dx%d is %llu pixels, over %llu "
+            "(limit max-pixels; raise it with --max-pixels N)\n",
+            o.render.width, o.render.height,
+            (unsigned long long)o.render.width *
+                (unsigned long long)o.render.height, o.max_pixels);
+    return 1;
+  }
   GC_INIT();
   GC_allow_register_threads();
   /* Ctrl-C ends a script's evaluation or render with "interrupted" (no
@@ -310,12 +369,25 @@ int main(int argc, char **argv) {
   if (o.nfiles || o.nexprs || o.tradeoff) repl_install_sigint();
   pthread_attr_t attr;
   pthread_attr_init(&attr);
-  pthread_attr_setstacksize(&attr, STACK_SIZE);
+  /* The stack reserved is a third more than max-stack allows, so that
+     what runs below the checks has room; :set max-stack may raise the
+     limit up to three quarters of it. */
+  int asked = o.stack_use != 0;
+  if (!asked) o.stack_use = STACK_USE;
+  o.stack_reserved = o.stack_use / 3 * 4;
+  if (o.stack_reserved < STACK_SIZE) o.stack_reserved = STACK_SIZE;
+  pthread_attr_setstacksize(&attr, o.stack_reserved);
   pthread_t th;
-  o.stack_use = STACK_USE;
   if (pthread_create(&th, &attr, run, &o) != 0) {
+    if (asked) {
+      char sz[32];
+      interp_format_size(sz, sizeof sz, o.stack_use);
+      fprintf(stderr, "qcs: error: --max-stack %s: cannot reserve a stack "
+              "that large\n", sz);
+      return 1;
+    }
     /* No big stack to be had: run here with the default one. */
-    o.stack_use = FALLBACK_STACK_USE;
+    o.stack_use = o.stack_reserved = FALLBACK_STACK_USE;
     run(&o);
   } else {
     pthread_join(th, NULL);

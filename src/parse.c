@@ -4,6 +4,8 @@
 #include <gc.h>
 #include <string.h>
 
+#include "eval.h"
+
 #define LAYOUT_MAX 256
 
 typedef struct Parser {
@@ -20,6 +22,12 @@ typedef struct Parser {
 
 static Expr *expr(Parser *P);
 static Expr *app(Parser *P);
+
+/* Deep nesting ((((... a million brackets) is stopped by the max-stack
+   limit, as deep recursion in evaluation is. */
+#define NESTING_CHECK(P)                                                       \
+  eval_stack_check((P)->I, (P)->toks[(P)->i].pos,                              \
+                   "expression nested too deeply: parsing it needs")
 static Def *binding(Parser *P, int toplevel, int *is_expr, Expr **ex);
 
 /* ---- tokens and layout ---- */
@@ -749,6 +757,7 @@ static void case_alts(Parser *P, Vec *alts, Pos casepos) {
            | 'if' expr 'then' expr 'else' expr | '-' operand | app */
 static Expr *operand(Parser *P, int minprec) {
   Pos pos = pos_here(P);
+  NESTING_CHECK(P);
   switch (peek(P)) {
   case T_LAMBDA: {
     next(P);
@@ -1003,6 +1012,7 @@ static void block_bindings(Parser *P, Vec *defs, int stop_at_in) {
 /* Skips a type expression: atype -> CNAME | NAME | '(' ... ')' | '[' ... ']'
    | '!' atype. Returns 0 if the next token cannot start one. */
 static int skip_atype(Parser *P) {
+  NESTING_CHECK(P);
   TokKind k = peek(P);
   if (k == T_BANG) {
     next(P);

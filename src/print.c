@@ -148,7 +148,9 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
   case V_NIL:
   case V_CONS:
     fputc('[', out);
+    unsigned long long n = 0;
     for (int first = 1; v->kind == V_CONS; first = 0) {
+      eval_list_count(I, pos_none, ++n);
       if (!first) fputs(", ", out);
       print_rec(I, out, v->u.cons.head, 0);
       v = force(I, v->u.cons.tail);
@@ -181,6 +183,7 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
 /* Forces v completely, visiting at most *budget nodes; returns 0 when the
    budget ran out first (a long or infinite value). */
 static int force_deep(Interp *I, Value *v, long *budget) {
+  unsigned long long n = 0;
   for (;;) {
     if (--*budget < 0) return 0;
     eval_check(I, pos_none);
@@ -195,6 +198,7 @@ static int force_deep(Interp *I, Value *v, long *budget) {
         if (!force_deep(I, v->u.con.args[i], budget)) return 0;
       return 1;
     case V_CONS:
+      eval_list_count(I, pos_none, ++n);
       if (!force_deep(I, v->u.cons.head, budget)) return 0;
       v = v->u.cons.tail; /* the spine iteratively */
       continue;

@@ -139,6 +139,16 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
     if (ov->float_pixels) float_pixels = 1;
     ov->renders++;
   }
+  /* The limits: a picture's size and its samples. */
+  if ((unsigned long long)rs.width * (unsigned long long)rs.height >
+      I->max_pixels)
+    eval_limit_error(I, pos, "max-pixels", "the image is %d x %d = %llu "
+                     "pixels, over %llu", rs.width, rs.height,
+                     (unsigned long long)rs.width *
+                         (unsigned long long)rs.height, I->max_pixels);
+  if (rs.spp > I->max_spp)
+    eval_limit_error(I, pos, "max-spp", "%d samples per pixel is over %d",
+                     rs.spp, I->max_spp);
   char err[512];
   if (ov && ov->capture) {
     Scene *cs = scene_compile(I, obj, pos);

@@ -202,7 +202,7 @@ static void note_status(Repl *R, RunStatus st) {
 
 /* ---- commands ---- */
 
-typedef enum { ARG_NONE, ARG_FILE } ArgKind;
+typedef enum { ARG_NONE, ARG_FILE, ARG_ANY } ArgKind;
 
 typedef struct {
   const char *name;
@@ -218,6 +218,7 @@ static void cmd_reload(Repl *R, const char *arg, int bang);
 static void cmd_browse(Repl *R, const char *arg, int bang);
 static void cmd_quit(Repl *R, const char *arg, int bang);
 static void cmd_tradeoff(Repl *R, const char *arg, int bang);
+static void cmd_set(Repl *R, const char *arg, int bang);
 
 /* Sorted by name; a command may be abbreviated to any unique prefix. */
 static const Command commands[] = {
@@ -228,6 +229,8 @@ static const Command commands[] = {
    "run a qcs file and remember it for :reload"},
   {"quit", ARG_NONE, 0, cmd_quit, ":quit", "leave qcs (so does Ctrl-D)"},
   {"reload", ARG_NONE, 0, cmd_reload, ":reload", "run the loaded files again"},
+  {"set", ARG_ANY, 0, cmd_set, ":set [LIMIT N]",
+   "list the resource limits, or change one (:set max-steps 1000000)"},
   {"tradeoff", ARG_FILE, 0, cmd_tradeoff, ":tradeoff FILE",
    "error against run time over root tolerances (writes tradeoff.svg)"},
 };
@@ -250,7 +253,50 @@ static void cmd_help(Repl *R, const char *arg, int bang) {
        "definitions. Tab completes names, commands and file names after\n"
        ":load. History is kept in ~/.qcs_history.\n"
        "The language is described in lang/ of the qcs sources; the command\n"
-       "line in qcs(1).");
+       "line in qcs(1).\n"
+       "\n"
+       "Limits: an evaluation or render that passes one stops with an error\n"
+       "naming it. :set lists them; :set NAME VALUE changes one:\n"
+       "  max-stack SIZE   stack for nested calls, i.e. recursion depth (256M)\n"
+       "  max-steps N      evaluation steps of one entry (0: no limit)\n"
+       "  max-list N       elements of one list (0: no limit)\n"
+       "  max-memory SIZE  memory for values, e.g. 512M or 2G (0: no limit)\n"
+       "  max-pixels N     pixels of one image, N or WxH (at most 8192x8192)\n"
+       "  max-spp N        samples per pixel of a render (at most 256)\n"
+       "The same limits are options of the command line: --max-steps N, ...");
+}
+
+/* :set lists the limits; :set NAME VALUE changes one. */
+static void cmd_set(Repl *R, const char *arg, int bang) {
+  if (!*arg) {
+    interp_list_limits(R->I, stdout);
+    fflush(stdout);
+    return;
+  }
+  char name[64];
+  size_t n = strcspn(arg, " \t=");
+  const char *val = arg + n;
+  while (*val == ' ' || *val == '\t' || *val == '=') val++;
+  if (n >= sizeof name) n = sizeof name - 1;
+  memcpy(name, arg, n);
+  name[n] = 0;
+  char err[300];
+  if (!*val) {
+    unsigned long long v;
+    if (interp_limit_parse(name, "0", &v, err, sizeof err) &&
+        !strncmp(err, "unknown", 7))
+      fprintf(stderr, "error: %s; :set alone lists the limits\n", err);
+    else
+      fprintf(stderr, "error: :set %s needs a value (usage: :set %s VALUE)\n",
+              name, name);
+    R->had_error = 1;
+    return;
+  }
+  if (interp_set_limit(R->I, name, val, err, sizeof err)) {
+    fprintf(stderr, "error: %s%s\n", err,
+            strncmp(err, "unknown", 7) ? "" : "; :set alone lists the limits");
+    R->had_error = 1;
+  }
 }
 
 static void remember_file(Repl *R, const char *path) {

@@ -100,12 +100,21 @@ typedef struct Forcing {
 struct Interp {
   Sym **symtab;
   size_t symcap, nsyms;
+  /* Resource limits (see interp_set_limit); 0 means no limit where a
+     limit may be switched off. */
   char *stack_base;          /* for the recursion-depth check */
-  size_t stack_limit;        /* bytes of C stack evaluation may use */
-  unsigned long long steps;  /* evaluation steps so far */
-  unsigned long long max_steps; /* 0 = no limit */
-  size_t max_memory;         /* bytes of values allowed (0 = no limit) */
+  size_t stack_limit;        /* max-stack: bytes of C stack evaluation and
+                                parsing may use */
+  size_t stack_reserved;     /* the stack the thread has (max-stack's cap) */
+  unsigned long long steps;  /* evaluation steps of the current item */
+  unsigned long long max_steps; /* max-steps, per top-level expression */
+  size_t max_memory;         /* max-memory: bytes of values allowed */
   unsigned memcheck;         /* steps since the memory was last checked */
+  unsigned long long max_list; /* max-list: elements of one list */
+  unsigned long long max_pixels; /* max-pixels: of one rendered image */
+  int max_spp;               /* max-spp: samples per pixel of a render */
+  Pos item_pos;              /* the top-level item being run, for errors
+                                found where no position is at hand */
   TraceEntry trace[TRACE_MAX];
   int ntrace;                /* entries in use (may exceed TRACE_MAX) */
   Forcing *forcing;
