@@ -184,26 +184,38 @@ static int emit(search *s, double t, int kind) {
   return s->n < s->maxout;
 }
 
-static int kind_of(double df) {
-  return df > 0 ? LG_ENTER : (df < 0 ? LG_EXIT : LG_TOUCH);
-}
 
-/* The root in a bracket [a, b] whose ends have opposite signs: Newton
- * steps from the better end, each kept only if it lands inside the
- * bracket and at least halves the step before it, else a bisection (the
- * safeguarded Newton of Numerical Recipes' rtsafe, in place of the paper's
- * regula falsi; both keep the bracket, this one converges quadratically
- * and uses the derivative every evaluation computes anyway). Stops when a
- * step is below max(tol, 4 ulp). */
+/* The inside predicate: the solid is where the density exceeds 0.5, so a
+ * point where f = rho - 0.5 is exactly 0 is outside (as PointInObject
+ * has it).  Crossings are the changes of this predicate; deciding them by
+ * the sign of f alone would turn a stretch where the density is exactly
+ * 0.5 (a ray in a face plane of a rounded cube) or a graze that the
+ * rounding lifts to exactly 0.5 into a pair of crossings, or classify a
+ * zero by its derivative. */
+static int pos(double f) { return f > 0; }
+
+/* The change of the inside predicate in a bracket [a, b] whose ends
+ * differ (pos(fa) != pos(fb)): Newton steps from the better end, each
+ * kept only if it lands inside the bracket and at least halves the step
+ * before it, else a bisection (the safeguarded Newton of Numerical
+ * Recipes' rtsafe, in place of the paper's regula falsi; both keep the
+ * bracket, this one converges quadratically and uses the derivative every
+ * evaluation computes anyway). Stops when a step is below
+ * max(tol, 4 ulp).  An end where f is exactly 0 is on the surface: the
+ * change is there when it is the outside end next to the bracket's inside
+ * part, so exact zeros (a face plane at density 0.5) come back exactly. */
 static double polish(search *s, const dt_tape *t, double a, double b,
                      double fa, double fb, double dfa, double dfb) {
+  int pa = pos(fa);
+  if (!pa && fa == 0) return a;    /* entering right after a zero at a */
+  if (pa && fb == 0) return b;     /* leaving at a zero at b */
   double rtol = fmax(s->tol, 4 * DBL_EPSILON * fmax(fabs(a), fabs(b)));
   double x, f, df;
   if (fabs(fa) < fabs(fb)) x = a, f = fa, df = dfa;
   else x = b, f = fb, df = dfb;
   double dx = b - a, dxold = dx;
   for (int it = 0; it < 200 && b - a > rtol; it++) {
-    double nx = df != 0 ? x - f / df : NAN;
+    double nx = df != 0 && f != 0 ? x - f / df : NAN;
     if (nx > a && nx < b && fabs(2 * f) <= fabs(dxold * df)) {
       dxold = dx;
       dx = x - nx;
@@ -216,11 +228,28 @@ static double polish(search *s, const dt_tape *t, double a, double b,
     }
     if (s->st) s->st->rf_steps++;
     f = feval(s, t, x, &df);
-    if (f == 0) return x;
-    if ((f < 0) == (fa < 0)) a = x, fa = f;
+    if (pos(f) == pa) a = x, fa = f;
     else b = x, fb = f;
+    if (f == 0) {
+      /* On the surface: a simple root is exact here, unless f stays 0
+       * on a stretch (then the change is at its far end): look one tol
+       * beyond. */
+      double y = pa ? x - rtol : x + rtol, dfy;
+      if (y > a && y < b) {
+        if (s->st) s->st->rf_steps++;
+        double fy = feval(s, t, y, &dfy);
+        if (pos(fy) != pos(f)) return x;
+        if (pa) b = y, fb = fy; else a = y, fa = fy;
+      } else {
+        return x;
+      }
+      df = 0;   /* bisect from here */
+      continue;
+    }
     if (fabs(dx) <= rtol) return x;
   }
+  if (!pa && fa == 0) return a;
+  if (pa && fb == 0) return b;
   return 0.5 * (a + b);
 }
 
@@ -236,25 +265,28 @@ static double envelope_min(double f, double df, double G, double h) {
 /* The tolerance rule for a segment shorter than tol (lg.h). */
 static int tiny_rule(search *s, const dt_tape *t, const segment *sg, double G,
                      int *nroots) {
-  if (sg->fb == 0) { (*nroots)++; return emit(s, sg->b, kind_of(sg->dfb)); }
-  if ((sg->fa < 0) != (sg->fb < 0) && sg->fa != 0) {
+  int pa = pos(sg->fa), pb = pos(sg->fb);
+  if (pa != pb) {
     (*nroots)++;
     double x = polish(s, t, sg->a, sg->b, sg->fa, sg->fb, sg->dfa, sg->dfb);
-    return emit(s, x, sg->fa < 0 ? LG_ENTER : LG_EXIT);
+    return emit(s, x, pa ? LG_EXIT : LG_ENTER);
   }
-  if (sg->fa == 0 || isinf(G)) return 1;
+  if (isinf(G)) return 1;
   double m = 0.5 * (sg->a + sg->b);
   if ((sg->dfa < 0) != (sg->dfb < 0) && sg->dfa != sg->dfb) {
     double x = sg->a + (sg->b - sg->a) * sg->dfa / (sg->dfa - sg->dfb);
     if (x > sg->a && x < sg->b) m = x;
   }
   double dfm, fm = feval(s, t, m, &dfm);
-  if (fm == 0 || (fm < 0) != (sg->fa < 0)) {
-    if (fm == 0) { (*nroots)++; return emit(s, m, LG_TOUCH); }
-    int k1 = sg->fa < 0 ? LG_ENTER : LG_EXIT;
+  if (pos(fm) != pa) {
+    int k1 = pa ? LG_EXIT : LG_ENTER;
     *nroots += 2;
     if (!emit(s, polish(s, t, sg->a, m, sg->fa, fm, sg->dfa, dfm), k1)) return 0;
     return emit(s, polish(s, t, m, sg->b, fm, sg->fb, dfm, sg->dfb), -k1);
+  }
+  if (fm == 0 || sg->fa == 0 || sg->fb == 0) {
+    (*nroots)++;
+    return emit(s, fm == 0 ? m : sg->fa == 0 ? sg->a : sg->b, LG_TOUCH);
   }
   double h1 = m - sg->a, h2 = sg->b - m;
   double lb1 = fmax(envelope_min(sg->fa, sg->dfa, G, h1),
@@ -283,7 +315,6 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
   segment first = {a, b, 0, 0, 0, 0, 0};
   first.fa = feval(s, t, a, &first.dfa);
   first.fb = feval(s, t, b, &first.dfb);
-  if (first.fa == 0 && !emit(s, a, kind_of(first.dfa))) return 0;
   stack[sp++] = first;
   while (sp) {
     segment sg = stack[--sp];
@@ -316,13 +347,10 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     }
     int nroots = 0, more = 1;
     if (shorty) {
-      if (sg.fb == 0) {
-        nroots = 1;
-        more = emit(s, sg.b, kind_of(sg.dfb));
-      } else if (sg.fa != 0 && (sg.fa < 0) != (sg.fb < 0)) {
+      if (pos(sg.fa) != pos(sg.fb)) {
         nroots = 1;
         more = emit(s, polish(s, &view, sg.a, sg.b, sg.fa, sg.fb, sg.dfa, sg.dfb),
-                    sg.fa < 0 ? LG_ENTER : LG_EXIT);
+                    pos(sg.fa) ? LG_EXIT : LG_ENTER);
       }
       trace(s, &sg, &lb, lhs, nroots ? LG_SEG_ROOT : LG_SEG_NO_ROOT, nc,
             nroots);

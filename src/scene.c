@@ -1,7 +1,9 @@
 /* scene.c: compiling constructor trees into scenes. See scene.h. */
 #include "scene.h"
 
+#include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -236,14 +238,39 @@ static int compile_sharp(Compile *C, Value *v) {
 
 static int all_sharp(const dt_tape *t) { return t->rmax == 0; }
 
-void scene_warn_once(Interp *I, Pos pos, const char *msg) {
+/* Once per (position, kind): the kind is folded into the remembered
+   column, so different warnings about one constructor are all given. */
+static void warn_once_kind(Interp *I, Pos pos, int kind, const char *msg) {
+  Pos key = pos;
+  key.col += kind * (1 << 24);
   for (int i = 0; i < I->nwarned; i++)
-    if (I->warned[i].src == pos.src && I->warned[i].line == pos.line &&
-        I->warned[i].col == pos.col)
+    if (I->warned[i].src == key.src && I->warned[i].line == key.line &&
+        I->warned[i].col == key.col)
       return;
   if (I->nwarned < (int)(sizeof I->warned / sizeof *I->warned))
-    I->warned[I->nwarned++] = pos;
+    I->warned[I->nwarned++] = key;
   qcs_warning(pos, "%s", msg);
+}
+
+void scene_warn_once(Interp *I, Pos pos, const char *msg) {
+  warn_once_kind(I, pos, 0, msg);
+}
+
+/* Coordinates of size S are rounded to about eps S; a feature of size r
+   (a filter radius, a key's radius) smaller than 100 eps S is then drawn
+   with errors above 1% of its size, whatever the root tolerance. */
+#define RESOLVE_FRAC 1e-2
+
+static void warn_resolution(Compile *C, Pos pos, const char *what, double r,
+                            double S) {
+  if (!(r > 0) || !(DBL_EPSILON * S > RESOLVE_FRAC * r)) return;
+  char msg[400];
+  snprintf(msg, sizeof msg, "%s %.3g is too small for coordinates of %.3g: "
+           "doubles resolve them only to %.2g (%.0f%% of the radius), so the "
+           "shape is drawn approximately; move the object nearer the origin "
+           "or use a larger radius", what, r, S, DBL_EPSILON * S,
+           100 * DBL_EPSILON * S / r);
+  warn_once_kind(C->I, pos, 1, msg);
 }
 
 static int compile_soft(Compile *C, Value *v, Pos pos) {
@@ -305,6 +332,12 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   soft_obj *obj = NULL;
   size_t bad = 0;
   int err = soft_build(keys, n, magic, &obj, &bad);
+  double wr = 0, ws = 0;  /* the key least resolved at its centre */
+  for (size_t j = 0; j < n; j++) {
+    if (keys[j].kind != SOFT_SPHERE) continue;
+    double S = fmax(fabs(keys[j].c[0]), fmax(fabs(keys[j].c[1]), fabs(keys[j].c[2])));
+    if (S * wr > ws * keys[j].R || wr == 0) wr = keys[j].R, ws = S;
+  }
   free(keys);
   if (err) {
     if (bad < n)
@@ -314,6 +347,7 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   }
   int i = add_node(C, SC_SOFT, pos);
   C->s->nodes[i].soft = obj;
+  if (wr > 0) warn_resolution(C, pos, "a key radius of", wr, ws);
   C->s->flags |= SCENE_HAS_SOFT;
   if (n > C->s->max_keys) C->s->max_keys = n;
   return i;
@@ -396,6 +430,17 @@ static int compile_rounded(Compile *C, Value *tree, double r, Pos pos) {
   int i = add_node(C, SC_ROUNDED, pos);
   ScNode *nd = &C->s->nodes[i];
   nd->tape = t;
+  /* the coordinates of the tree: its planes' offsets (a bounded
+     polyhedron at distance D from the origin has a plane with |d| >=
+     D / sqrt 3) */
+  double wr = 0, ws = 0;
+  for (int j = 0; j < t->nleaves; j++) {
+    const dt_leaf *lf = &t->leaves[j];
+    if (lf->r > 0 && (wr == 0 || fabs(lf->d) * wr > ws * lf->r))
+      wr = lf->r, ws = fabs(lf->d);
+  }
+  for (int j = 0; j < t->nleaves; j++) ws = fmax(ws, fabs(t->leaves[j].d));
+  warn_resolution(C, pos, "a radius of", wr, ws);
   int fo = 0, fi = 0;
   nd->outer = bnd_outer(t, 0.5, &fo);
   nd->inner = bnd_inner(t, 0.5, &fi);
