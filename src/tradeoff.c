@@ -622,20 +622,23 @@ static void add_ray(Obj *ob, const double target[3], const double dir_out[3],
   ob->nrays++;
 }
 
-/* Rays in the z = 0 plane aimed at the apex of a wedge of interior angle
-   alpha, from 7 directions spread over the outside angles, and rays
-   perpendicular to the face y = 0 at distances 0.5r, r and 2r from it. */
+/* Rays in the z = 0 plane through the apex of a wedge of interior angle
+   alpha, travelling into the wedge in 7 directions spread over its
+   interior angle (so every one meets the rounded tip, however acute), and
+   rays perpendicular to the face y = 0 where the wedge is at least 4r
+   thick, 0.5r, r and 2r beyond that point. */
 static void wedge_rays(Obj *ob, double alpha_deg) {
   double apex[3] = {0, 0, 0};
   double a = alpha_deg * M_PI / 180;
   for (int i = 1; i <= 7; i++) {
-    double beta = a + (2 * M_PI - a) * i / 8.0;
-    double dir[3] = {cos(beta), sin(beta), 0};
+    double gamma = a * i / 8.0;
+    double dir[3] = {-cos(gamma), -sin(gamma), 0}; /* outward: back along */
     add_ray(ob, apex, dir, 3 * ob->r);
   }
   double fr[3] = {0.5, 1, 2};
+  double x0 = alpha_deg < 90 ? 4 * ob->r / tan(a) : 0;
   for (int i = 0; i < 3; i++) {
-    double x = fr[i] * ob->r;
+    double x = x0 + fr[i] * ob->r;
     /* a point on face y = 0 inside the wedge's face (x > 0) */
     double tgt[3] = {x, 0, 0}, dir[3] = {0, -1, 0};
     add_ray(ob, tgt, dir, 3 * ob->r);
