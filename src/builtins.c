@@ -78,8 +78,12 @@ static Value *bi_not(Interp *I, Value **args, Pos pos) {
 static Value *bi_show(Interp *I, Value **args, Pos pos) {
   return val_str(show_value(I, force(I, args[0])));
 }
+/* error msg: said where the user's code called it, even when that was
+   through the prelude (Scale's "factors > 0"); the text is the user's
+   own, shown as it is. */
 static Value *bi_error(Interp *I, Value **args, Pos pos) {
-  qcs_error(pos, "%s", force_str(I, args[0], pos, "the message of error"));
+  const char *msg = force_str(I, args[0], pos, "the message of error");
+  qcs_error_verbatim(eval_user_pos(I, pos), msg);
 }
 static Value *bi_seq(Interp *I, Value **args, Pos pos) {
   force(I, args[0]);

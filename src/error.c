@@ -32,11 +32,55 @@ static _Noreturn void err_throw(void) {
 
 _Noreturn void err_rethrow(void) { err_throw(); }
 
+static int word_char(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+         (c >= '0' && c <= '9') || c == '_' || c == '.' || c == '\'' || c == '"';
+}
+
+/* "nan", "-nan", "inf", "-inf" standing alone (as printf's %g writes
+   them) become NaN, NaN, Infinity, -Infinity, so that messages of the C
+   code agree with what the language prints, whatever the platform's sign
+   of a NaN. */
+static void qcs_nonfinite(char *msg, size_t size) {
+  static const struct { const char *c, *qcs; } words[] = {
+    {"-nan", "NaN"}, {"nan", "NaN"}, {"-inf", "-Infinity"}, {"inf", "Infinity"}};
+  char out[sizeof err_current.msg];
+  size_t o = 0;
+  for (const char *p = msg; *p && o + 1 < sizeof out;) {
+    int done = 0;
+    if (p == msg || !word_char(p[-1]))
+      for (size_t w = 0; w < sizeof words / sizeof words[0] && !done; w++) {
+        size_t n = strlen(words[w].c);
+        if (!strncmp(p, words[w].c, n) && !word_char(p[n])) {
+          size_t m = strlen(words[w].qcs);
+          if (o + m >= sizeof out) break;
+          memcpy(out + o, words[w].qcs, m);
+          o += m;
+          p += n;
+          done = 1;
+        }
+      }
+    if (!done) out[o++] = *p++;
+  }
+  out[o] = 0;
+  snprintf(msg, size, "%s", out);
+}
+
 _Noreturn void qcs_verror(Pos pos, const char *fmt, va_list ap) {
   err_current.pos = pos;
   err_current.incomplete = 0;
   err_current.trace[0] = 0;
   vsnprintf(err_current.msg, sizeof err_current.msg, fmt, ap);
+  if (strstr(err_current.msg, "nan") || strstr(err_current.msg, "inf"))
+    qcs_nonfinite(err_current.msg, sizeof err_current.msg);
+  err_throw();
+}
+
+_Noreturn void qcs_error_verbatim(Pos pos, const char *msg) {
+  err_current.pos = pos;
+  err_current.incomplete = 0;
+  err_current.trace[0] = 0;
+  snprintf(err_current.msg, sizeof err_current.msg, "%s", msg);
   err_throw();
 }
 

@@ -48,10 +48,17 @@ void err_pop(ErrFrame *f);
    frame is popped in both branches by the macro's caller via err_pop. */
 #define ERR_TRY(f) (err_push(&(f)), setjmp((f).jb) == 0)
 
+/* Messages are formatted with printf; a non-finite number formatted with
+   %g ("nan", "-nan", "inf", "-inf") is rewritten as the language prints
+   it (NaN, Infinity, -Infinity). */
 _Noreturn void qcs_error(Pos pos, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 _Noreturn void qcs_verror(Pos pos, const char *fmt, va_list ap);
 /* Like qcs_error, but marks the error as "more input would help". */
+/* An error whose text is given as it is (a user's `error "..."`): not
+   passed through printf, and C's spellings of non-finite numbers in it
+   are not rewritten (see qcs_error). */
+_Noreturn void qcs_error_verbatim(Pos pos, const char *msg);
 _Noreturn void qcs_error_incomplete(Pos pos, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 

@@ -518,7 +518,7 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
 /* A position in the user's code for something the prelude builds: the
    innermost call from outside the prelude (a Rounded rebuilt by Shift is
    reported where the user wrote Shift). */
-static Pos user_pos(Interp *I, Pos pos) {
+Pos eval_user_pos(Interp *I, Pos pos) {
   if (!pos.src || strcmp(pos.src->name, "<prelude>")) return pos;
   int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
   for (int i = n - 1; i >= 0; i--) {
@@ -571,7 +571,7 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
       *result = val_con(c, a, cargs);
       if (pos.src) { /* scene errors found later point back here */
         Pos *p = GC_MALLOC(sizeof *p);
-        *p = user_pos(I, pos);
+        *p = eval_user_pos(I, pos);
         (*result)->u.con.pos = p;
       }
       return 0;

@@ -65,6 +65,11 @@ static inline void eval_stack_check(Interp *I, Pos pos, const char *what) {
     eval_stack_error(I, pos, what, "");
 }
 
+/* For a position inside the prelude, the innermost call from the user's
+   code in the call trace (an error raised by the prelude is reported
+   where the user called it); other positions are returned as they are. */
+Pos eval_user_pos(Interp *I, Pos pos);
+
 /* The brief, non-forcing description of a value for error messages:
    thunks show as "...", long lists and deep trees are cut. */
 void val_brief(Value *v, char *buf, size_t size);

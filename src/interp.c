@@ -423,6 +423,32 @@ RunStatus interp_eval_print(Interp *I, const char *text) {
   return RUN_ERROR;
 }
 
+RunStatus interp_render_scene(Interp *I, const char *path) {
+  Sym *s = sym_intern(I, "scene", 5);
+  if (!s->global) {
+    fprintf(stderr, "qcs: error: -o %s: the scripts render nothing and "
+            "define no `scene` to render\n", path);
+    return RUN_ERROR;
+  }
+  int nforcing = I->nforcing;
+  I->steps = 0;
+  I->item_pos = s->def_pos;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    Value *v = render_value(I, NULL, path, s->global, s->def_pos);
+    print_value(I, stdout, v);
+    fputc('\n', stdout);
+    fflush(stdout);
+    err_pop(&f);
+    return RUN_OK;
+  }
+  err_pop(&f);
+  fflush(stdout);
+  report_error(I);
+  unwind(I, nforcing);
+  return RUN_ERROR;
+}
+
 RunStatus interp_set_override(Interp *I, const char *name, const char *expr) {
   Src *src = GC_MALLOC(sizeof *src);
   char *nm = GC_MALLOC_ATOMIC(strlen(name) + 16);

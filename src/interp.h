@@ -46,6 +46,10 @@ RunStatus interp_run_file(Interp *I, const char *path);
 /* Evaluate one expression given as text and print its value (qcs -e). */
 RunStatus interp_eval_print(Interp *I, const char *text);
 
+/* Render the top-level `scene` to path (qcs -o FILE with scripts that
+   render nothing); errors point at scene's definition. */
+RunStatus interp_render_scene(Interp *I, const char *path);
+
 /* Replace (or add) the top-level definition NAME = VALUE-TEXT before a
    script runs (qcs --set NAME=VALUE). The script's own definition of NAME
    is then ignored. */

@@ -108,13 +108,15 @@ static int is_ident(char c) {
 static void lex_number(Lexer *L) {
   Pos pos = here(L);
   const char *start = L->p;
-  int nonzero = 0;
+  int nonzero = 0, whole = 1;
   while (*L->p >= '0' && *L->p <= '9') nonzero |= *L->p != '0', advance(L);
   if (L->p[0] == '.' && L->p[1] >= '0' && L->p[1] <= '9') {
+    whole = 0;
     advance(L);
     while (*L->p >= '0' && *L->p <= '9') nonzero |= *L->p != '0', advance(L);
   }
   if (*L->p == 'e' || *L->p == 'E') {
+    whole = 0;
     const char *q = L->p + 1;
     if (*q == '+' || *q == '-') q++;
     if (*q >= '0' && *q <= '9') {
@@ -141,6 +143,18 @@ static void lex_number(Lexer *L) {
   if (v == 0 && nonzero)
     qcs_error(pos, "number %s is too small for a Real: it would be 0 "
               "(smallest is about 4.9e-324)", buf);
+  /* A whole number written out in digits is meant exactly: one that a
+     Real would round is refused (write 1e23 or N.0 to accept rounding). */
+  if (whole && v >= 9007199254740992.0) {
+    char back[400];
+    const char *digits = buf;
+    while (digits[0] == '0' && digits[1]) digits++;
+    snprintf(back, sizeof back, "%.0f", v);
+    if (strcmp(back, digits))
+      qcs_error(pos, "number %s cannot be held exactly by a Real (whole "
+                "numbers are exact up to 9007199254740992); write %s.0 if the "
+                "nearest Real will do", buf, buf);
+  }
   Token *t = push(L, T_NUM, pos, start);
   t->num = v;
 }

@@ -126,17 +126,10 @@ static void *run(void *arg) {
       return NULL;
     }
   /* -o with scripts that render nothing: render their `scene`. */
-  if (o->render.output && o->render.renders == 0) {
-    if (!interp_has_global(I, "scene")) {
-      fprintf(stderr, "qcs: error: -o %s: the scripts render nothing and "
-              "define no `scene` to render\n", o->render.output);
-      o->status = 1;
-      return NULL;
-    }
-    if (interp_eval_print(I, "renderWith [] \"-o\" scene") != RUN_OK) {
-      o->status = 1;
-      return NULL;
-    }
+  if (o->render.output && o->render.renders == 0 &&
+      interp_render_scene(I, o->render.output) != RUN_OK) {
+    o->status = 1;
+    return NULL;
   }
   if (o->nfiles == 0 && o->nexprs == 0) o->status = repl_run(I);
   return NULL;
@@ -340,7 +333,8 @@ int main(int argc, char **argv) {
   }
   if (o.render.output) {
     char err[300];
-    if (img_format(o.render.output, err, sizeof err) < 0) {
+    if (img_format(o.render.output, err, sizeof err) < 0 ||
+        render_writable(o.render.output, err, sizeof err) < 0) {
       fprintf(stderr, "qcs: error: -o: %s\n", err);
       return 1;
     }

@@ -11,7 +11,9 @@
  * is the name of the file written. */
 #include "render_lang.h"
 
+#include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -21,6 +23,28 @@
 #include "image.h"
 #include "render.h"
 #include "scene.h"
+
+int render_writable(const char *path, char *err, size_t errlen) {
+  const char *slash = strrchr(path, '/');
+  char *dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path))
+                    : strdup(".");
+  if (!dir) {
+    snprintf(err, errlen, "cannot write %s: out of memory", path);
+    return -1;
+  }
+  int ok = access(dir, W_OK | X_OK) == 0;
+  int e = errno;
+  free(dir);
+  if (!ok) {
+    snprintf(err, errlen, "cannot write %s: %s", path, strerror(e));
+    return -1;
+  }
+  if (slash && !slash[1]) {
+    snprintf(err, errlen, "cannot write %s: it names a folder", path);
+    return -1;
+  }
+  return 0;
+}
 
 static RenderOverrides *overrides_of(Interp *I) { return I->render_overrides; }
 
@@ -76,6 +100,8 @@ static void read_settings(Interp *I, Value *list, Pos pos, RenderSettings *rs,
       rs->camera_set = 1;
     } else if (con_is(s, "Up")) {
       arg_vec(I, s, 0, sp, "the up direction", rs->up);
+      if (rs->up[0] == 0 && rs->up[1] == 0 && rs->up[2] == 0)
+        qcs_error(sp, "the up direction cannot be zero");
     } else if (con_is(s, "Light") || con_is(s, "PointLight")) {
       if (rs->nlights == RENDER_MAX_LIGHTS)
         qcs_error(sp, "at most %d lights", RENDER_MAX_LIGHTS);
@@ -93,6 +119,9 @@ static void read_settings(Interp *I, Value *list, Pos pos, RenderSettings *rs,
       arg_vec(I, s, 0, sp, "the floor colour", rs->floor_colour);
     } else if (con_is(s, "Ambient")) {
       rs->ambient = arg_num(I, s, 0, sp, "the ambient light");
+      if (!isfinite(rs->ambient) || rs->ambient < 0)
+        qcs_error(sp, "the ambient light must be finite and >= 0, not %g",
+                  rs->ambient);
     } else if (con_is(s, "Tolerance")) {
       double t = arg_num(I, s, 0, sp, "the root tolerance");
       if (!(t > 0) || !isfinite(t))
@@ -124,6 +153,7 @@ static void read_settings(Interp *I, Value *list, Pos pos, RenderSettings *rs,
 Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
                     Pos pos) {
   RenderSettings rs;
+  pos = eval_user_pos(I, pos); /* render is renderWith [] in the prelude */
   render_defaults(&rs);
   rs.progress = isatty(2);
   int quiet = 0, float_pixels = 0;
@@ -157,7 +187,9 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
     if (rc) qcs_error(pos, "%s", err);
     return val_str(path);
   }
-  if (img_format(path, err, sizeof err) < 0) qcs_error(pos, "%s", err);
+  if (img_format(path, err, sizeof err) < 0 ||
+      render_writable(path, err, sizeof err) < 0)
+    qcs_error(pos, "%s", err);
   Scene *s = scene_compile(I, obj, pos);
   RenderReport rep;
   Image *im = render_scene(s, &rs, &rep, &qcs_interrupted, err, sizeof err);

@@ -32,6 +32,12 @@ typedef struct RenderOverrides {
 } RenderOverrides;
 
 void render_install(Interp *I);
+/* 0 if a file can be made at path (its folder exists and may be written
+   in), else -1 with "cannot write PATH: REASON" in err, so that a bad
+   output name is refused before a long render rather than after it. As
+   root a folder's permissions are not enforced; the write itself may
+   still fail, and then leaves nothing behind (see image.h). */
+int render_writable(const char *path, char *err, size_t errlen);
 /* The overrides stay owned by the caller and must outlive I's use. */
 void render_set_overrides(Interp *I, RenderOverrides *o);
 /* Render obj to path with settings (a qcs list, or NULL for none); the
