@@ -333,6 +333,8 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   size_t bad = 0;
   int err = soft_build(keys, n, magic, &obj, &bad);
   double wr = 0, ws = 0;  /* the key least resolved at its centre */
+  double wmax = 0;
+  for (size_t j = 0; j < n; j++) wmax = fmax(wmax, fabs(keys[j].w));
   for (size_t j = 0; j < n; j++) {
     if (keys[j].kind != SOFT_SPHERE) continue;
     double S = fmax(fabs(keys[j].c[0]), fmax(fabs(keys[j].c[1]), fabs(keys[j].c[2])));
@@ -348,6 +350,21 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   int i = add_node(C, SC_SOFT, pos);
   C->s->nodes[i].soft = obj;
   if (wr > 0) warn_resolution(C, pos, "a key radius of", wr, ws);
+  /* Near the edge of a key's bound its field is (5/9) w u^2, u = 1 -
+     r^2/R^2, and is summed to eps W absolute (W the largest weight), so a
+     small magic m is met at u = sqrt(9 m / 5w) known only within
+     [sqrt(9 (m - eps W)/5w), sqrt(9 (m + eps W)/5w)]: half that width is
+     the error in r/R. */
+  double ew = DBL_EPSILON * wmax;
+  double placed = wmax > 0 ? 0.5 * (sqrt(1.8 * (magic + ew) / wmax) -
+                                    sqrt(1.8 * fmax(0, magic - ew) / wmax)) : 0;
+  if (placed > 1e-9) {
+    char msg[300];
+    snprintf(msg, sizeof msg, "magic %.3g is so small beside key weights up to "
+             "%.3g that the surface hugs the keys' bounds and is placed only to "
+             "about %.1g of their radius", magic, wmax, placed);
+    warn_once_kind(C->I, pos, 2, msg);
+  }
   C->s->flags |= SCENE_HAS_SOFT;
   if (n > C->s->max_keys) C->s->max_keys = n;
   return i;

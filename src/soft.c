@@ -54,9 +54,15 @@ struct soft_scratch {
   double *sq;      /* s(v) coefficients of the active keys, 3 cap */
 };
 
+/* eq. (1) in the factored form C(s) = (1 - s)^2 (1 - 4s/9): the same
+ * polynomial, but with full relative accuracy near the edge of the key's
+ * bound (s -> 1), where the expanded form's cancellation leaves only an
+ * absolute eps. */
 static double cfield(double s)
 {
-  return s >= 1 ? 0 : 1 + s * (A1 + s * (A2 + s * A3));
+  if (s >= 1) return 0;
+  double u = 1 - s;
+  return u * u * (1 - s * (4.0 / 9.0));
 }
 
 static double cslope(double s)  /* dC/ds */
@@ -581,7 +587,10 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
       }
       continue;
     }
-    if (!isfinite(tnext)) break;  /* nothing active, nothing left to find */
+    if (!isfinite(tnext)) {  /* nothing active, nothing left to find */
+      if (state == 1 && na == 0 && iv > 0 && nout < maxout) out[nout++] = cur / len;
+      break;
+    }
 
     /* The interval [cur, tnext]: the active set is fixed inside it. */
     if (tnext > cur && na > 0) {
@@ -626,9 +635,18 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
         if (nout >= maxout) break;
       }
     } else if (na == 0 && tnext > cur) {
-      state = 0;  /* no key acts on a stretch: field 0 < magic (not at an
-                     empty [cur, cur], where keys holding the origin are
-                     about to be opened) */
+      /* no key acts on a stretch: field 0 < magic (not at an empty
+         [cur, cur], where keys holding the origin are about to be
+         opened). If the last interval ended "inside" (its end state is the
+         sign of a sextic whose value there is rounding noise when magic
+         is tiny: the field vanishes at a key's bound), the exit is at its
+         end: crossings must alternate. */
+      if (state == 1 && iv > 0) {
+        if (nout < maxout) out[nout++] = cur / len;
+        last_from = iv;
+        if (nout >= maxout) { state = 0; break; }
+      }
+      state = 0;
     }
     cur = tnext;
     if (cur >= r.tb) break;

@@ -224,14 +224,21 @@ typedef struct {
   int nkeys;
   double magic;
   int *act, nact;  /* the keys a ray can meet (soft_select) */
+  double *te, *tx; /* and where along the ray (padded) */
+  double tcur;     /* the ray parameter being evaluated (NAN: any) */
 } ssoft;
 
 /* Keys whose sphere the line o + t d passes within R of (in double with a
  * generous margin), so that 1e5 keys cost only what a ray meets. */
 static inline void soft_select(ssoft *S, const double o[3], const double d[3]) {
-  if (!S->act) S->act = malloc(sizeof(int) * (size_t)(S->nkeys + 1));
+  if (!S->act) {
+    S->act = malloc(sizeof(int) * (size_t)(S->nkeys + 1));
+    S->te = malloc(sizeof(double) * (size_t)(2 * S->nkeys + 2));
+    S->tx = S->te + S->nkeys + 1;
+  }
   double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
   S->nact = 0;
+  S->tcur = NAN;
   for (int k = 0; k < S->nkeys; k++) {
     const skey *K = &S->keys[k];
     double q[3] = {K->c[0] - o[0], K->c[1] - o[1], K->c[2] - o[2]};
@@ -239,7 +246,13 @@ static inline void soft_select(ssoft *S, const double o[3], const double d[3]) {
     double q2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
     double perp2 = q2 - qd * qd / len2;
     double R = K->R * (1 + 1e-6) + 1e-9 * sqrt(q2);
-    if (perp2 <= R * R) S->act[S->nact++] = k;
+    if (perp2 <= R * R) {
+      double tc = qd / len2, half = sqrt(fmax(0, R * R - perp2) / len2);
+      double pad = 1e-6 * half + 1e-9 * fabs(tc) + 1e-300;
+      S->te[S->nact] = tc - half - pad;
+      S->tx[S->nact] = tc + half + pad;
+      S->act[S->nact++] = k;
+    }
   }
 }
 
@@ -251,6 +264,8 @@ static inline void soft_eval(mpfr_t out, const ssoft *S, mpfr_t p[3], int sel,
   mpfr_set_zero(out, 1);
   int n = sel ? S->nact : S->nkeys;
   for (int j = 0; j < n; j++) {
+    if (sel && !isnan(S->tcur) && !(S->tcur >= S->te[j] && S->tcur <= S->tx[j]))
+      continue;
     const skey *K = &S->keys[sel ? S->act[j] : j];
     mpfr_set_zero(r2, 1);
     for (int i = 0; i < 3; i++) {
@@ -260,7 +275,11 @@ static inline void soft_eval(mpfr_t out, const ssoft *S, mpfr_t p[3], int sel,
     mpfr_set_d(q, K->R, MPFR_RNDN);
     mpfr_sqr(q, q, MPFR_RNDN);
     mpfr_div(x, r2, q, MPFR_RNDN);               /* r^2 / R^2 */
-    if (mpfr_cmp_ui(x, 1) >= 0) continue;
+    if (mpfr_cmp_ui(x, 1) >= 0) {
+      /* a key whose bound is within rounding still conditions f */
+      if (cond && mpfr_cmp_d(x, 1 + 1e-9) <= 0) *cond += fabs(K->w);
+      continue;
+    }
     /* -4/9 x^3 + 17/9 x^2 - 22/9 x + 1 */
     mpfr_mul_si(c, x, -4, MPFR_RNDN);
     mpfr_add_ui(c, c, 17, MPFR_RNDN);
@@ -308,6 +327,7 @@ static inline void sray_at_point(sray *R, mpfr_t p[3], mpfr_t out,
 }
 
 static inline void sray_point(const sray *R, double t, mpfr_t p[3]) {
+  if (R->soft) R->soft->tcur = t;
   for (int i = 0; i < 3; i++) {
     mpfr_set_d(p[i], R->d[i], MPFR_RNDN);
     mpfr_mul_d(p[i], p[i], t, MPFR_RNDN);     /* exact at 200 bits */
