@@ -4,8 +4,8 @@
  *  - Displacement (Lobb eq. 5) at t within 1e-15 of 0, 0.5 and 1: the
  *    reference solves cap(s, r) = t (the cap-volume fraction of eq. 1) by
  *    MPFR bisection; tolerance 4 ulp of the reference displacement plus
- *    4 eps r (the absolute rounding of a result of size r), and the
- *    result's density must be within 2 eps of t (relative near 0).
+ *    4 eps r (the absolute rounding of a result of size r); finite and
+ *    monotone in t.
  *  - No NaN or infinity escapes the density, its gradient, the ray
  *    derivative and the LG bounds (finite L and G for rounded leaves) at
  *    coordinates up to 1e8, radii 1e-12 .. 1e3 and |d| 1e-6 .. 1e6; the
@@ -35,16 +35,6 @@ static double ref_disp(double r, double t) {
   return s;
 }
 
-static double cap_at(double s, double r) {
-  mpfr_t x, v;
-  mpfr_inits2(STAB_PREC, x, v, (mpfr_ptr)0);
-  mpfr_set_d(x, s, MPFR_RNDN);
-  st_cap(v, x, r);
-  double d = mpfr_get_d(v, MPFR_RNDN);
-  mpfr_clears(x, v, (mpfr_ptr)0);
-  return d;
-}
-
 static void test_displacement(void) {
   double ts[64];
   int n = 0;
@@ -57,7 +47,7 @@ static void test_displacement(void) {
   static const double d1[] = {0x1p-53, 0x1p-52, 3.3e-16, 5.5e-16, 1e-15};
   for (int i = 0; i < 5; i++) ts[n++] = 1 - d1[i];                 /* 1 */
   static const double radii[] = {1e-12, 0.07, 1, 1e3};
-  double maxulp = 0, maxrho = 0;
+  double maxulp = 0;
   int bad = 0, nonfinite = 0, nonmono = 0;
   for (int k = 0; k < 4; k++) {
     double r = radii[k], prev = INFINITY;
@@ -75,11 +65,7 @@ static void test_displacement(void) {
       double err = fabs(got - want);
       double allow = 4 * (nextafter(fabs(want), INFINITY) - fabs(want)) + 4 * DBL_EPSILON * r;
       if (ulps > maxulp) maxulp = ulps;
-      /* the density at the result: t to 2 eps (relative to min(t, 1-t)
-       * where that is below 1/2, since t and 1 - t are exact) */
-      double rho = cap_at(got, r), tau = fmin(t, 1 - t);
-      double drho = fabs(rho - t) / fmax(tau, DBL_MIN);
-      if (drho > maxrho && tau > 1e-300) maxrho = drho;
+      double tau = fmin(t, 1 - t);
       if (err > allow && !(tau <= 1e-300)) {
         bad++;
         printf("#   Displacement %g %.17g = %.17g, reference %.17g\n", r, t, got,
@@ -89,8 +75,8 @@ static void test_displacement(void) {
   }
   printf("# summary | Displacement at t within 1e-15 of 0, 0.5, 1 (%d t x 4 "
          "radii) | MPFR bisection of the cap fraction | 4 ulp + 4 eps r | %d | "
-         "%d/%d | %.2f ulp | rho rel %.2g | - | %s |\n", n, 4 * n,
-         4 * n - bad, 4 * n, maxulp, maxrho, bad || nonfinite || nonmono ? "FAIL" : "pass");
+         "%d/%d | %.2f ulp | - | - | %s |\n", n, 4 * n,
+         4 * n - bad, 4 * n, maxulp, bad || nonfinite || nonmono ? "FAIL" : "pass");
   CHECK("Displacement near 0, 0.5, 1 agrees with the MPFR inverse to 4 ulp",
         bad == 0);
   CHECK("Displacement is finite and monotone in t", nonfinite == 0 && nonmono == 0);
