@@ -63,6 +63,21 @@ void eval_check(Interp *I, Pos pos) {
   }
 }
 
+void eval_alloc_check(Interp *I, Pos pos, size_t bytes) {
+  if (!I->max_memory) return;
+  size_t used = GC_get_heap_size() - GC_get_free_bytes();
+  if (bytes > I->max_memory || used + bytes > I->max_memory) {
+    GC_gcollect();
+    used = GC_get_heap_size() - GC_get_free_bytes();
+    if (bytes > I->max_memory || used + bytes > I->max_memory) {
+      char sz[32];
+      interp_format_size(sz, sizeof sz, I->max_memory);
+      eval_limit_error(I, pos, "max-memory", "evaluation stopped: values "
+                       "would use more than %s of memory", sz);
+    }
+  }
+}
+
 void eval_list_limit(Interp *I, Pos pos, unsigned long long n) {
   eval_limit_error(I, pos, "max-list", "a list longer than %llu elements",
                    n - 1);
@@ -532,6 +547,10 @@ Pos eval_user_pos(Interp *I, Pos pos) {
    is a function body to evaluate in tail position, or 0 with *result. */
 static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
                 Value **result, Expr **body, Env **benv, int depth) {
+  /* A function given more arguments than it takes applies its result to
+     the rest: if that is no function, the message says so by name. */
+  const char *over_name = NULL;
+  int over_arity = 0;
   for (;;) {
     f = force(I, f);
     if (f->kind == V_PAP) {
@@ -546,6 +565,11 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
     if (f->kind != V_FUNC) {
       char buf[160];
       val_brief(f, buf, sizeof buf);
+      if (over_name)
+        qcs_error(pos, "%s takes %d argument%s, but it is given %d (its "
+                  "result, %s, is not a function: %s)", over_name, over_arity,
+                  over_arity == 1 ? "" : "s", over_arity + n, val_describe(f),
+                  buf);
       qcs_error(pos, "%s is not a function, but it is applied to %d "
                 "argument%s: %s", val_describe(f), n, n == 1 ? "" : "s", buf);
     }
@@ -599,6 +623,15 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
     if (n == a) {
       *result = r;
       return 0;
+    }
+    if (f->u.fn.kind == F_DEF && f->u.fn.u.def->name) {
+      over_name = f->u.fn.u.def->name->name;
+      over_arity = a;
+    } else if (f->u.fn.kind == F_BUILTIN) {
+      over_name = f->u.fn.u.bi->name;
+      over_arity = a;
+    } else {
+      over_name = NULL;
     }
     f = r;
     args += a;
@@ -735,7 +768,10 @@ static Value *append(Interp *I, Value *a, Value *b, Pos pos) {
   if (a->kind == V_STR) {
     const char *y = force_str(I, b, pos, "the right side of ++ on strings");
     size_t la = strlen(a->u.str), lb = strlen(y);
+    eval_alloc_check(I, pos, la + lb + 1);
     char *s = GC_MALLOC_ATOMIC(la + lb + 1);
+    if (!s) qcs_error(pos, "out of memory for a string of %zu bytes",
+                      la + lb + 1);
     memcpy(s, a->u.str, la);
     memcpy(s + la, y, lb + 1);
     return val_str(s);

@@ -53,6 +53,9 @@ _Noreturn void eval_limit_error(Interp *I, Pos pos, const char *limit,
 /* "WHAT more than SIZE of stackAFTER" as a max-stack error. */
 _Noreturn void eval_stack_error(Interp *I, Pos pos, const char *what,
                                 const char *after);
+/* Before one large allocation (a String): bytes more would pass
+   max-memory -> the limit's error. */
+void eval_alloc_check(Interp *I, Pos pos, size_t bytes);
 /* Counts element n (1-based) of a list against max-list. */
 _Noreturn void eval_list_limit(Interp *I, Pos pos, unsigned long long n);
 static inline void eval_list_count(Interp *I, Pos pos, unsigned long long n) {

@@ -10,6 +10,7 @@
 #include <gc.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "builtins.h"
 #include "image.h"
@@ -82,6 +83,7 @@ typedef struct Check {
   Interp *I;
   Item **items;
   int nitems;
+  int depth;  /* of check_expr calls: one per KB of max-stack at most */
 } Check;
 
 static void scope_add(Scope *s, Sym *name) {
@@ -185,9 +187,20 @@ static void check_defs(Check *C, int n, Def **defs, Scope *sc) {
   for (int i = 0; i < n; i++) check_def(C, defs[i], sc);
 }
 
+/* The AST's depth is bounded here, before anything runs: a chain of a
+   million '+' would otherwise recurse a million deep in eval. */
+static void check_expr_body(Check *C, Expr *e, Scope *sc);
 static void check_expr(Check *C, Expr *e, Scope *sc) {
+  if ((size_t)++C->depth > C->I->stack_limit >> 10)
+    eval_limit_error(C->I, e->pos, "max-stack",
+                     "expression nested too deeply to evaluate");
   eval_stack_check(C->I, e->pos,
                    "expression nested too deeply: checking it needs");
+  check_expr_body(C, e, sc);
+  C->depth--;
+}
+
+static void check_expr_body(Check *C, Expr *e, Scope *sc) {
   switch (e->kind) {
   case E_VAR: check_var(C, e->u.var, sc, e->pos); break;
   case E_WILD: qcs_error(e->pos, "'_' stands only in patterns");
@@ -258,7 +271,7 @@ static void refresh_values(Interp *I) {
 static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
                            const char *runname) {
   int runid = ++run_counter;
-  Check C = {I, items, n};
+  Check C = {I, items, n, 0};
   /* Duplicate definitions within one script are mistakes. */
   for (int i = 0; i < n; i++) {
     if (items[i]->kind != ITEM_DEF) continue;
@@ -467,7 +480,7 @@ RunStatus interp_set_override(Interp *I, const char *name, const char *expr) {
     if (!ok) qcs_error(pos_none, "--set needs NAME=VALUE with a plain name, "
                        "not '%s'", name);
     Expr *e = parse_expression(I, src);
-    Check C = {I, NULL, 0};
+    Check C = {I, NULL, 0, 0};
     check_expr(&C, e, NULL);
     Sym *s = sym_intern(I, name, (int)strlen(name));
     if (s->con_arity >= 0)
@@ -549,7 +562,16 @@ Interp *interp_new(void) {
   char probe;
   I->stack_base = &probe;
   I->stack_limit = I->stack_reserved = 6u << 20;
-  I->max_memory = (size_t)8 << 30; /* 8 GB of values unless told otherwise */
+  /* 8 GB of values unless told otherwise, or half the machine's memory
+     when it has less than 16 GB (the limit must come before the
+     system's out-of-memory killer). */
+  I->max_memory = (size_t)8 << 30;
+  long pages = sysconf(_SC_PHYS_PAGES), pagesize = sysconf(_SC_PAGESIZE);
+  if (pages > 0 && pagesize > 0 &&
+      (unsigned long long)pages * (unsigned long long)pagesize / 2 <
+          I->max_memory)
+    I->max_memory = (size_t)((unsigned long long)pages *
+                             (unsigned long long)pagesize / 2 >> 20 << 20);
   I->max_steps = QCS_DEFAULT_MAX_STEPS;
   I->max_list = QCS_DEFAULT_MAX_LIST;
   I->max_pixels = QCS_DEFAULT_MAX_PIXELS;

@@ -18,16 +18,26 @@ typedef struct Parser {
   Token *open_tok[LAYOUT_MAX]; /* the innermost open brackets */
   int sep_used;  /* index of the token whose virtual separator was used */
   RunMode mode;
+  int depth, max_depth; /* nesting of operand/binary calls (see below) */
 } Parser;
 
 static Expr *expr(Parser *P);
 static Expr *app(Parser *P);
 
-/* Deep nesting ((((... a million brackets) is stopped by the max-stack
-   limit, as deep recursion in evaluation is. */
+/* Deep nesting ((((... a million brackets, - - - ... 1, a : b : ...) is
+   stopped under the max-stack limit, as deep recursion in evaluation is:
+   by a count of nested operand and binary calls (a bracket is two), one
+   per KB of the limit, so that where it stops does not depend on how
+   large the compiler made the frames; and by the stack itself. */
 #define NESTING_CHECK(P)                                                       \
   eval_stack_check((P)->I, (P)->toks[(P)->i].pos,                              \
                    "expression nested too deeply: parsing it needs")
+static void nesting_enter(Parser *P) {
+  if (++P->depth > P->max_depth)
+    eval_limit_error(P->I, P->toks[P->i].pos, "max-stack",
+                     "expression nested too deeply to parse");
+  NESTING_CHECK(P);
+}
 static Def *binding(Parser *P, int toplevel, int *is_expr, Expr **ex);
 
 /* ---- tokens and layout ---- */
@@ -755,9 +765,15 @@ static void case_alts(Parser *P, Vec *alts, Pos casepos) {
 /* prefix -> '\' pats '->' expr | 'let' bindings 'in' expr
            | 'case' expr 'of' alts
            | 'if' expr 'then' expr 'else' expr | '-' operand | app */
+static Expr *operand_body(Parser *P, int minprec);
 static Expr *operand(Parser *P, int minprec) {
+  nesting_enter(P);
+  Expr *e = operand_body(P, minprec);
+  P->depth--;
+  return e;
+}
+static Expr *operand_body(Parser *P, int minprec) {
   Pos pos = pos_here(P);
-  NESTING_CHECK(P);
   switch (peek(P)) {
   case T_LAMBDA: {
     next(P);
@@ -841,7 +857,14 @@ static Expr *operand(Parser *P, int minprec) {
 }
 
 /* Precedence climbing over the binary operators. */
+static Expr *binary_body(Parser *P, int minprec);
 static Expr *binary(Parser *P, int minprec) {
+  nesting_enter(P);
+  Expr *e = binary_body(P, minprec);
+  P->depth--;
+  return e;
+}
+static Expr *binary_body(Parser *P, int minprec) {
   Expr *lhs = operand(P, minprec);
   for (;;) {
     TokKind op = peek(P);
@@ -1152,6 +1175,8 @@ static void parser_init(Parser *P, Interp *I, const Src *src, RunMode mode) {
   P->src = src;
   P->mode = mode;
   P->sep_used = -1;
+  P->max_depth = (int)(I->stack_limit >> 10 < 1000000000 ? I->stack_limit >> 10
+                                                         : 1000000000);
   P->toks = lex_all(src, &P->ntoks);
 }
 

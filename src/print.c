@@ -1,4 +1,5 @@
 /* print.c: printing values. See print.h. */
+#define _GNU_SOURCE /* fopencookie */
 #include "print.h"
 
 #include <gc.h>
@@ -116,8 +117,50 @@ static void print_fn(FILE *out, Value *v) {
   }
 }
 
+/* show's stream writes into a buffer in the values' heap, counted
+   against max-memory: an error while showing leaves nothing to free but
+   the small FILE. */
+typedef struct ShowBuf {
+  FILE *f;
+  char *buf;
+  size_t len, cap, max;
+  int over;  /* a write would have passed max */
+} ShowBuf;
+static _Thread_local ShowBuf *cur_show;
+
+static ssize_t show_write(void *cookie, const char *data, size_t n) {
+  ShowBuf *b = cookie;
+  if (b->max && b->len + n + 1 > b->max) {
+    b->over = 1;
+    return 0;
+  }
+  if (b->len + n + 1 > b->cap) {
+    size_t cap = b->cap * 2;
+    while (cap < b->len + n + 1) cap *= 2;
+    char *nb = GC_MALLOC_ATOMIC(cap);
+    if (!nb) {
+      b->over = 1;
+      return 0;
+    }
+    memcpy(nb, b->buf, b->len);
+    b->buf = nb;
+    b->cap = cap;
+  }
+  memcpy(b->buf + b->len, data, n);
+  b->len += n;
+  return (ssize_t)n;
+}
+
+static _Noreturn void show_too_big(Interp *I) {
+  char sz[32];
+  interp_format_size(sz, sizeof sz, I->max_memory);
+  eval_limit_error(I, pos_none, "max-memory", "show: the text would use more "
+                   "than %s of memory", sz);
+}
+
 static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
   eval_check(I, pos_none);
+  if (cur_show && out == cur_show->f && cur_show->over) show_too_big(I);
   v = force(I, v);
   char buf[32];
   if (parens && needs_parens(v)) {
@@ -218,19 +261,22 @@ void print_value(Interp *I, FILE *out, Value *v) {
 }
 
 const char *show_value(Interp *I, Value *v) {
-  char *buf = NULL;
-  size_t len = 0;
-  FILE *f = open_memstream(&buf, &len);
-  if (!f) return "";
-  /* An error while printing must not leak the stream: print to it inside
-     the caller's handler is fine, since the buffer is freed below only on
-     success; a failed show leaks one small buffer at most. */
-  print_value(I, f, v);
-  fclose(f);
-  char *s = GC_MALLOC_ATOMIC(len + 1);
-  memcpy(s, buf, len + 1);
-  free(buf);
-  return s;
+  ShowBuf *b = GC_MALLOC(sizeof *b);
+  b->cap = 64;
+  b->buf = GC_MALLOC_ATOMIC(b->cap);
+  b->max = I->max_memory;
+  cookie_io_functions_t io = {NULL, show_write, NULL, NULL};
+  b->f = fopencookie(b, "w", io);
+  if (!b->f) qcs_error(pos_none, "show: cannot open a stream");
+  ShowBuf *outer = cur_show; /* show inside show */
+  cur_show = b;
+  print_value(I, b->f, v);
+  int bad = fflush(b->f) != 0 || b->over;
+  fclose(b->f);
+  cur_show = outer;
+  if (bad) show_too_big(I);
+  b->buf[b->len] = 0;
+  return b->buf;
 }
 
 void print_brief(FILE *out, Value *v, int depth) {
