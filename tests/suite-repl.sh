@@ -10,7 +10,8 @@ case $QCS in /*) ;; *) QCS=$PWD/$QCS ;; esac
 TMUX_CHECKS="repl-prompt repl-expression repl-definition repl-error-keeps-defs
 repl-continuation repl-paste repl-ctrl-c-eval repl-ctrl-c-prompt repl-tab-name
 repl-tab-command repl-tab-file repl-browse repl-unknown-command repl-history-live
-repl-ctrl-d repl-history-file"
+repl-set-list repl-set-bad repl-limit-steps-keeps-defs repl-limit-stack-keeps-defs
+repl-limit-list-keeps-defs repl-history-after-error repl-ctrl-d repl-history-file"
 
 if [ ! -x "$QCS" ]; then
   echo "FAIL repl: no binary at $QCS"
@@ -178,11 +179,37 @@ else fail repl-unknown-command "$(why 'no did-you-mean for :laod')"; fi
 if grep -qx 'f x = x \* 2' "$home/.qcs_history" 2>/dev/null; then ok repl-history-live
 else fail repl-history-live "~/.qcs_history lacks 'f x = x * 2' during the session"; fi
 
+# Limits: :set lists them, changes one, refuses a bad one; a limit hit
+# stops the entry with an error naming it, and every definition stays.
+if enter '^max-steps +10000000000 ' ':set' && [ "$(count '^max-(stack|steps|list|memory|pixels|spp) ')" -ge 6 ]; then
+  ok repl-set-list
+else fail repl-set-list "$(why ':set did not list the six limits')"; fi
+if enter "unknown limit 'max-stpes' \(did you mean max-steps\?\)" ':set max-stpes 5' &&
+   enter "max-steps needs a whole number" ':set max-steps lots'; then ok repl-set-bad
+else fail repl-set-bad "$(why 'no clear errors for a bad :set')"; fi
+enter '^qcs> :set max-steps 200000$' ':set max-steps 200000'
+if enter 'evaluation stopped after 200000 steps \(limit max-steps; raise it with :set max-steps N or --max-steps N\)' 'length [1..]' &&
+   enter '^12$' 'f 6'; then ok repl-limit-steps-keeps-defs
+else fail repl-limit-steps-keeps-defs "$(why 'no max-steps error for length [1..], or f lost after it')"; fi
+enter '^qcs> :set max-steps 0$' ':set max-steps 0'
+enter '^qcs> deep n = 1 \+ deep \(n \+ 1\)$' 'deep n = 1 + deep (n + 1)'
+if enter 'recursion too deep.*limit max-stack' 'deep 0' && enter '^16$' 'f 8' &&
+   enter '^qcs> deep' 'deep'; then ok repl-limit-stack-keeps-defs
+else fail repl-limit-stack-keeps-defs "$(why 'no max-stack error for deep 0, or definitions lost')"; fi
+enter '^qcs> :set max-list 1000$' ':set max-list 1000'
+if enter 'a list longer than 1000 elements \(limit max-list' 'sum [1..5000]' && enter '^18$' 'f 9' &&
+   enter '^500500$' 'sum [1..1000]'; then ok repl-limit-list-keeps-defs
+else fail repl-limit-list-keeps-defs "$(why 'no max-list error for sum [1..5000], or f lost')"; fi
+# Every line is in the history file as it is entered, failed ones too.
+if grep -qxF 'length [1..]' "$home/.qcs_history" 2>/dev/null &&
+   grep -qxF 'sum [1..5000]' "$home/.qcs_history" 2>/dev/null; then ok repl-history-after-error
+else fail repl-history-after-error "~/.qcs_history lacks lines that ended in errors"; fi
+
 if keys_then '^qcs-exit-status=0$' C-d; then ok repl-ctrl-d
 else fail repl-ctrl-d "$(why 'Ctrl-D did not leave with status 0')"; fi
 
 missing=""
-for want in '1 + 2' 'f x = x * 2' 'g x =' 'x + 1' 'myLongName = 7' 'f 21'; do
+for want in '1 + 2' 'f x = x * 2' 'g x =' 'x + 1' 'myLongName = 7' 'f 21' ':set max-steps 200000' 'deep 0'; do
   grep -qxF "$want" "$home/.qcs_history" 2>/dev/null || missing="$missing '$want'"
 done
 if [ -z "$missing" ]; then ok repl-history-file
