@@ -164,6 +164,8 @@ typedef struct {
   lg_stats *st;
   const lg_hook *hook;
   dt_instr *segbuf;
+  int first;          /* stop at the first crossing after first_after */
+  double first_after;
 } search;
 
 static double feval(search *s, const dt_tape *t, double x, double *df) {
@@ -181,6 +183,7 @@ static int emit(search *s, double t, int kind) {
   s->out[s->n].kind = kind;
   s->n++;
   if (kind == LG_TOUCH && s->st) s->st->touches++;
+  if (s->first && kind != LG_TOUCH && t > s->first_after) return 0;
   return s->n < s->maxout;
 }
 
@@ -397,14 +400,15 @@ static int support_hull(const dt_tape *t, const double o[3], const double d[3],
 /* Search the sorted, disjoint intervals iv[0..n) (pairs of doubles). */
 static int run(const dt_tape *t, const double o[3], const double d[3],
                const double *iv, int n, double tol, lg_root *out, int maxout,
-               lg_stats *stats, const lg_hook *hook) {
+               lg_stats *stats, const lg_hook *hook, int first,
+               double first_after) {
   dt_instr local[2 * LG_LOCAL_CODE], *buf = local;
   if (t->ncode > LG_LOCAL_CODE) {
     buf = malloc((size_t)t->ncode * 2 * sizeof *buf);
     if (!buf) return -1;
   }
   search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
-              buf + t->ncode};
+              buf + t->ncode, first, first_after};
   if (maxout > 0) {
     for (int i = 0; i < n; i++) {
       double a = iv[2 * i], b = iv[2 * i + 1];
@@ -423,13 +427,13 @@ int lg_roots(const dt_tape *t, const double o[3], const double d[3],
              double t0, double t1, double tol, lg_root *out, int maxout,
              lg_stats *stats) {
   double iv[2] = {t0, t1};
-  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL);
+  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL, 0, 0);
 }
 
-int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
-                   double t0, double t1, const csg_span *spans, int nspans,
-                   double tol, lg_root *out, int maxout, lg_stats *stats,
-                   const lg_hook *hook) {
+static int spans_run(const dt_tape *t, const double o[3], const double d[3],
+                     double t0, double t1, const csg_span *spans, int nspans,
+                     double tol, lg_root *out, int maxout, lg_stats *stats,
+                     const lg_hook *hook, int first) {
   double local[2 * 64] = {0}, *iv = local;
   if (nspans > 64) {
     iv = malloc((size_t)nspans * 2 * sizeof *iv);
@@ -449,17 +453,24 @@ int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
     iv[2 * n + 1] = b;
     n++;
   }
-  int r = run(t, o, d, iv, n, tol, out, maxout, stats, hook);
+  int r = run(t, o, d, iv, n, tol, out, maxout, stats, hook, first, t0);
   if (iv != local) free(iv);
   return r;
 }
 
+int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
+                   double t0, double t1, const csg_span *spans, int nspans,
+                   double tol, lg_root *out, int maxout, lg_stats *stats,
+                   const lg_hook *hook) {
+  return spans_run(t, o, d, t0, t1, spans, nspans, tol, out, maxout, stats,
+                   hook, 0);
+}
+
 /* Figure 7 (c): search where outer and not inner. */
-int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
-                     const csg_tape *inner, const double o[3],
-                     const double d[3], double t0, double t1, double tol,
-                     lg_root *out, int maxout, lg_stats *stats,
-                     const lg_hook *hook) {
+static int bounded(const dt_tape *t, const csg_tape *outer,
+                   const csg_tape *inner, const double o[3], const double d[3],
+                   double t0, double t1, double tol, lg_root *out, int maxout,
+                   lg_stats *stats, const lg_hook *hook, int first) {
   int no = outer->nleaves + 1, ni = inner ? inner->nleaves + 1 : 0;
   int nsc = csg_scratch_spans(outer);
   if (inner && csg_scratch_spans(inner) > nsc) nsc = csg_scratch_spans(inner);
@@ -475,9 +486,27 @@ int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
     int m = inner ? csg_ray_spans(inner, o, d, t0, t1, is, ni, sc, nsc) : 0;
     if (m >= 0) {
       int k = csg_spans_diff(os, n, is, m, ds);
-      r = lg_roots_spans(t, o, d, t0, t1, ds, k, tol, out, maxout, stats, hook);
+      r = spans_run(t, o, d, t0, t1, ds, k, tol, out, maxout, stats, hook,
+                    first);
     }
   }
   if (mem != local) free(mem);
   return r;
+}
+
+int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
+                     const csg_tape *inner, const double o[3],
+                     const double d[3], double t0, double t1, double tol,
+                     lg_root *out, int maxout, lg_stats *stats,
+                     const lg_hook *hook) {
+  return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, hook,
+                 0);
+}
+
+int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
+                     const csg_tape *inner, const double o[3],
+                     const double d[3], double t0, double t1, double tol,
+                     lg_root *out, int maxout, lg_stats *stats) {
+  return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, NULL,
+                 1);
 }

@@ -141,4 +141,15 @@ int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
                      lg_root *out, int maxout, lg_stats *stats,
                      const lg_hook *hook);
 
+/* As lg_roots_bounded, but the search stops as soon as it reports a
+ * crossing (LG_ENTER or LG_EXIT, not a touch) after t0: that crossing is
+ * the first one in (t0, t1] and the last root returned.  The roots before
+ * it (touches, crossings at t0) are those lg_roots_bounded returns, so the
+ * first crossing is the same; only the search after it is skipped (a
+ * primary ray needs the nearest hit, a shadow ray any). */
+int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
+                     const csg_tape *inner, const double o[3],
+                     const double d[3], double t0, double t1, double tol,
+                     lg_root *out, int maxout, lg_stats *stats);
+
 #endif

@@ -423,8 +423,8 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
     double len = sqrt(dot3(d, d));
     double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
     double tol = fmax(c->tol, 4e-16 * scale) / len;
-    int nr = lg_roots_bounded(n->tape, n->outer, n->inner, o, d, t0, t1, tol,
-                              roots, 8, &c->stats.lg, NULL);
+    int nr = lg_first_bounded(n->tape, n->outer, n->inner, o, d, t0, t1, tol,
+                              roots, 8, &c->stats.lg);
     int k = 0;
     while (k < nr && (roots[k].kind == LG_TOUCH || !(roots[k].t > t0))) k++;
     if (k >= nr) return 0;
