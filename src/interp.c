@@ -83,7 +83,7 @@ typedef struct Check {
   Interp *I;
   Item **items;
   int nitems;
-  int depth;  /* of check_expr calls: one per KB of max-stack at most */
+  int depth;  /* of check_expr calls: one per 8 KB of max-stack at most */
 } Check;
 
 static void scope_add(Scope *s, Sym *name) {
@@ -191,7 +191,7 @@ static void check_defs(Check *C, int n, Def **defs, Scope *sc) {
    million '+' would otherwise recurse a million deep in eval. */
 static void check_expr_body(Check *C, Expr *e, Scope *sc);
 static void check_expr(Check *C, Expr *e, Scope *sc) {
-  if ((size_t)++C->depth > C->I->stack_limit >> 10)
+  if ((size_t)++C->depth > C->I->stack_limit >> 13)
     eval_limit_error(C->I, e->pos, "max-stack",
                      "expression nested too deeply to evaluate");
   eval_stack_check(C->I, e->pos,

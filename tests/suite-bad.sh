@@ -36,8 +36,15 @@ run() {
   st=$?
 }
 
-# judge NAME WANTFILE: the status is 1 and stderr is WANTFILE exactly
+# judge NAME WANTFILE: the status is 1 and stderr is WANTFILE exactly.
+# AddressSanitizer's note on a longjmp out of a deep stack (the recursion
+# and nesting limits do that) is not the program's output: it is dropped.
 judge() {
+  grep -a -v -e '^==[0-9]*==WARNING: ASan is ignoring requested __asan_handle_no_return' \
+    -e '^False positive error reports may follow$' \
+    -e '^For details see https://github.com/google/sanitizers/issues/189$' \
+    "$tmp/err" >"$tmp/err.san"
+  mv "$tmp/err.san" "$tmp/err"
   if [ "$st" -eq 124 ] && [ -n "$lim" ]; then
     fail "$1" "did not finish in 300 s"
   elif [ "$st" -gt 128 ]; then
@@ -91,12 +98,12 @@ window() {
 }
 
 # A million '(' closed, and unclosed: the parser stops at its nesting
-# limit (131072 brackets with the default max-stack), not the C stack.
+# limit (16384 brackets with the default max-stack), not the C stack.
 awk 'BEGIN { printf "x = "; for (i = 0; i < 1000000; i++) printf "("; printf "1";
              for (i = 0; i < 1000000; i++) printf ")"; print "" }' >"$g/parens.qcs"
 run parens "$g" parens.qcs
-want 'parens.qcs:1:131077: error: expression nested too deeply to parse %s\n' "$MAXSTACK"
-window "$g/parens.qcs" 131077 >>"$g/want"
+want 'parens.qcs:1:16389: error: expression nested too deeply to parse %s\n' "$MAXSTACK"
+window "$g/parens.qcs" 16389 >>"$g/want"
 judge gen/million-parens "$g/want"
 
 awk 'BEGIN { printf "x = "; for (i = 0; i < 1000000; i++) printf "("; print "" }' >"$g/open.qcs"
@@ -108,15 +115,15 @@ judge gen/million-open-parens "$g/want2"
 # tree: the checker stops it before evaluation could overflow.
 awk 'BEGIN { printf "x = 1"; for (i = 0; i < 1000000; i++) printf " + 1"; print ""; print "x" }' >"$g/chain.qcs"
 run chain "$g" chain.qcs
-want 'chain.qcs:1:2951427: error: expression nested too deeply to evaluate %s\n' "$MAXSTACK"
-window "$g/chain.qcs" 2951427 >>"$g/want"
+want 'chain.qcs:1:3868931: error: expression nested too deeply to evaluate %s\n' "$MAXSTACK"
+window "$g/chain.qcs" 3868931 >>"$g/want"
 judge gen/million-operators "$g/want"
 
 # A million nested lets: let x = 1 in let x = 1 in ... x
 awk 'BEGIN { printf "y = "; for (i = 0; i < 1000000; i++) printf "let x = 1 in "; print "x"; print "y" }' >"$g/lets.qcs"
 run lets "$g" lets.qcs
-want 'lets.qcs:1:1703932: error: expression nested too deeply to parse %s\n' "$MAXSTACK"
-window "$g/lets.qcs" 1703932 >>"$g/want"
+want 'lets.qcs:1:212988: error: expression nested too deeply to parse %s\n' "$MAXSTACK"
+window "$g/lets.qcs" 212988 >>"$g/want"
 judge gen/million-lets "$g/want"
 
 # A NUL byte, and bytes that are not UTF-8.
