@@ -31,6 +31,9 @@ void csg_tape_free(csg_tape *t) {
   if (!t) return;
   free(t->code);
   free(t->planes);
+  free(t->rcode);
+  free(t->gstart);
+  free(t->gplane);
   free(t);
 }
 
@@ -202,6 +205,64 @@ static int reorder(const csg_instr *in, int n, csg_instr *out, int *depth) {
   return CSG_OK;
 }
 
+/* The ray program of t (csg.h): maximal subtrees of intersected planes
+ * (more than one plane) become CSG_CONVEX groups.  A subtree is the
+ * contiguous stretch of postfix code that ends at its root, so a group's
+ * planes are the CSG_PLANE instructions of that stretch. */
+static int ray_program(csg_tape *t) {
+  int n = t->ncode;
+  int *gend = malloc(((size_t)n + 1) * sizeof(int));
+  t->rcode = malloc(((size_t)n + 1) * sizeof *t->rcode);
+  t->gstart = malloc(((size_t)n + 1) * sizeof(int));
+  t->gplane = malloc(((size_t)n + 1) * sizeof(int));
+  if (!gend || !t->rcode || !t->gstart || !t->gplane) {
+    free(gend);
+    return CSG_ENOMEM;
+  }
+  /* Per operand on the stack: where its code starts, whether it is pure
+   * (planes and intersections only) and where it ends. */
+  int sst[CSG_STACK_MAX + 1], spure[CSG_STACK_MAX + 1], send[CSG_STACK_MAX + 1];
+  int sp = 0;
+  for (int i = 0; i < n; i++) gend[i] = -1;
+  for (int i = 0; i < n; i++) {
+    int op = t->code[i].op;
+    if (op <= CSG_ALL) {
+      sst[sp] = send[sp] = i;
+      spure[sp++] = op == CSG_PLANE;
+      continue;
+    }
+    sp--;
+    int x = sp - 1, y = sp;
+    int p = op == CSG_INTER && spure[x] && spure[y];
+    if (!p) {   /* pure operands of an impure op are maximal */
+      if (spure[x]) gend[sst[x]] = send[x];
+      if (spure[y]) gend[sst[y]] = send[y];
+    }
+    spure[x] = p;
+    send[x] = i;
+  }
+  if (n > 0 && spure[0]) gend[sst[0]] = send[0];
+  int nr = 0, ng = 0, np = 0;
+  for (int i = 0; i < n;) {
+    int e = gend[i];
+    if (e > i) {
+      t->gstart[ng] = np;
+      for (int k = i; k <= e; k++)
+        if (t->code[k].op == CSG_PLANE) t->gplane[np++] = t->code[k].arg;
+      csg_instr in = {CSG_CONVEX, ng++};
+      t->rcode[nr++] = in;
+      i = e + 1;
+    } else {
+      t->rcode[nr++] = t->code[i++];
+    }
+  }
+  t->gstart[ng] = np;
+  t->nrcode = nr;
+  t->ngroups = ng;
+  free(gend);
+  return CSG_OK;
+}
+
 csg_tape *csg_builder_finish(csg_builder *b, int *err) {
   int e = b->err;
   if (!e && b->nstack != 1) e = CSG_EUNBALANCED;
@@ -223,6 +284,7 @@ csg_tape *csg_builder_finish(csg_builder *b, int *err) {
       for (int i = 0; i < t->ncode; i++)
         if (t->code[i].op <= CSG_ALL) t->nleaves++;
       if (t->depth > CSG_STACK_MAX) e = CSG_EOP;
+      else e = ray_program(t);
     }
     if (e) { csg_tape_free(t); t = NULL; }
   }
@@ -360,6 +422,43 @@ static int plane_span(const csg_plane *p, int id, const double o[3],
   return 1;
 }
 
+/* The span (or none) of the intersection of group g's planes: the planes'
+ * spans clipped one after another, which is what csg_spans_inter makes of
+ * them in any tree shape (the larger start and the smaller end win, the
+ * earlier operand on ties), without the merges. */
+static int convex_span(const csg_tape *t, int g, const double o[3],
+                       const double d[3], double s0, double s1,
+                       csg_span *out) {
+  double t0 = s0, t1 = s1;
+  int id0 = -1, id1 = -1;
+  for (int k = t->gstart[g]; k < t->gstart[g + 1]; k++) {
+    int id = t->gplane[k];
+    const csg_plane *p = &t->planes[id];
+    double base = p->n[0] * o[0] + p->n[1] * o[1] + p->n[2] * o[2] - p->d;
+    double kd = p->n[0] * d[0] + p->n[1] * d[1] + p->n[2] * d[2];
+    /* The plane's own span [a, b] within [s0, s1], as plane_span has it. */
+    double a = s0, b = s1;
+    if (kd == 0) {
+      if (!(base < 0)) return 0;
+      continue;
+    }
+    double ts = -base / kd;
+    if (kd > 0) {
+      if (ts < s1) b = ts;
+      if (!(a < b)) return 0;
+      if (b < t1) { t1 = b; id1 = id; }
+    } else {
+      if (ts > s0) a = ts;
+      if (!(a < b)) return 0;
+      if (a > t0) { t0 = a; id0 = id; }
+    }
+  }
+  if (!(t0 < t1)) return 0;
+  csg_span sp = {t0, t1, id0, id1, 0, 0};
+  *out = sp;
+  return 1;
+}
+
 /* Roth's ray casting: one span per halfspace, combined bottom-up with the
  * span-list set operations. */
 int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
@@ -376,11 +475,13 @@ int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
    * through the second half and are copied back. */
   csg_span *tmp = scratch + t->nleaves + 1;
   int off[CSG_STACK_MAX], cnt[CSG_STACK_MAX], sp = 0, top = 0;
-  for (int i = 0; i < t->ncode; i++) {
-    const csg_instr *in = &t->code[i];
-    if (in->op <= CSG_ALL) {
+  for (int i = 0; i < t->nrcode; i++) {
+    const csg_instr *in = &t->rcode[i];
+    if (in->op <= CSG_ALL || in->op == CSG_CONVEX) {
       int c = 0;
-      if (in->op == CSG_PLANE)
+      if (in->op == CSG_CONVEX)
+        c = convex_span(t, in->arg, o, d, s0, s1, &scratch[top]);
+      else if (in->op == CSG_PLANE)
         c = plane_span(&t->planes[in->arg], in->arg, o, d, s0, s1,
                        &scratch[top]);
       else if (in->op == CSG_ALL && s0 < s1) {

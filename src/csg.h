@@ -26,7 +26,8 @@ typedef enum {
   CSG_UNION,
   CSG_INTER,
   CSG_DIFF,    /* x y -> x - y (y on top of the stack) */
-  CSG_RDIFF    /* x y -> y - x (made by the reordering) */
+  CSG_RDIFF,   /* x y -> y - x (made by the reordering) */
+  CSG_CONVEX   /* only in a tape's ray program: groups[arg] */
 } csg_op;
 
 enum { CSG_OK = 0, CSG_EPLANE, CSG_EOP, CSG_EUNBALANCED, CSG_ENOMEM };
@@ -41,6 +42,16 @@ typedef struct csg_tape {
   csg_plane *planes;
   int depth;     /* stack slots needed */
   int nleaves;   /* planes and constants in the code */
+  /* The ray program, made by csg_builder_finish for csg_ray_spans: code
+   * with every subtree that only intersects planes (a convex polyhedron,
+   * the usual piece of a bound) replaced by one CSG_CONVEX instruction,
+   * whose span is clipped plane by plane without span-list merges.
+   * Group g holds the planes gplane[gstart[g] .. gstart[g + 1]), in code
+   * order. */
+  int nrcode;
+  csg_instr *rcode;
+  int ngroups;
+  int *gstart, *gplane;
 } csg_tape;
 
 /* One inside interval of a ray, t0 < t1.  id0/id1 name the plane whose
