@@ -305,10 +305,32 @@ double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
       g[sp][0] = g[sp][1] = g[sp][2] = 0;
       sp++;
     } else {
+      /* apply_d with the op decided once for the three components */
       sp--;
-      double out[3];
-      v[sp - 1] = apply_d(in->op, v[sp - 1], g[sp - 1], v[sp], g[sp], out, 3);
-      memcpy(g[sp - 1], out, sizeof out);
+      double x = v[sp - 1], y = v[sp], *gx = g[sp - 1];
+      const double *gy = g[sp];
+      switch (in->op) {
+      case DT_SUM:
+        for (int j = 0; j < 3; j++) gx[j] = gx[j] + gy[j];
+        v[sp - 1] = x + y;
+        break;
+      case DT_PRODUCT:
+        for (int j = 0; j < 3; j++) gx[j] = gx[j] * y + x * gy[j];
+        v[sp - 1] = x * y;
+        break;
+      case DT_DIFF:
+        for (int j = 0; j < 3; j++) gx[j] = gx[j] - gy[j];
+        v[sp - 1] = x - y;
+        break;
+      case DT_RDIFF:
+        for (int j = 0; j < 3; j++) gx[j] = gy[j] - gx[j];
+        v[sp - 1] = y - x;
+        break;
+      default:
+        for (int j = 0; j < 3; j++) gx[j] = gx[j] * (1 - y) + gy[j] * (1 - x);
+        v[sp - 1] = x + y - x * y;
+        break;
+      }
     }
   }
   memcpy(grad, g[0], sizeof g[0]);
@@ -341,6 +363,54 @@ double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
       v[sp - 1] = apply_d(in->op, v[sp - 1], &dv[sp - 1], v[sp], &dv[sp],
                           &out, 1);
       dv[sp - 1] = out;
+    }
+  }
+  if (drho_ds) *drho_ds = dv[0];
+  return v[0];
+}
+
+void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],
+                   dt_ray_leaf *rl) {
+  for (int i = 0; i < t->nleaves; i++) {
+    const dt_leaf *lf = &t->leaves[i];
+    rl[i].base = leaf_dist(lf, o);
+    rl[i].nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+  }
+}
+
+/* dt_density_ray with the leaves' distances from the ray's table: the same
+ * operations in the same order, so the same result to the last bit. */
+double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
+                     double *drho_ds) {
+  double v[DT_STACK_MAX], dv[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double nd = rl[in->arg].nd;
+      double dist = rl[in->arg].base + s * nd, dda = 0;
+      if (lf->r > 0) v[sp] = leaf_va(dist * lf->inv_r, &dda);
+      else v[sp] = dt_halfspace(dist, 0);
+      dv[sp] = dda * nd * lf->inv_r;
+      sp++;
+    } else if (in->op == DT_CONST) {
+      v[sp] = in->c;
+      dv[sp] = 0;
+      sp++;
+    } else {
+      sp--;
+      double x = v[sp - 1], y = v[sp], dx = dv[sp - 1], dy = dv[sp];
+      switch (in->op) {
+      case DT_SUM: dv[sp - 1] = dx + dy; v[sp - 1] = x + y; break;
+      case DT_PRODUCT: dv[sp - 1] = dx * y + x * dy; v[sp - 1] = x * y; break;
+      case DT_DIFF: dv[sp - 1] = dx - dy; v[sp - 1] = x - y; break;
+      case DT_RDIFF: dv[sp - 1] = dy - dx; v[sp - 1] = y - x; break;
+      default:
+        dv[sp - 1] = dx * (1 - y) + dy * (1 - x);
+        v[sp - 1] = x + y - x * y;
+        break;
+      }
     }
   }
   if (drho_ds) *drho_ds = dv[0];
@@ -389,10 +459,8 @@ double dt_displacement(double r, double level) {
 }
 
 /* A leaf's value if it is constant over the ray segment, else -1. */
-static double leaf_const(const dt_leaf *lf, const double o[3],
-                         const double d[3], double s0, double s1) {
-  double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
-  double base = leaf_dist(lf, o);
+static double leaf_const(const dt_leaf *lf, double base, double nd,
+                         double s0, double s1) {
   double a = nd == 0 ? base : base + s0 * nd;
   double b = nd == 0 ? base : base + s1 * nd;
   double lo = a < b ? a : b, hi = a < b ? b : a;
@@ -409,15 +477,25 @@ static double leaf_const(const dt_leaf *lf, const double o[3],
 /* Per-segment pruning (Section 3.4.1: a leaf contributes nothing to L and
  * G where the segment misses its filter).  Constants are kept lazily on
  * the fold stack and only emitted when combined with live code. */
-int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
-                 double s0, double s1, dt_instr *buf, dt_tape *view) {
+static int prune(const dt_tape *t, const double o[3], const double d[3],
+                 const dt_ray_leaf *rl, double s0, double s1, dt_instr *buf,
+                 dt_tape *view) {
   struct { int isc; double c; int start; } st[DT_STACK_MAX];
   int sp = 0, n = 0;
   for (int i = 0; i < t->ncode; i++) {
     const dt_instr *in = &t->code[i];
     if (in->op == DT_LEAF || in->op == DT_CONST) {
-      double c = in->op == DT_CONST
-                     ? in->c : leaf_const(&t->leaves[in->arg], o, d, s0, s1);
+      double c;
+      if (in->op == DT_CONST) {
+        c = in->c;
+      } else if (rl) {
+        c = leaf_const(&t->leaves[in->arg], rl[in->arg].base, rl[in->arg].nd,
+                       s0, s1);
+      } else {
+        const dt_leaf *lf = &t->leaves[in->arg];
+        double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+        c = leaf_const(lf, leaf_dist(lf, o), nd, s0, s1);
+      }
       if (in->op == DT_CONST || c >= 0) {
         st[sp].isc = 1;
         st[sp].c = c;
@@ -485,6 +563,17 @@ int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
   *view = *t;
   view->code = buf;
   view->ncode = n;
+  return n;
+}
+
+int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
+                 double s0, double s1, dt_instr *buf, dt_tape *view) {
+  int n = prune(t, o, d, NULL, s0, s1, buf, view);
   tape_range(view);
   return n;
+}
+
+int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
+                dt_instr *buf, dt_tape *view) {
+  return prune(t, NULL, NULL, rl, s0, s1, buf, view);
 }

@@ -109,4 +109,22 @@ double dt_max(const dt_tape *t);
 int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
                  double s0, double s1, dt_instr *buf, dt_tape *view);
 
+/* One ray o + s*d seen from each leaf: base = n.o - d (the signed distance
+ * at s = 0) and nd = n.d, computed once per ray instead of at every
+ * evaluation.  The _rl functions take t's table (t->nleaves entries,
+ * indexed like t->leaves, so a view's table is its parent's) and give the
+ * results of their o, d counterparts to the last bit. */
+typedef struct dt_ray_leaf {
+  double base, nd;
+} dt_ray_leaf;
+
+void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],
+                   dt_ray_leaf *rl);
+double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
+                     double *drho_ds);
+/* As dt_prune_ray, but the view keeps t's density range lo, hi (it still
+ * bounds the view's) instead of recomputing it; t may itself be a view. */
+int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
+                dt_instr *buf, dt_tape *view);
+
 #endif

@@ -16,16 +16,19 @@ static double mulnn(double x, double y) {
   return x == 0 || y == 0 ? 0 : x * y;
 }
 
+/* max and min of two numbers that are never NaN (fmax and fmin are calls
+ * into libm). */
+static double max2(double x, double y) { return x > y ? x : y; }
+static double min2(double x, double y) { return x < y ? x : y; }
+
 static double maxabs(double lo, double hi) {
   return fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi);
 }
 
 /* eq. (2) and its alpha-derivatives over the segment for one leaf. */
-static void leaf_bounds(const dt_leaf *lf, const double o[3], const double d[3],
-                        double a, double b, double *lo, double *hi, double *L,
+static void leaf_bounds(const dt_leaf *lf, double base, double nd, double a,
+                        double b, double *lo, double *hi, double *L,
                         double *G, double *split) {
-  double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
-  double base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
   double sa = nd == 0 ? base : base + a * nd;
   double sb = nd == 0 ? base : base + b * nd;
   double smin = sa < sb ? sa : sb, smax = sa < sb ? sb : sa;
@@ -51,24 +54,35 @@ static void leaf_bounds(const dt_leaf *lf, const double o[3], const double d[3],
   if (amax > 1) amax = 1;
   *lo = dt_halfspace(amax, 1);
   *hi = dt_halfspace(amin, 1);
-  double near = amin <= 0 && amax >= 0 ? 0 : fmin(fabs(amin), fabs(amax));
-  double far = fmax(fabs(amin), fabs(amax));
+  double near = amin <= 0 && amax >= 0 ? 0 : min2(fabs(amin), fabs(amax));
+  double far = max2(fabs(amin), fabs(amax));
   double k = fabs(nd) * lf->inv_r;
   *L = 0.75 * (1 - near * near) * k;
   *G = 1.5 * far * k * k;
 }
 
-/* Section 3.4.1: LG values of a tape over [a, b]. */
-void lg_eval_bounds(const dt_tape *t, const double o[3], const double d[3],
-                    double a, double b, lg_bounds *out) {
+/* Section 3.4.1: LG values of a tape over [a, b], the leaves' distances
+ * from rl (dt_ray_leaf) or, without it, from o and d. */
+static void eval_bounds(const dt_tape *t, const dt_ray_leaf *ray,
+                        const double o[3], const double d[3], double a,
+                        double b, lg_bounds *out) {
   double lo[DT_STACK_MAX], hi[DT_STACK_MAX], L[DT_STACK_MAX], G[DT_STACK_MAX];
   int sp = 0;
   out->split = NAN;
   for (int i = 0; i < t->ncode; i++) {
     const dt_instr *in = &t->code[i];
     if (in->op == DT_LEAF) {
-      leaf_bounds(&t->leaves[in->arg], o, d, a, b, &lo[sp], &hi[sp], &L[sp],
-                  &G[sp], &out->split);
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double base, nd;
+      if (ray) {
+        base = ray[in->arg].base;
+        nd = ray[in->arg].nd;
+      } else {
+        nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+        base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
+      }
+      leaf_bounds(lf, base, nd, a, b, &lo[sp], &hi[sp], &L[sp], &G[sp],
+                  &out->split);
       sp++;
       continue;
     }
@@ -120,6 +134,11 @@ void lg_eval_bounds(const dt_tape *t, const double o[3], const double d[3],
   out->G = G[0] * LG_SAFE;
 }
 
+void lg_eval_bounds(const dt_tape *t, const double o[3], const double d[3],
+                    double a, double b, lg_bounds *out) {
+  eval_bounds(t, NULL, o, d, a, b, out);
+}
+
 /* x/y for bounds: 0/0 is 0 and x/0 is infinite. */
 static double sdiv(double x, double y) {
   if (y > 0) return x / y;
@@ -150,6 +169,10 @@ double lg_multiroot_length(double f0, double df0, double f1, double df1,
   return reach(f0, df0, L, G) + reach(f1, -df1, L, G);
 }
 
+#define LG_LOCAL_LEAVES 64
+#define LG_LEVEL_CODE 4096   /* instructions for the levels' views */
+#define LG_MAX_LEVELS 32
+
 typedef struct {
   double a, b, fa, dfa, fb, dfb;
   int depth;
@@ -163,14 +186,16 @@ typedef struct {
   int n, maxout;
   lg_stats *st;
   const lg_hook *hook;
-  dt_instr *segbuf;
+  const dt_ray_leaf *rl;  /* the leaves along this ray */
+  dt_instr *lvbuf;        /* nlv code buffers of ncode instructions, then */
+  int nlv, ncode;         /* one scratch buffer for deeper segments */
   int first;          /* stop at the first crossing after first_after */
   double first_after;
 } search;
 
 static double feval(search *s, const dt_tape *t, double x, double *df) {
   if (s->st) s->st->evals++;
-  return dt_density_ray(t, s->o, s->d, x, df) - 0.5;
+  return dt_density_rl(t, s->rl, x, df) - 0.5;
 }
 
 /* Returns 0 when out is full (the search stops). */
@@ -212,7 +237,7 @@ static double polish(search *s, const dt_tape *t, double a, double b,
   int pa = pos(fa);
   if (!pa && fa == 0) return a;    /* entering right after a zero at a */
   if (pa && fb == 0) return b;     /* leaving at a zero at b */
-  double rtol = fmax(s->tol, 4 * DBL_EPSILON * fmax(fabs(a), fabs(b)));
+  double rtol = max2(s->tol, 4 * DBL_EPSILON * max2(fabs(a), fabs(b)));
   double x, f, df;
   if (fabs(fa) < fabs(fb)) x = a, f = fa, df = dfa;
   else x = b, f = fb, df = dfb;
@@ -311,10 +336,16 @@ static void trace(search *s, const segment *sg, const lg_bounds *lb,
 }
 
 /* Figure 9 over [a, b] of the (span-pruned) tape t.  Returns 0 when the
- * output is full. */
+ * output is full.  A segment's tape is pruned from its parent's, not from
+ * t: the search is depth first, so when a segment of depth k is popped
+ * the views of levels below k are those of its ancestors (only the
+ * ancestors' other descendants, all deeper, ran since).  Levels from nlv
+ * on prune from the deepest stored one. */
 static int search_interval(search *s, const dt_tape *t, double a, double b) {
   segment stack[LG_STACK];
+  dt_tape lv[LG_MAX_LEVELS];
   int sp = 0;
+  lv[0] = *t;
   segment first = {a, b, 0, 0, 0, 0, 0};
   first.fa = feval(s, t, a, &first.dfa);
   first.fb = feval(s, t, b, &first.dfb);
@@ -323,9 +354,18 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     segment sg = stack[--sp];
     if (s->st) s->st->segments++;
     dt_tape view;
-    int nc = dt_prune_ray(t, s->o, s->d, sg.a, sg.b, s->segbuf, &view);
+    if (sg.depth == 0) {
+      view = *t;
+    } else {
+      int from = sg.depth - 1 < s->nlv - 1 ? sg.depth - 1 : s->nlv - 1;
+      int to = sg.depth < s->nlv ? sg.depth : s->nlv;
+      dt_prune_rl(&lv[from], s->rl, sg.a, sg.b,
+                  s->lvbuf + (size_t)to * s->ncode, &view);
+      if (to < s->nlv) lv[to] = view;
+    }
+    int nc = view.ncode;
     lg_bounds lb;
-    lg_eval_bounds(&view, s->o, s->d, sg.a, sg.b, &lb);
+    eval_bounds(&view, s->rl, s->o, s->d, sg.a, sg.b, &lb);
     double margin = 1e-12 * (1 + fabs(lb.lo) + fabs(lb.hi));
     if (lb.lo > 0.5 + margin || lb.hi < 0.5 - margin) {
       trace(s, &sg, &lb, INFINITY, LG_SEG_EXCLUDED, nc, 0);
@@ -338,7 +378,7 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     double len = sg.b - sg.a;
     double lhs = lg_multiroot_length(sg.fa, sg.dfa, sg.fb, sg.dfb, lb.L, lb.G);
     int shorty = lhs > len * LG_SAFE;
-    double minlen = fmax(s->tol, 16 * DBL_EPSILON * fmax(fabs(sg.a), fabs(sg.b)));
+    double minlen = max2(s->tol, 16 * DBL_EPSILON * max2(fabs(sg.a), fabs(sg.b)));
     double m = 0.5 * (sg.a + sg.b);
     if (!isnan(lb.split) && lb.split > sg.a + 0.25 * minlen &&
         lb.split < sg.b - 0.25 * minlen)
@@ -379,14 +419,14 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
 
 /* The part of [t0, t1] where some filter is touched: outside it every
  * leaf is constant, so the density is too. */
-static int support_hull(const dt_tape *t, const double o[3], const double d[3],
-                        double *t0, double *t1) {
+static int support_hull(const dt_tape *t, const dt_ray_leaf *rl, double *t0,
+                        double *t1) {
   double lo = INFINITY, hi = -INFINITY;
   for (int i = 0; i < t->nleaves; i++) {
     const dt_leaf *lf = &t->leaves[i];
-    double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+    double nd = rl[i].nd;
     if (nd == 0) continue;
-    double base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
+    double base = rl[i].base;
     double x = (-lf->r - base) / nd, y = (lf->r - base) / nd;
     if (x > y) { double tmp = x; x = y; y = tmp; }
     if (x < lo) lo = x;
@@ -402,23 +442,39 @@ static int run(const dt_tape *t, const double o[3], const double d[3],
                const double *iv, int n, double tol, lg_root *out, int maxout,
                lg_stats *stats, const lg_hook *hook, int first,
                double first_after) {
-  dt_instr local[2 * LG_LOCAL_CODE], *buf = local;
-  if (t->ncode > LG_LOCAL_CODE) {
-    buf = malloc((size_t)t->ncode * 2 * sizeof *buf);
+  if (n <= 0 || maxout <= 0) return 0;
+  dt_instr local[LG_LEVEL_CODE], *buf = local;
+  dt_ray_leaf lrl[LG_LOCAL_LEAVES], *rl = lrl;
+  int nc = t->ncode > 0 ? t->ncode : 1;
+  /* Buffers: the interval's view, nlv levels (the first is the interval's
+   * view itself), one scratch. */
+  int nlv = LG_LEVEL_CODE / nc - 2;
+  if (nlv > LG_MAX_LEVELS) nlv = LG_MAX_LEVELS;
+  if (nlv < 1) nlv = 1;
+  size_t need = (size_t)(nlv + 2) * (size_t)nc;
+  if (need > LG_LEVEL_CODE) {
+    buf = malloc(need * sizeof *buf);
     if (!buf) return -1;
   }
-  search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
-              buf + t->ncode, first, first_after};
-  if (maxout > 0) {
-    for (int i = 0; i < n; i++) {
-      double a = iv[2 * i], b = iv[2 * i + 1];
-      if (!support_hull(t, o, d, &a, &b)) continue;
-      dt_tape view;
-      dt_prune_ray(t, o, d, a, b, buf, &view);
-      if (!search_interval(&s, &view, a, b)) break;
+  if (t->nleaves > LG_LOCAL_LEAVES) {
+    rl = malloc((size_t)t->nleaves * sizeof *rl);
+    if (!rl) {
+      if (buf != local) free(buf);
+      return -1;
     }
   }
+  dt_ray_leaves(t, o, d, rl);
+  search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
+              rl, buf + nc, nlv, nc, first, first_after};
+  for (int i = 0; i < n; i++) {
+    double a = iv[2 * i], b = iv[2 * i + 1];
+    if (!support_hull(t, rl, &a, &b)) continue;
+    dt_tape view;
+    dt_prune_rl(t, rl, a, b, buf, &view);
+    if (!search_interval(&s, &view, a, b)) break;
+  }
   if (buf != local) free(buf);
+  if (rl != lrl) free(rl);
   return s.n;
 }
 
@@ -434,7 +490,7 @@ static int spans_run(const dt_tape *t, const double o[3], const double d[3],
                      double t0, double t1, const csg_span *spans, int nspans,
                      double tol, lg_root *out, int maxout, lg_stats *stats,
                      const lg_hook *hook, int first) {
-  double local[2 * 64] = {0}, *iv = local;
+  double local[2 * 64], *iv = local;
   if (nspans > 64) {
     iv = malloc((size_t)nspans * 2 * sizeof *iv);
     if (!iv) return -1;
@@ -443,7 +499,7 @@ static int spans_run(const dt_tape *t, const double o[3], const double d[3],
   for (int i = 0; i < nspans; i++) {
     double pad0 = tol + 8 * DBL_EPSILON * fabs(spans[i].t0);
     double pad1 = tol + 8 * DBL_EPSILON * fabs(spans[i].t1);
-    double a = fmax(spans[i].t0 - pad0, t0), b = fmin(spans[i].t1 + pad1, t1);
+    double a = max2(spans[i].t0 - pad0, t0), b = min2(spans[i].t1 + pad1, t1);
     if (!(a <= b)) continue;
     if (n > 0 && a <= iv[2 * n - 1]) {   /* merge widened neighbours */
       if (b > iv[2 * n - 1]) iv[2 * n - 1] = b;
@@ -482,7 +538,9 @@ static int bounded(const dt_tape *t, const csg_tape *outer,
   }
   csg_span *os = mem, *is = os + no, *ds = is + ni, *sc = ds + no + ni;
   int n = csg_ray_spans(outer, o, d, t0, t1, os, no, sc, nsc), r = -1;
-  if (n >= 0) {
+  if (n == 0) {   /* the ray misses the outer bound: no crossing */
+    r = 0;
+  } else if (n > 0) {
     int m = inner ? csg_ray_spans(inner, o, d, t0, t1, is, ni, sc, nsc) : 0;
     if (m >= 0) {
       int k = csg_spans_diff(os, n, is, m, ds);
