@@ -459,7 +459,7 @@ double dt_displacement(double r, double level) {
 }
 
 /* A leaf's value if it is constant over the ray segment, else -1. */
-static double leaf_const(const dt_leaf *lf, double base, double nd,
+static inline double leaf_const(const dt_leaf *lf, double base, double nd,
                          double s0, double s1) {
   double a = nd == 0 ? base : base + s0 * nd;
   double b = nd == 0 ? base : base + s1 * nd;
@@ -480,38 +480,48 @@ static double leaf_const(const dt_leaf *lf, double base, double nd,
 static int prune(const dt_tape *t, const double o[3], const double d[3],
                  const dt_ray_leaf *rl, double s0, double s1, dt_instr *buf,
                  dt_tape *view) {
-  struct { int isc; double c; int start; } st[DT_STACK_MAX];
+  /* Per operand on the fold stack: constant (isc, c) or live code
+   * starting at buf[start]. */
+  double cst[DT_STACK_MAX];
+  int start[DT_STACK_MAX];
+  unsigned char isc[DT_STACK_MAX];
   int sp = 0, n = 0;
-  for (int i = 0; i < t->ncode; i++) {
-    const dt_instr *in = &t->code[i];
-    if (in->op == DT_LEAF || in->op == DT_CONST) {
-      double c;
-      if (in->op == DT_CONST) {
-        c = in->c;
-      } else if (rl) {
-        c = leaf_const(&t->leaves[in->arg], rl[in->arg].base, rl[in->arg].nd,
-                       s0, s1);
+  const dt_instr *code = t->code;
+  for (int i = 0, nc = t->ncode; i < nc; i++) {
+    const dt_instr *in = &code[i];
+    int op = in->op;
+    if (op == DT_CONST) {
+      isc[sp] = 1;
+      cst[sp] = in->c;
+      start[sp++] = n;
+      continue;
+    }
+    if (op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double base, nd;
+      if (rl) {
+        base = rl[in->arg].base;
+        nd = rl[in->arg].nd;
       } else {
-        const dt_leaf *lf = &t->leaves[in->arg];
-        double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
-        c = leaf_const(lf, leaf_dist(lf, o), nd, s0, s1);
+        nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+        base = leaf_dist(lf, o);
       }
-      if (in->op == DT_CONST || c >= 0) {
-        st[sp].isc = 1;
-        st[sp].c = c;
-        st[sp].start = n;
+      double c = leaf_const(lf, base, nd, s0, s1);
+      start[sp] = n;
+      if (c >= 0) {
+        isc[sp] = 1;
+        cst[sp] = c;
       } else {
-        st[sp].isc = 0;
-        st[sp].start = n;
+        isc[sp] = 0;
         buf[n++] = *in;
       }
       sp++;
       continue;
     }
     sp--;
-    int xc = st[sp - 1].isc, yc = st[sp].isc, op = in->op;
+    int xc = isc[sp - 1], yc = isc[sp];
     if (xc && yc) {
-      st[sp - 1].c = apply(op, st[sp - 1].c, st[sp].c);
+      cst[sp - 1] = apply(op, cst[sp - 1], cst[sp]);
       continue;
     }
     if (!xc && !yc) {
@@ -519,8 +529,8 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
       continue;
     }
     /* Exactly one constant c; the live operand's code is buf[start..n). */
-    double c = xc ? st[sp - 1].c : st[sp].c;
-    int start = xc ? st[sp].start : st[sp - 1].start;
+    double c = xc ? cst[sp - 1] : cst[sp];
+    int st = xc ? start[sp] : start[sp - 1];
     int keep = 0, fold = 0;
     double fv = 0;
     switch (op) {
@@ -534,13 +544,13 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
     case DT_DIFF: keep = yc && c == 0; break;   /* x - 0 */
     case DT_RDIFF: keep = xc && c == 0; break;  /* y - 0 */
     }
-    st[sp - 1].start = start;
+    start[sp - 1] = st;
     if (fold) {
-      n = start;
-      st[sp - 1].isc = 1;
-      st[sp - 1].c = fv;
+      n = st;
+      isc[sp - 1] = 1;
+      cst[sp - 1] = fv;
     } else if (keep) {
-      st[sp - 1].isc = 0;
+      isc[sp - 1] = 0;
     } else {
       /* Emit the constant after the live code: the operands are now in
        * swapped order, so differences flip. */
@@ -552,11 +562,11 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
         else if (op == DT_RDIFF) oi.op = DT_DIFF;
       }
       buf[n++] = oi;
-      st[sp - 1].isc = 0;
+      isc[sp - 1] = 0;
     }
   }
-  if (st[0].isc) {
-    dt_instr ci = {DT_CONST, 0, st[0].c};
+  if (isc[0]) {
+    dt_instr ci = {DT_CONST, 0, cst[0]};
     n = 0;
     buf[n++] = ci;
   }
