@@ -54,7 +54,7 @@ static int replay(const char *path) {
     snprintf(names[nn++], len, "%s/%s", path, e->d_name);
   }
   closedir(d);
-  qsort(names, nn, sizeof *names, by_name);
+  if (nn) qsort(names, nn, sizeof *names, by_name);
   int rc = 0;
   for (size_t i = 0; i < nn; i++) {
     if (replay(names[i]) != 0) rc = -1;
