@@ -735,7 +735,7 @@ static int setup_camera(Tracer *T, char *err, size_t errlen) {
   cross3(T->fwd, rs->up, T->right);
   double rl = sqrt(dot3(T->right, T->right));
   if (!(rl > 1e-12)) {
-    snprintf(err, errlen, "the camera's up direction is parallel to its view");
+    snprintf(err, errlen, "the camera's up direction is zero or parallel to its view");
     return -1;
   }
   for (int i = 0; i < 3; i++) T->right[i] /= rl;
