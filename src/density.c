@@ -289,7 +289,11 @@ static double apply_d(int op, double x, const double *dx, double y,
 
 /* Section 2.4: gradient by the usual differentiation rules. */
 double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
+  /* z[k]: the gradient of stack entry k is zero (a leaf outside its
+   * filter, a constant, or ops on such), so the three components need no
+   * arithmetic: at a point on a surface most leaves are constant. */
   double v[DT_STACK_MAX], g[DT_STACK_MAX][3];
+  unsigned char z[DT_STACK_MAX];
   int sp = 0;
   for (int i = 0; i < t->ncode; i++) {
     const dt_instr *in = &t->code[i];
@@ -298,17 +302,28 @@ double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
       double s = leaf_dist(lf, p), dda = 0;
       if (lf->r > 0) v[sp] = leaf_va(s * lf->inv_r, &dda);
       else v[sp] = dt_halfspace(s, 0);
-      for (int j = 0; j < 3; j++) g[sp][j] = dda * lf->inv_r * lf->n[j];
+      z[sp] = dda == 0;
+      if (!z[sp])
+        for (int j = 0; j < 3; j++) g[sp][j] = dda * lf->inv_r * lf->n[j];
       sp++;
     } else if (in->op == DT_CONST) {
       v[sp] = in->c;
-      g[sp][0] = g[sp][1] = g[sp][2] = 0;
+      z[sp] = 1;
       sp++;
     } else {
       /* apply_d with the op decided once for the three components */
       sp--;
       double x = v[sp - 1], y = v[sp], *gx = g[sp - 1];
       const double *gy = g[sp];
+      int zx = z[sp - 1], zy = z[sp];
+      if (zx && zy) {
+        v[sp - 1] = apply(in->op, x, y);
+        continue;
+      }
+      if (zx) gx[0] = gx[1] = gx[2] = 0;
+      const double zero[3] = {0, 0, 0};
+      if (zy) gy = zero;
+      z[sp - 1] = 0;
       switch (in->op) {
       case DT_SUM:
         for (int j = 0; j < 3; j++) gx[j] = gx[j] + gy[j];
@@ -333,7 +348,8 @@ double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
       }
     }
   }
-  memcpy(grad, g[0], sizeof g[0]);
+  if (z[0]) grad[0] = grad[1] = grad[2] = 0;
+  else memcpy(grad, g[0], sizeof g[0]);
   return v[0];
 }
 
