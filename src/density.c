@@ -30,6 +30,11 @@ void dt_tape_free(dt_tape *t) {
   if (!t) return;
   free(t->code);
   free(t->leaves);
+  free(t->pcode);
+  free(t->groups);
+  free(t->gleaf);
+  free(t->gsnip);
+  free(t->gcode);
   free(t);
 }
 
@@ -184,6 +189,8 @@ static void tape_range(dt_tape *t) {
   t->hi = hi[0];
 }
 
+static int prune_program(dt_tape *t);
+
 dt_tape *dt_builder_finish(dt_builder *b, int *err) {
   int e = b->err;
   if (!e && b->depth != 1) e = DT_EUNBALANCED;
@@ -205,7 +212,10 @@ dt_tape *dt_builder_finish(dt_builder *b, int *err) {
       for (int i = 0; i < t->nleaves; i++)
         if (t->leaves[i].r > t->rmax) t->rmax = t->leaves[i].r;
       if (t->depth > DT_STACK_MAX) e = DT_EOP; /* needs > 2^63 leaves */
-      else tape_range(t);
+      else {
+        tape_range(t);
+        e = prune_program(t);
+      }
     }
     if (e) { dt_tape_free(t); t = NULL; }
   }
@@ -490,106 +500,238 @@ static inline double leaf_const(const dt_leaf *lf, double base, double nd,
   return -1;
 }
 
-/* Per-segment pruning (Section 3.4.1: a leaf contributes nothing to L and
- * G where the segment misses its filter).  Constants are kept lazily on
- * the fold stack and only emitted when combined with live code. */
-static int prune(const dt_tape *t, const double o[3], const double d[3],
-                 const dt_ray_leaf *rl, double s0, double s1, dt_instr *buf,
-                 dt_tape *view) {
-  /* Per operand on the fold stack: constant (isc, c) or live code
-   * starting at buf[start]. */
+/* The fold stack of the pruning: per operand, a constant (isc, c) or live
+ * code starting at buf[start]. */
+typedef struct {
   double cst[DT_STACK_MAX];
   int start[DT_STACK_MAX];
   unsigned char isc[DT_STACK_MAX];
-  int sp = 0, n = 0;
-  const dt_instr *code = t->code;
-  for (int i = 0, nc = t->ncode; i < nc; i++) {
+  int sp, n;
+} fold_state;
+
+/* Push a leaf or constant that is the constant c (isc) or live. */
+static inline void fold_leaf(fold_state *f, const dt_instr *in, int isc,
+                             double c, dt_instr *buf) {
+  int sp = f->sp++;
+  f->start[sp] = f->n;
+  if (isc) {
+    f->isc[sp] = 1;
+    f->cst[sp] = c;
+  } else {
+    f->isc[sp] = 0;
+    buf[f->n++] = *in;
+  }
+}
+
+/* Combine the top two operands by the binary op in. */
+static inline void fold_op(fold_state *f, const dt_instr *in, dt_instr *buf) {
+  int sp = --f->sp, op = in->op;
+  int xc = f->isc[sp - 1], yc = f->isc[sp];
+  if (xc && yc) {
+    f->cst[sp - 1] = apply(op, f->cst[sp - 1], f->cst[sp]);
+    return;
+  }
+  if (!xc && !yc) {
+    buf[f->n++] = *in;
+    return;
+  }
+  /* Exactly one constant c; the live operand's code is buf[start..n). */
+  double c = xc ? f->cst[sp - 1] : f->cst[sp];
+  int st = xc ? f->start[sp] : f->start[sp - 1];
+  int keep = 0, fold = 0;
+  double fv = 0;
+  switch (op) {
+  case DT_SUM: keep = c == 0; break;
+  case DT_PRODUCT:
+    if (c == 0) { fold = 1; fv = 0; } else keep = c == 1;
+    break;
+  case DT_UNION:
+    if (c == 1) { fold = 1; fv = 1; } else keep = c == 0;
+    break;
+  case DT_DIFF: keep = yc && c == 0; break;   /* x - 0 */
+  case DT_RDIFF: keep = xc && c == 0; break;  /* y - 0 */
+  }
+  f->start[sp - 1] = st;
+  if (fold) {
+    f->n = st;
+    f->isc[sp - 1] = 1;
+    f->cst[sp - 1] = fv;
+  } else if (keep) {
+    f->isc[sp - 1] = 0;
+  } else {
+    /* Emit the constant after the live code: the operands are now in
+     * swapped order, so differences flip. */
+    dt_instr ci = {DT_CONST, 0, c};
+    buf[f->n++] = ci;
+    dt_instr oi = *in;
+    if (xc) {
+      if (op == DT_DIFF) oi.op = DT_RDIFF;
+      else if (op == DT_RDIFF) oi.op = DT_DIFF;
+    }
+    buf[f->n++] = oi;
+    f->isc[sp - 1] = 0;
+  }
+}
+
+/* Per-segment pruning (Section 3.4.1: a leaf contributes nothing to L and
+ * G where the segment misses its filter).  Constants are kept lazily on
+ * the fold stack and only emitted when combined with live code.  A
+ * finished tape is pruned through its prune program (density.h), with the
+ * same result. */
+static int prune(const dt_tape *t, const double o[3], const double d[3],
+                 const dt_ray_leaf *rl, double s0, double s1, dt_instr *buf,
+                 dt_tape *view) {
+  fold_state f;
+  f.sp = f.n = 0;
+  const dt_instr *code = t->npcode ? t->pcode : t->code;
+  int nc = t->npcode ? t->npcode : t->ncode;
+  for (int i = 0; i < nc; i++) {
     const dt_instr *in = &code[i];
     int op = in->op;
     if (op == DT_CONST) {
-      isc[sp] = 1;
-      cst[sp] = in->c;
-      start[sp++] = n;
-      continue;
-    }
-    if (op == DT_LEAF) {
-      const dt_leaf *lf = &t->leaves[in->arg];
-      double base, nd;
-      if (rl) {
-        base = rl[in->arg].base;
-        nd = rl[in->arg].nd;
-      } else {
-        nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
-        base = leaf_dist(lf, o);
+      fold_leaf(&f, in, 1, in->c, buf);
+    } else if (op == DT_LEAF || op == DT_GROUP) {
+      const dt_group *g = op == DT_GROUP ? &t->groups[in->arg] : NULL;
+      int nl = g ? g->n : 1;
+      unsigned live = 0;
+      double c = 1;
+      for (int k = 0; k < nl; k++) {
+        int li = g ? t->gleaf[g->leaf0 + k] : in->arg;
+        const dt_leaf *lf = &t->leaves[li];
+        double base, nd;
+        if (rl) {
+          base = rl[li].base;
+          nd = rl[li].nd;
+        } else {
+          nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+          base = leaf_dist(lf, o);
+        }
+        double lc = leaf_const(lf, base, nd, s0, s1);
+        if (lc == 0) { c = 0; break; }   /* a product with a 0 is 0 */
+        if (lc < 0) live |= 1u << k;
       }
-      double c = leaf_const(lf, base, nd, s0, s1);
-      start[sp] = n;
-      if (c >= 0) {
-        isc[sp] = 1;
-        cst[sp] = c;
+      if (!g) {
+        fold_leaf(&f, in, !live || c == 0, c, buf);
+      } else if (c == 0 || !live) {
+        fold_leaf(&f, in, 1, c, buf);
       } else {
-        isc[sp] = 0;
-        buf[n++] = *in;
+        int a = t->gsnip[g->snip0 + live], b = t->gsnip[g->snip0 + live + 1];
+        f.start[f.sp] = f.n;
+        f.isc[f.sp++] = 0;
+        memcpy(buf + f.n, t->gcode + a, (size_t)(b - a) * sizeof *buf);
+        f.n += b - a;
       }
-      sp++;
-      continue;
-    }
-    sp--;
-    int xc = isc[sp - 1], yc = isc[sp];
-    if (xc && yc) {
-      cst[sp - 1] = apply(op, cst[sp - 1], cst[sp]);
-      continue;
-    }
-    if (!xc && !yc) {
-      buf[n++] = *in;
-      continue;
-    }
-    /* Exactly one constant c; the live operand's code is buf[start..n). */
-    double c = xc ? cst[sp - 1] : cst[sp];
-    int st = xc ? start[sp] : start[sp - 1];
-    int keep = 0, fold = 0;
-    double fv = 0;
-    switch (op) {
-    case DT_SUM: keep = c == 0; break;
-    case DT_PRODUCT:
-      if (c == 0) { fold = 1; fv = 0; } else keep = c == 1;
-      break;
-    case DT_UNION:
-      if (c == 1) { fold = 1; fv = 1; } else keep = c == 0;
-      break;
-    case DT_DIFF: keep = yc && c == 0; break;   /* x - 0 */
-    case DT_RDIFF: keep = xc && c == 0; break;  /* y - 0 */
-    }
-    start[sp - 1] = st;
-    if (fold) {
-      n = st;
-      isc[sp - 1] = 1;
-      cst[sp - 1] = fv;
-    } else if (keep) {
-      isc[sp - 1] = 0;
     } else {
-      /* Emit the constant after the live code: the operands are now in
-       * swapped order, so differences flip. */
-      dt_instr ci = {DT_CONST, 0, c};
-      buf[n++] = ci;
-      dt_instr oi = *in;
-      if (xc) {
-        if (op == DT_DIFF) oi.op = DT_RDIFF;
-        else if (op == DT_RDIFF) oi.op = DT_DIFF;
-      }
-      buf[n++] = oi;
-      isc[sp - 1] = 0;
+      fold_op(&f, in, buf);
     }
   }
-  if (isc[0]) {
-    dt_instr ci = {DT_CONST, 0, cst[0]};
+  int n = f.n;
+  if (f.isc[0]) {
+    dt_instr ci = {DT_CONST, 0, f.cst[0]};
     n = 0;
     buf[n++] = ci;
   }
   *view = *t;
   view->code = buf;
   view->ncode = n;
+  view->npcode = 0;
+  view->pcode = NULL;
+  view->ngroups = 0;
+  view->groups = NULL;
+  view->gleaf = view->gsnip = NULL;
+  view->gcode = NULL;
   return n;
+}
+
+/* The prune program of a finished tape (density.h). */
+static int prune_program(dt_tape *t) {
+  int n = t->ncode;
+  int *mem = malloc((size_t)n * 5 * sizeof(int) + 1);
+  if (!mem) return DT_ENOMEM;
+  int *start = mem, *nl = mem + n, *pure = mem + 2 * n, *parent = mem + 3 * n;
+  int *groot = mem + 4 * n;   /* at a group's first instruction: its root */
+  int stk[DT_STACK_MAX + 1], sp = 0;
+  for (int i = 0; i < n; i++) {
+    int op = t->code[i].op;
+    parent[i] = groot[i] = -1;
+    start[i] = i;
+    if (op == DT_LEAF || op == DT_CONST) {
+      nl[i] = op == DT_LEAF;
+      pure[i] = op == DT_LEAF;
+    } else {
+      int y = stk[--sp], x = stk[--sp];
+      parent[x] = parent[y] = i;
+      start[i] = start[x];
+      nl[i] = nl[x] + nl[y];
+      pure[i] = op == DT_PRODUCT && pure[x] && pure[y];
+    }
+    stk[sp++] = i;
+  }
+#define CAND(i) (pure[i] && nl[i] >= 2 && nl[i] <= DT_GROUP_MAX)
+  int ng = 0, nleaf = 0;
+  size_t nsnip = 0, ncodes = 0;
+  for (int i = 0; i < n; i++)
+    if (CAND(i) && (parent[i] < 0 || !CAND(parent[i]))) {
+      groot[start[i]] = i;
+      ng++;
+      nleaf += nl[i];
+      nsnip += ((size_t)1 << nl[i]) + 1;
+      ncodes += ((size_t)1 << nl[i]) * (size_t)(i - start[i] + 1);
+    }
+#undef CAND
+  if (!ng) {
+    free(mem);
+    return DT_OK;
+  }
+  t->pcode = malloc((size_t)n * sizeof *t->pcode);
+  t->groups = malloc((size_t)ng * sizeof *t->groups);
+  t->gleaf = malloc((size_t)nleaf * sizeof *t->gleaf);
+  t->gsnip = malloc(nsnip * sizeof *t->gsnip);
+  t->gcode = malloc(ncodes * sizeof *t->gcode);
+  if (!t->pcode || !t->groups || !t->gleaf || !t->gsnip || !t->gcode) {
+    free(mem);
+    return DT_ENOMEM;   /* the caller frees the tape and its parts */
+  }
+  int np = 0, g = 0, lf = 0, sn = 0, nc = 0;
+  for (int i = 0; i < n;) {
+    int e = groot[i];
+    if (e < 0) {
+      t->pcode[np++] = t->code[i++];
+      continue;
+    }
+    dt_group *gr = &t->groups[g];
+    gr->n = nl[e];
+    gr->leaf0 = lf;
+    gr->snip0 = sn;
+    for (int k = i; k <= e; k++)
+      if (t->code[k].op == DT_LEAF) t->gleaf[lf++] = t->code[k].arg;
+    /* The code each set of live leaves prunes to; the others are 1. */
+    for (unsigned m = 0; m < 1u << gr->n; m++) {
+      t->gsnip[sn++] = nc;
+      if (!m) continue;   /* all 1: the constant 1, no code */
+      fold_state f;
+      f.sp = f.n = 0;
+      int k = 0;
+      for (int j = i; j <= e; j++) {
+        const dt_instr *in = &t->code[j];
+        if (in->op == DT_LEAF) {
+          fold_leaf(&f, in, !((m >> k) & 1), 1, t->gcode + nc);
+          k++;
+        } else {
+          fold_op(&f, in, t->gcode + nc);
+        }
+      }
+      nc += f.n;
+    }
+    t->gsnip[sn++] = nc;
+    t->pcode[np++] = (dt_instr){DT_GROUP, g, 0};
+    g++;
+    i = e + 1;
+  }
+  t->npcode = np;
+  t->ngroups = ng;
+  free(mem);
+  return DT_OK;
 }
 
 int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
