@@ -34,6 +34,7 @@ void csg_tape_free(csg_tape *t) {
   free(t->rcode);
   free(t->gstart);
   free(t->gplane);
+  free(t->gpl);
   free(t);
 }
 
@@ -260,6 +261,14 @@ static int ray_program(csg_tape *t) {
   t->nrcode = nr;
   t->ngroups = ng;
   free(gend);
+  t->gpl = malloc(((size_t)np + 1) * sizeof *t->gpl);
+  if (!t->gpl) return CSG_ENOMEM;
+  for (int k = 0; k < np; k++) {
+    const csg_plane *p = &t->planes[t->gplane[k]];
+    memcpy(t->gpl[k].n, p->n, sizeof p->n);
+    t->gpl[k].d = p->d;
+    t->gpl[k].id = t->gplane[k];
+  }
   return CSG_OK;
 }
 
@@ -431,9 +440,10 @@ static int convex_span(const csg_tape *t, int g, const double o[3],
                        csg_span *out) {
   double t0 = s0, t1 = s1;
   int id0 = -1, id1 = -1;
-  for (int k = t->gstart[g]; k < t->gstart[g + 1]; k++) {
-    int id = t->gplane[k];
-    const csg_plane *p = &t->planes[id];
+  const struct csg_gplane *p = t->gpl + t->gstart[g];
+  const struct csg_gplane *end = t->gpl + t->gstart[g + 1];
+  for (; p < end; p++) {
+    int id = p->id;
     double base = p->n[0] * o[0] + p->n[1] * o[1] + p->n[2] * o[2] - p->d;
     double kd = p->n[0] * d[0] + p->n[1] * d[1] + p->n[2] * d[2];
     /* The plane's own span [a, b] within [s0, s1], as plane_span has it. */

@@ -47,11 +47,12 @@ typedef struct csg_tape {
    * the usual piece of a bound) replaced by one CSG_CONVEX instruction,
    * whose span is clipped plane by plane without span-list merges.
    * Group g holds the planes gplane[gstart[g] .. gstart[g + 1]), in code
-   * order. */
+   * order, copied to gpl with their indices. */
   int nrcode;
   csg_instr *rcode;
   int ngroups;
   int *gstart, *gplane;
+  struct csg_gplane { double n[3], d; int id; } *gpl;
 } csg_tape;
 
 /* One inside interval of a ray, t0 < t1.  id0/id1 name the plane whose

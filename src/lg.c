@@ -417,24 +417,27 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
   return 1;
 }
 
-/* The part of [t0, t1] where some filter is touched: outside it every
- * leaf is constant, so the density is too. */
-static int support_hull(const dt_tape *t, const dt_ray_leaf *rl, double *t0,
-                        double *t1) {
-  double lo = INFINITY, hi = -INFINITY;
+/* The leaves along the ray (dt_ray_leaves) and the part of the ray where
+ * some filter is touched, [*lo, *hi]: outside it every leaf is constant,
+ * so the density is too. */
+static void ray_leaves_hull(const dt_tape *t, const double o[3],
+                            const double d[3], dt_ray_leaf *rl, double *lo,
+                            double *hi) {
+  double l = INFINITY, h = -INFINITY;
   for (int i = 0; i < t->nleaves; i++) {
     const dt_leaf *lf = &t->leaves[i];
-    double nd = rl[i].nd;
+    double base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
+    double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+    rl[i].base = base;
+    rl[i].nd = nd;
     if (nd == 0) continue;
-    double base = rl[i].base;
     double x = (-lf->r - base) / nd, y = (lf->r - base) / nd;
     if (x > y) { double tmp = x; x = y; y = tmp; }
-    if (x < lo) lo = x;
-    if (y > hi) hi = y;
+    if (x < l) l = x;
+    if (y > h) h = y;
   }
-  if (lo > *t0) *t0 = lo;
-  if (hi < *t1) *t1 = hi;
-  return *t0 <= *t1;
+  *lo = l;
+  *hi = h;
 }
 
 /* Search the sorted, disjoint intervals iv[0..n) (pairs of doubles). */
@@ -463,12 +466,15 @@ static int run(const dt_tape *t, const double o[3], const double d[3],
       return -1;
     }
   }
-  dt_ray_leaves(t, o, d, rl);
+  double hlo, hhi;
+  ray_leaves_hull(t, o, d, rl, &hlo, &hhi);
   search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
               rl, buf + nc, nlv, nc, first, first_after};
   for (int i = 0; i < n; i++) {
     double a = iv[2 * i], b = iv[2 * i + 1];
-    if (!support_hull(t, rl, &a, &b)) continue;
+    if (hlo > a) a = hlo;
+    if (hhi < b) b = hhi;
+    if (!(a <= b)) continue;
     dt_tape view;
     dt_prune_rl(t, rl, a, b, buf, &view);
     if (!search_interval(&s, &view, a, b)) break;
