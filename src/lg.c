@@ -189,7 +189,8 @@ typedef struct {
   const dt_ray_leaf *rl;  /* the leaves along this ray */
   dt_instr *lvbuf;        /* nlv code buffers of ncode instructions, then */
   int nlv, ncode;         /* one scratch buffer for deeper segments */
-  int first;          /* stop at the first crossing after first_after */
+  int first;          /* stop at the first crossing after first_after; 2:
+                         any point of its bracket will do (polish) */
   double first_after;
 } search;
 
@@ -234,6 +235,9 @@ static int pos(double f) { return f > 0; }
  * part, so exact zeros (a face plane at density 0.5) come back exactly. */
 static double polish(search *s, const dt_tape *t, double a, double b,
                      double fa, double fb, double dfa, double dfb) {
+  /* The caller only asks whether there is a crossing after first_after
+   * (a shadow ray): the bracket's far end stands for it. */
+  if (s->first == 2 && a > s->first_after) return b;
   int pa = pos(fa);
   if (!pa && fa == 0) return a;    /* entering right after a zero at a */
   if (pa && fb == 0) return b;     /* leaving at a zero at b */
@@ -570,7 +574,7 @@ int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
 int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
                      const csg_tape *inner, const double o[3],
                      const double d[3], double t0, double t1, double tol,
-                     lg_root *out, int maxout, lg_stats *stats) {
+                     lg_root *out, int maxout, lg_stats *stats, int any) {
   return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, NULL,
-                 1);
+                 any ? 2 : 1);
 }

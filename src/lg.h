@@ -146,10 +146,14 @@ int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
  * the first one in (t0, t1] and the last root returned.  The roots before
  * it (touches, crossings at t0) are those lg_roots_bounded returns, so the
  * first crossing is the same; only the search after it is skipped (a
- * primary ray needs the nearest hit, a shadow ray any). */
+ * primary ray needs the nearest hit).  With any != 0 (a shadow ray, which
+ * only asks whether there is a crossing after t0) a crossing bracketed
+ * after t0 is not polished: its reported t is the bracket's far end, in
+ * (t0, t1] like the crossing, and the answer (a crossing after t0 or
+ * none) is the same. */
 int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
                      const csg_tape *inner, const double o[3],
                      const double d[3], double t0, double t1, double tol,
-                     lg_root *out, int maxout, lg_stats *stats);
+                     lg_root *out, int maxout, lg_stats *stats, int any);
 
 #endif

@@ -400,10 +400,12 @@ typedef struct Hit {
   int id, flip;   /* the surface: scene node and orientation */
 } Hit;
 
-/* The first surface crossing of one primitive in (t0, t1). */
+/* The first surface crossing of one primitive in (t0, t1); with any != 0
+   (a shadow ray) a rounded primitive may report any t in (t0, t1] when
+   there is a crossing, and none when there is none. */
 static int prim_hit(const Tracer *T, int pi, const double o[3],
                     const double d[3], double t0, double t1, RayCtx *c,
-                    Hit *h) {
+                    Hit *h, int any) {
   const Scene *s = T->s;
   int node = T->prims[pi].node;
   const ScNode *n = &s->nodes[node];
@@ -424,7 +426,7 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
     double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
     double tol = fmax(c->tol, 4e-16 * scale) / len;
     int nr = lg_first_bounded(n->tape, n->outer, n->inner, o, d, t0, t1, tol,
-                              roots, 8, &c->stats.lg);
+                              roots, 8, &c->stats.lg, any);
     int k = 0;
     while (k < nr && (roots[k].kind == LG_TOUCH || !(roots[k].t > t0))) k++;
     if (k >= nr) return 0;
@@ -473,7 +475,7 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
   int found = 0;
   for (int i = 0; i < T->nunbounded; i++) {
     Hit h;
-    if (prim_hit(T, T->unbounded[i], o, d, t0, t1, c, &h)) {
+    if (prim_hit(T, T->unbounded[i], o, d, t0, t1, c, &h, any)) {
       *best = h;
       t1 = h.t;
       found = 1;
@@ -494,7 +496,7 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
         double e2;
         if (!box_hit(&T->prims[pi].box, o, inv, t0, t1, &e2)) continue;
         Hit h;
-        if (prim_hit(T, pi, o, d, t0, t1, c, &h)) {
+        if (prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
           *best = h;
           t1 = h.t;
           found = 1;
