@@ -153,32 +153,27 @@ static int make_key(const soft_key *in, skey_t *k)
   return SOFT_OK;
 }
 
-static void box_of_keys(const skey_t *k, int n, double lo[3], double hi[3])
-{
-  for (int i = 0; i < 3; i++) { lo[i] = INFINITY; hi[i] = -INFINITY; }
-  for (int j = 0; j < n; j++)
-    for (int i = 0; i < 3; i++) {
-      if (k[j].lo[i] < lo[i]) lo[i] = k[j].lo[i];
-      if (k[j].hi[i] > hi[i]) hi[i] = k[j].hi[i];
-    }
-}
+/* The BVH is built over an index array (the keys themselves, 152 bytes
+ * each, are moved once at the end into leaf order): the centroid of key
+ * idx[j] on an axis is cen[axis][idx[j]]. */
+typedef struct {
+  soft_obj *o;
+  const skey_t *keys;  /* in input order */
+  int *idx;
+  double *cen[3];
+} bvh_build;
 
-static double centroid(const skey_t *k, int axis)
-{
-  return k->x0[axis];
-}
-
-/* Quickselect: order keys so that key[mid] has the median centroid. */
-static void select_median(skey_t *k, int n, int mid, int axis)
+/* Quickselect: order idx[0..n) so that idx[mid] has the median centroid. */
+static void select_median(int *idx, const double *c, int n, int mid)
 {
   int lo = 0, hi = n - 1;
   while (lo < hi) {
-    double pv = centroid(&k[(lo + hi) / 2], axis);
+    double pv = c[idx[(lo + hi) / 2]];
     int i = lo, j = hi;
     while (i <= j) {
-      while (centroid(&k[i], axis) < pv) i++;
-      while (centroid(&k[j], axis) > pv) j--;
-      if (i <= j) { skey_t t = k[i]; k[i] = k[j]; k[j] = t; i++; j--; }
+      while (c[idx[i]] < pv) i++;
+      while (c[idx[j]] > pv) j--;
+      if (i <= j) { int t = idx[i]; idx[i] = idx[j]; idx[j] = t; i++; j--; }
     }
     if (mid <= j) hi = j;
     else if (mid >= i) lo = i;
@@ -187,28 +182,53 @@ static void select_median(skey_t *k, int n, int mid, int axis)
 }
 
 /* Median split on the longest axis of the centroids; children of a node
- * are adjacent. Depth is at most ceil(log2 n) + 1. */
-static void build_node(soft_obj *o, int ni, int first, int n)
+ * are adjacent. Depth is at most ceil(log2 n) + 1. A leaf's box is that of
+ * its keys, an inner node's the union of its children's, so the boxes cost
+ * O(n) in all. */
+static void build_node(bvh_build *b, int ni, int first, int n)
 {
-  node_t *nd = &o->nodes[ni];
-  box_of_keys(o->keys + first, n, nd->lo, nd->hi);
-  if (n <= LEAF_MAX) { nd->first = first; nd->count = n; return; }
-  double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int j = first; j < first + n; j++)
-    for (int i = 0; i < 3; i++) {
-      clo[i] = fmin(clo[i], o->keys[j].x0[i]);
-      chi[i] = fmax(chi[i], o->keys[j].x0[i]);
+  soft_obj *o = b->o;
+  const int *idx = b->idx + first;
+  if (n <= LEAF_MAX) {
+    node_t *nd = &o->nodes[ni];
+    for (int i = 0; i < 3; i++) { nd->lo[i] = INFINITY; nd->hi[i] = -INFINITY; }
+    for (int j = 0; j < n; j++) {
+      const skey_t *k = &b->keys[idx[j]];
+      for (int i = 0; i < 3; i++) {
+        if (k->lo[i] < nd->lo[i]) nd->lo[i] = k->lo[i];
+        if (k->hi[i] > nd->hi[i]) nd->hi[i] = k->hi[i];
+      }
     }
+    nd->first = first;
+    nd->count = n;
+    return;
+  }
   int axis = 0;
-  for (int i = 1; i < 3; i++) if (chi[i] - clo[i] > chi[axis] - clo[axis]) axis = i;
+  double ext[3];
+  for (int i = 0; i < 3; i++) {
+    const double *c = b->cen[i];
+    double clo = INFINITY, chi = -INFINITY;
+    for (int j = 0; j < n; j++) {
+      double x = c[idx[j]];
+      if (x < clo) clo = x;
+      if (x > chi) chi = x;
+    }
+    ext[i] = chi - clo;
+    if (ext[i] > ext[axis]) axis = i;
+  }
   int half = n / 2;
-  select_median(o->keys + first, n, half, axis);
+  select_median(b->idx + first, b->cen[axis], n, half);
   int left = o->nnodes;
   o->nnodes += 2;
+  build_node(b, left, first, half);
+  build_node(b, left + 1, first + half, n - half);
+  node_t *nd = &o->nodes[ni], *l = &o->nodes[left], *r = &o->nodes[left + 1];
+  for (int i = 0; i < 3; i++) {
+    nd->lo[i] = fmin(l->lo[i], r->lo[i]);
+    nd->hi[i] = fmax(l->hi[i], r->hi[i]);
+  }
   nd->first = left;
   nd->count = 0;
-  build_node(o, left, first, half);
-  build_node(o, left + 1, first + half, n - half);
 }
 
 int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
@@ -228,12 +248,28 @@ int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
     if (err) { *bad_key = i; free(all); free(o); return err; }
     if (!all[live].empty && all[live].w != 0) live++;  /* others act nowhere */
   }
-  o->keys = all;
   o->nkeys = live;
   o->nodes = malloc((2 * live + 1) * sizeof *o->nodes);
-  if (!o->nodes) { free(all); free(o); return SOFT_ERR_NOMEM; }
+  bvh_build b = {o, all, malloc((live ? live : 1) * sizeof(int)), {NULL}};
+  for (int i = 0; i < 3; i++) b.cen[i] = malloc((live ? live : 1) * sizeof(double));
+  o->keys = malloc((live ? live : 1) * sizeof *o->keys);
+  if (!o->nodes || !b.idx || !b.cen[0] || !b.cen[1] || !b.cen[2] || !o->keys) {
+    free(o->nodes); free(o->keys); free(b.idx);
+    for (int i = 0; i < 3; i++) free(b.cen[i]);
+    free(all); free(o);
+    return SOFT_ERR_NOMEM;
+  }
+  for (size_t j = 0; j < live; j++) {
+    b.idx[j] = (int)j;
+    for (int i = 0; i < 3; i++) b.cen[i][j] = all[j].x0[i];
+  }
   o->nnodes = 1;
-  build_node(o, 0, 0, (int)live);
+  build_node(&b, 0, 0, (int)live);
+  for (size_t j = 0; j < live; j++) o->keys[j] = all[b.idx[j]];
+  free(b.idx);
+  for (int i = 0; i < 3; i++) free(b.cen[i]);
+  free(all);
+  all = o->keys;
   for (int i = 0; i < 3; i++) { o->lo[i] = INFINITY; o->hi[i] = -INFINITY; }
   for (size_t j = 0; j < live; j++)
     if (all[j].w > 0)
