@@ -30,11 +30,14 @@ void dt_tape_free(dt_tape *t) {
   if (!t) return;
   free(t->code);
   free(t->leaves);
-  free(t->pcode);
-  free(t->groups);
-  free(t->gleaf);
-  free(t->gsnip);
-  free(t->gcode);
+  if (t->prog) {
+    free(t->prog->pcode);
+    free(t->prog->groups);
+    free(t->prog->gleaf);
+    free(t->prog->gsnip);
+    free(t->prog->gcode);
+    free(t->prog);
+  }
   free(t);
 }
 
@@ -583,20 +586,21 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
                  dt_tape *view) {
   fold_state f;
   f.sp = f.n = 0;
-  const dt_instr *code = t->npcode ? t->pcode : t->code;
-  int nc = t->npcode ? t->npcode : t->ncode;
+  const dt_prune_prog *pp = t->prog;
+  const dt_instr *code = pp ? pp->pcode : t->code;
+  int nc = pp ? pp->npcode : t->ncode;
   for (int i = 0; i < nc; i++) {
     const dt_instr *in = &code[i];
     int op = in->op;
     if (op == DT_CONST) {
       fold_leaf(&f, in, 1, in->c, buf);
     } else if (op == DT_LEAF || op == DT_GROUP) {
-      const dt_group *g = op == DT_GROUP ? &t->groups[in->arg] : NULL;
+      const dt_group *g = op == DT_GROUP ? &pp->groups[in->arg] : NULL;
       int nl = g ? g->n : 1;
       unsigned live = 0;
       double c = 1;
       for (int k = 0; k < nl; k++) {
-        int li = g ? t->gleaf[g->leaf0 + k] : in->arg;
+        int li = g ? pp->gleaf[g->leaf0 + k] : in->arg;
         const dt_leaf *lf = &t->leaves[li];
         double base, nd;
         if (rl) {
@@ -615,10 +619,10 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
       } else if (c == 0 || !live) {
         fold_leaf(&f, in, 1, c, buf);
       } else {
-        int a = t->gsnip[g->snip0 + live], b = t->gsnip[g->snip0 + live + 1];
+        int a = pp->gsnip[g->snip0 + live], b = pp->gsnip[g->snip0 + live + 1];
         f.start[f.sp] = f.n;
         f.isc[f.sp++] = 0;
-        memcpy(buf + f.n, t->gcode + a, (size_t)(b - a) * sizeof *buf);
+        memcpy(buf + f.n, pp->gcode + a, (size_t)(b - a) * sizeof *buf);
         f.n += b - a;
       }
     } else {
@@ -634,12 +638,7 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
   *view = *t;
   view->code = buf;
   view->ncode = n;
-  view->npcode = 0;
-  view->pcode = NULL;
-  view->ngroups = 0;
-  view->groups = NULL;
-  view->gleaf = view->gsnip = NULL;
-  view->gcode = NULL;
+  view->prog = NULL;
   return n;
 }
 
@@ -683,12 +682,17 @@ static int prune_program(dt_tape *t) {
     free(mem);
     return DT_OK;
   }
-  t->pcode = malloc((size_t)n * sizeof *t->pcode);
-  t->groups = malloc((size_t)ng * sizeof *t->groups);
-  t->gleaf = malloc((size_t)nleaf * sizeof *t->gleaf);
-  t->gsnip = malloc(nsnip * sizeof *t->gsnip);
-  t->gcode = malloc(ncodes * sizeof *t->gcode);
-  if (!t->pcode || !t->groups || !t->gleaf || !t->gsnip || !t->gcode) {
+  dt_prune_prog *pp = t->prog = calloc(1, sizeof *pp);
+  if (!pp) {
+    free(mem);
+    return DT_ENOMEM;
+  }
+  pp->pcode = malloc((size_t)n * sizeof *pp->pcode);
+  pp->groups = malloc((size_t)ng * sizeof *pp->groups);
+  pp->gleaf = malloc((size_t)nleaf * sizeof *pp->gleaf);
+  pp->gsnip = malloc(nsnip * sizeof *pp->gsnip);
+  pp->gcode = malloc(ncodes * sizeof *pp->gcode);
+  if (!pp->pcode || !pp->groups || !pp->gleaf || !pp->gsnip || !pp->gcode) {
     free(mem);
     return DT_ENOMEM;   /* the caller frees the tape and its parts */
   }
@@ -696,18 +700,18 @@ static int prune_program(dt_tape *t) {
   for (int i = 0; i < n;) {
     int e = groot[i];
     if (e < 0) {
-      t->pcode[np++] = t->code[i++];
+      pp->pcode[np++] = t->code[i++];
       continue;
     }
-    dt_group *gr = &t->groups[g];
+    dt_group *gr = &pp->groups[g];
     gr->n = nl[e];
     gr->leaf0 = lf;
     gr->snip0 = sn;
     for (int k = i; k <= e; k++)
-      if (t->code[k].op == DT_LEAF) t->gleaf[lf++] = t->code[k].arg;
+      if (t->code[k].op == DT_LEAF) pp->gleaf[lf++] = t->code[k].arg;
     /* The code each set of live leaves prunes to; the others are 1. */
     for (unsigned m = 0; m < 1u << gr->n; m++) {
-      t->gsnip[sn++] = nc;
+      pp->gsnip[sn++] = nc;
       if (!m) continue;   /* all 1: the constant 1, no code */
       fold_state f;
       f.sp = f.n = 0;
@@ -715,21 +719,21 @@ static int prune_program(dt_tape *t) {
       for (int j = i; j <= e; j++) {
         const dt_instr *in = &t->code[j];
         if (in->op == DT_LEAF) {
-          fold_leaf(&f, in, !((m >> k) & 1), 1, t->gcode + nc);
+          fold_leaf(&f, in, !((m >> k) & 1), 1, pp->gcode + nc);
           k++;
         } else {
-          fold_op(&f, in, t->gcode + nc);
+          fold_op(&f, in, pp->gcode + nc);
         }
       }
       nc += f.n;
     }
-    t->gsnip[sn++] = nc;
-    t->pcode[np++] = (dt_instr){DT_GROUP, g, 0};
+    pp->gsnip[sn++] = nc;
+    pp->pcode[np++] = (dt_instr){DT_GROUP, g, 0};
     g++;
     i = e + 1;
   }
-  t->npcode = np;
-  t->ngroups = ng;
+  pp->npcode = np;
+  pp->ngroups = ng;
   free(mem);
   return DT_OK;
 }

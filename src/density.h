@@ -65,22 +65,17 @@ typedef struct dt_tape {
   double lo, hi;    /* range of the density, assuming leaves in [0,1] */
   double rmax;      /* largest leaf radius */
   /* The prune program, made by dt_builder_finish for the pruning
-   * functions (views have none: npcode = 0): pcode is code with every
-   * maximal subtree that only multiplies 2 to DT_GROUP_MAX leaves replaced
-   * by one DT_GROUP instruction.  Such a subtree prunes to 0 if a leaf is
-   * 0 over the segment, and otherwise to the code the live leaves leave,
-   * which is stored for every set of live leaves (bit k: the group's k-th
-   * leaf, in code order): the pruning classifies the leaves and copies
-   * that code instead of folding instruction by instruction. */
-  int npcode;
-  dt_instr *pcode;
-  int ngroups;
-  struct dt_group *groups;
-  int *gleaf;        /* the groups' leaf indices */
-  int *gsnip;        /* per group and set of live leaves: code offsets */
-  dt_instr *gcode;   /* the code of every group and set */
+   * functions (NULL in views and when the tape has no group). */
+  struct dt_prune_prog *prog;
 } dt_tape;
 
+/* The prune program: pcode is the tape's code with every maximal subtree
+ * that only multiplies 2 to DT_GROUP_MAX leaves replaced by one DT_GROUP
+ * instruction.  Such a subtree prunes to 0 if a leaf is 0 over the
+ * segment, and otherwise to the code the live leaves leave, which is
+ * stored for every set of live leaves (bit k: the group's k-th leaf, in
+ * code order): the pruning classifies the leaves and copies that code
+ * instead of folding instruction by instruction. */
 #define DT_GROUP_MAX 8
 typedef struct dt_group {
   int n;       /* leaves, 2 .. DT_GROUP_MAX */
@@ -88,6 +83,16 @@ typedef struct dt_group {
   int snip0;   /* the code for live set m is gcode[gsnip[snip0 + m] ..
                   gsnip[snip0 + m + 1]) */
 } dt_group;
+
+typedef struct dt_prune_prog {
+  int npcode;
+  dt_instr *pcode;
+  int ngroups;
+  dt_group *groups;
+  int *gleaf;        /* the groups' leaf indices */
+  int *gsnip;        /* per group and set of live leaves: code offsets */
+  dt_instr *gcode;   /* the code of every group and set */
+} dt_prune_prog;
 
 typedef struct dt_builder dt_builder;
 

@@ -25,6 +25,13 @@ static double maxabs(double lo, double hi) {
   return fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi);
 }
 
+/* dt_halfspace(a, 1) for a in [-1, 1], inline. */
+static inline double halfspace1(double a) {
+  if (a >= 1) return 0;
+  if (a <= -1) return 1;
+  return (1 - a) * (1 - a) * (2 + a) * 0.25;
+}
+
 /* eq. (2) and its alpha-derivatives over the segment for one leaf. */
 static void leaf_bounds(const dt_leaf *lf, double base, double nd, double a,
                         double b, double *lo, double *hi, double *L,
@@ -52,8 +59,8 @@ static void leaf_bounds(const dt_leaf *lf, double base, double nd, double a,
   }
   if (amin < -1) amin = -1;
   if (amax > 1) amax = 1;
-  *lo = dt_halfspace(amax, 1);
-  *hi = dt_halfspace(amin, 1);
+  *lo = halfspace1(amax);
+  *hi = halfspace1(amin);
   double near = amin <= 0 && amax >= 0 ? 0 : min2(fabs(amin), fabs(amax));
   double far = max2(fabs(amin), fabs(amax));
   double k = fabs(nd) * lf->inv_r;
@@ -347,9 +354,8 @@ static void trace(search *s, const segment *sg, const lg_bounds *lb,
  * on prune from the deepest stored one. */
 static int search_interval(search *s, const dt_tape *t, double a, double b) {
   segment stack[LG_STACK];
-  dt_tape lv[LG_MAX_LEVELS];
+  dt_tape lv[LG_MAX_LEVELS + 1];   /* lv[nlv]: deeper segments' views */
   int sp = 0;
-  lv[0] = *t;
   segment first = {a, b, 0, 0, 0, 0, 0};
   first.fa = feval(s, t, a, &first.dfa);
   first.fb = feval(s, t, b, &first.dfb);
@@ -357,19 +363,17 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
   while (sp) {
     segment sg = stack[--sp];
     if (s->st) s->st->segments++;
-    dt_tape view;
-    if (sg.depth == 0) {
-      view = *t;
-    } else {
+    const dt_tape *vp = t;   /* this segment's view; level 0 is t */
+    if (sg.depth > 0) {
       int from = sg.depth - 1 < s->nlv - 1 ? sg.depth - 1 : s->nlv - 1;
       int to = sg.depth < s->nlv ? sg.depth : s->nlv;
-      dt_prune_rl(&lv[from], s->rl, sg.a, sg.b,
-                  s->lvbuf + (size_t)to * s->ncode, &view);
-      if (to < s->nlv) lv[to] = view;
+      dt_prune_rl(from ? &lv[from] : t, s->rl, sg.a, sg.b,
+                  s->lvbuf + (size_t)to * s->ncode, &lv[to]);
+      vp = &lv[to];
     }
-    int nc = view.ncode;
+    int nc = vp->ncode;
     lg_bounds lb;
-    eval_bounds(&view, s->rl, s->o, s->d, sg.a, sg.b, &lb);
+    eval_bounds(vp, s->rl, s->o, s->d, sg.a, sg.b, &lb);
     double margin = 1e-12 * (1 + fabs(lb.lo) + fabs(lb.hi));
     if (lb.lo > 0.5 + margin || lb.hi < 0.5 - margin) {
       trace(s, &sg, &lb, INFINITY, LG_SEG_EXCLUDED, nc, 0);
@@ -396,19 +400,19 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     if (shorty) {
       if (pos(sg.fa) != pos(sg.fb)) {
         nroots = 1;
-        more = emit(s, polish(s, &view, sg.a, sg.b, sg.fa, sg.fb, sg.dfa, sg.dfb),
+        more = emit(s, polish(s, vp, sg.a, sg.b, sg.fa, sg.fb, sg.dfa, sg.dfb),
                     pos(sg.fa) ? LG_EXIT : LG_ENTER);
       }
       trace(s, &sg, &lb, lhs, nroots ? LG_SEG_ROOT : LG_SEG_NO_ROOT, nc,
             nroots);
     } else if (tiny) {
-      more = tiny_rule(s, &view, &sg, lb.G, &nroots);
+      more = tiny_rule(s, vp, &sg, lb.G, &nroots);
       trace(s, &sg, &lb, lhs, LG_SEG_TINY, nc, nroots);
     } else {
       trace(s, &sg, &lb, lhs, LG_SEG_SPLIT, nc, 0);
       segment left = sg, right = sg;
       double fm, dfm;
-      fm = feval(s, &view, m, &dfm);
+      fm = feval(s, vp, m, &dfm);
       left.b = right.a = m;
       left.fb = right.fa = fm;
       left.dfb = right.dfa = dfm;
