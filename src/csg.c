@@ -456,11 +456,19 @@ static int convex_span(const csg_tape *t, int g, const double o[3],
     if (kd > 0) {
       if (ts < s1) b = ts;
       if (!(a < b)) return 0;
-      if (b < t1) { t1 = b; id1 = id; }
+      if (b < t1) {
+        t1 = b;
+        id1 = id;
+        if (!(t0 < t1)) return 0;   /* empty: the rest cannot refill it */
+      }
     } else {
       if (ts > s0) a = ts;
       if (!(a < b)) return 0;
-      if (a > t0) { t0 = a; id0 = id; }
+      if (a > t0) {
+        t0 = a;
+        id0 = id;
+        if (!(t0 < t1)) return 0;
+      }
     }
   }
   if (!(t0 < t1)) return 0;
@@ -474,6 +482,9 @@ static int convex_span(const csg_tape *t, int g, const double o[3],
 int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
                   double s0, double s1, csg_span *out, int maxout,
                   csg_span *scratch, int nscratch) {
+  /* One convex polyhedron (a typical bound): straight to out. */
+  if (t->nrcode == 1 && t->rcode[0].op == CSG_CONVEX && maxout >= 1)
+    return convex_span(t, t->rcode[0].arg, o, d, s0, s1, out);
   csg_span local[CSG_LOCAL_SPANS];
   int need = csg_scratch_spans(t);
   if (!scratch) {

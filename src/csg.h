@@ -93,7 +93,8 @@ int csg_scratch_spans(const csg_tape *t);
 /* The inside spans of the ray o + s*d for s in [s0, s1], sorted and
  * disjoint, written to out (at most maxout).  d may have any non-zero
  * length; rays parallel to a plane are classified by their origin.
- * scratch may be NULL when csg_scratch_spans(t) <= CSG_LOCAL_SPANS.
+ * scratch may be NULL when csg_scratch_spans(t) <= CSG_LOCAL_SPANS (a tape
+ * that is one convex polyhedron needs none).
  * Returns the number of spans, or -1 if out or scratch is too small. */
 int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
                   double s0, double s1, csg_span *out, int maxout,
