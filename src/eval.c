@@ -118,7 +118,7 @@ Value *eval_con_value(Interp *I, Sym *s) {
     if (s->con_arity == 0) {
       s->con_value = val_con(s, 0, NULL);
     } else {
-      Value *v = GC_MALLOC(sizeof *v);
+      Value *v = val_cell();
       v->kind = V_FUNC;
       v->u.fn.kind = F_CON;
       v->u.fn.arity = s->con_arity;
@@ -145,7 +145,7 @@ static Value *lookup(Interp *I, Sym *s, Env *env, Pos pos) {
 /* ---- thunks ---- */
 
 static Value *mk_thunk(Expr *e, Env *env) {
-  Value *v = GC_MALLOC(sizeof *v);
+  Value *v = val_cell();
   v->kind = V_THUNK;
   v->u.thunk.e = e;
   v->u.thunk.env = env;
@@ -211,7 +211,7 @@ Value *delay(Interp *I, Expr *e, Env *env) {
 }
 
 Value *delay_apply(Value *f, int n, Value **args) {
-  Value *v = GC_MALLOC(sizeof *v);
+  Value *v = val_cell();
   v->kind = V_APTHUNK;
   v->u.pap.fn = f;
   v->u.pap.n = n;
@@ -384,7 +384,7 @@ static int match(Interp *I, Pat *p, Value *v, Env *frame) {
 static void pat_bind_vars(Pat *p, Value *whole, Env *frame, Pat *top) {
   switch (p->kind) {
   case P_VAR: {
-    Value *v = GC_MALLOC(sizeof *v);
+    Value *v = val_cell();
     v->kind = V_PATSEL;
     v->u.patsel.pat = top;
     v->u.patsel.var = p->u.var;
@@ -411,7 +411,7 @@ static void pat_bind_vars(Pat *p, Value *whole, Env *frame, Pat *top) {
 }
 
 static Value *mk_fn(Def *d, Env *env) {
-  Value *v = GC_MALLOC(sizeof *v);
+  Value *v = val_cell();
   v->kind = V_FUNC;
   v->u.fn.kind = F_DEF;
   v->u.fn.arity = d->arity;
@@ -575,7 +575,7 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
     }
     int a = f->u.fn.arity;
     if (n < a) {
-      Value *p = GC_MALLOC(sizeof *p);
+      Value *p = val_cell();
       p->kind = V_PAP;
       p->u.pap.fn = f;
       p->u.pap.n = n;

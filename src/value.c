@@ -42,8 +42,21 @@ Sym *sym_intern(Interp *I, const char *name, int len) {
   return s;
 }
 
+static void *cell_batch;  /* GC_malloc_many's list, linked by GC_NEXT */
+
+Value *val_cell(void) {
+  if (!cell_batch) {
+    cell_batch = GC_malloc_many(sizeof(Value));
+    if (!cell_batch) return GC_MALLOC(sizeof(Value));  /* out of memory: */
+  }                                                    /* GC's own handler */
+  Value *v = cell_batch;
+  cell_batch = GC_NEXT(cell_batch);
+  GC_NEXT(v) = NULL;
+  return v;
+}
+
 static Value *alloc(VKind k) {
-  Value *v = GC_MALLOC(sizeof *v);
+  Value *v = val_cell();
   v->kind = (unsigned char)k;
   return v;
 }
@@ -113,12 +126,14 @@ Value *val_foreign(void *ptr, const char *tag) {
   return v;
 }
 
+/* The frame and its first arrays are one block (most frames never grow). */
 Env *env_new(Env *up, int cap) {
-  Env *e = GC_MALLOC(sizeof *e);
+  if (cap < 1) cap = 1;
+  Env *e = GC_MALLOC(sizeof *e + (sizeof(Sym *) + sizeof(Value *)) * (size_t)cap);
   e->up = up;
-  e->cap = cap > 0 ? cap : 1;
-  e->names = GC_MALLOC(sizeof(Sym *) * (size_t)e->cap);
-  e->vals = GC_MALLOC(sizeof(Value *) * (size_t)e->cap);
+  e->cap = cap;
+  e->names = (Sym **)(e + 1);
+  e->vals = (Value **)(e->names + cap);
   return e;
 }
 

@@ -75,6 +75,12 @@ struct Value {
   } u;
 };
 
+/* A new, zeroed Value cell from the collected heap. Cells come in batches
+   from GC_malloc_many, which costs far less per cell than GC_MALLOC; the
+   batch waits in a static list (a root the collector scans), so Values
+   must be allocated by one thread at a time, the interpreter's. */
+Value *val_cell(void);
+
 /* A frame of local bindings; `up` is the enclosing scope. */
 struct Env {
   Env *up;
