@@ -569,10 +569,11 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
     len = m * sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     if (!(len > 0) || !isfinite(len)) return -1;
   }
-  if (scratch->cap < obj->nkeys) return -1;
   if (!isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]) || t0 != t0 || t1 != t1)
     return -1;
+  /* No keys (SoftObject m []): nothing to cross, and no scratch needed. */
   if (maxout <= 0 || obj->nkeys == 0 || !(t0 < t1)) return 0;
+  if (!scratch || scratch->cap < obj->nkeys) return -1;
 
   /* Work in units of length along the unit direction (tau = t |d|). */
   ray_t r;
