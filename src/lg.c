@@ -452,7 +452,7 @@ static void ray_leaves_hull(const dt_tape *t, const double o[3],
 static int run(const dt_tape *t, const double o[3], const double d[3],
                const double *iv, int n, double tol, lg_root *out, int maxout,
                lg_stats *stats, const lg_hook *hook, int first,
-               double first_after) {
+               double first_after, int bounded_iv) {
   if (n <= 0 || maxout <= 0) return 0;
   dt_instr local[LG_LEVEL_CODE], *buf = local;
   dt_ray_leaf lrl[LG_LOCAL_LEAVES], *rl = lrl;
@@ -474,8 +474,15 @@ static int run(const dt_tape *t, const double o[3], const double d[3],
       return -1;
     }
   }
-  double hlo, hhi;
-  ray_leaves_hull(t, o, d, rl, &hlo, &hhi);
+  /* Intervals from the outer bound (bounded_iv) already lie where the
+   * filters are, unless an end is infinite (an unbounded object): the
+   * clip to the filters' hull, which costs two divisions per leaf, is
+   * only needed for those and for intervals from the caller. */
+  double hlo = -INFINITY, hhi = INFINITY;
+  if (bounded_iv && isfinite(iv[0]) && isfinite(iv[2 * n - 1]))
+    dt_ray_leaves(t, o, d, rl);
+  else
+    ray_leaves_hull(t, o, d, rl, &hlo, &hhi);
   search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
               rl, buf + nc, nlv, nc, first, first_after};
   for (int i = 0; i < n; i++) {
@@ -497,13 +504,13 @@ int lg_roots(const dt_tape *t, const double o[3], const double d[3],
              double t0, double t1, double tol, lg_root *out, int maxout,
              lg_stats *stats) {
   double iv[2] = {t0, t1};
-  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL, 0, 0);
+  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL, 0, 0, 0);
 }
 
 static int spans_run(const dt_tape *t, const double o[3], const double d[3],
                      double t0, double t1, const csg_span *spans, int nspans,
                      double tol, lg_root *out, int maxout, lg_stats *stats,
-                     const lg_hook *hook, int first) {
+                     const lg_hook *hook, int first, int bounded_iv) {
   double local[2 * 64], *iv = local;
   if (nspans > 64) {
     iv = malloc((size_t)nspans * 2 * sizeof *iv);
@@ -523,7 +530,8 @@ static int spans_run(const dt_tape *t, const double o[3], const double d[3],
     iv[2 * n + 1] = b;
     n++;
   }
-  int r = run(t, o, d, iv, n, tol, out, maxout, stats, hook, first, t0);
+  int r = run(t, o, d, iv, n, tol, out, maxout, stats, hook, first, t0,
+              bounded_iv);
   if (iv != local) free(iv);
   return r;
 }
@@ -533,7 +541,7 @@ int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
                    double tol, lg_root *out, int maxout, lg_stats *stats,
                    const lg_hook *hook) {
   return spans_run(t, o, d, t0, t1, spans, nspans, tol, out, maxout, stats,
-                   hook, 0);
+                   hook, 0, 0);
 }
 
 /* Figure 7 (c): search where outer and not inner. */
@@ -559,7 +567,7 @@ static int bounded(const dt_tape *t, const csg_tape *outer,
     if (m >= 0) {
       int k = csg_spans_diff(os, n, is, m, ds);
       r = spans_run(t, o, d, t0, t1, ds, k, tol, out, maxout, stats, hook,
-                    first);
+                    first, 1);
     }
   }
   if (mem != local) free(mem);
