@@ -199,6 +199,7 @@ typedef struct {
   int first;          /* stop at the first crossing after first_after; 2:
                          any point of its bracket will do (polish) */
   double first_after;
+  double *grad;       /* if not NULL: the gradient at that crossing */
 } search;
 
 static double feval(search *s, const dt_tape *t, double x, double *df) {
@@ -207,7 +208,7 @@ static double feval(search *s, const dt_tape *t, double x, double *df) {
 }
 
 /* Returns 0 when out is full (the search stops). */
-static int emit(search *s, double t, int kind) {
+static int emit(search *s, const dt_tape *view, double t, int kind) {
   if (s->n >= s->maxout) return 0;
   /* One graze seen from two adjacent tiny segments is one touch. */
   if (kind == LG_TOUCH && s->n > 0 && t - s->out[s->n - 1].t <= s->tol)
@@ -216,7 +217,14 @@ static int emit(search *s, double t, int kind) {
   s->out[s->n].kind = kind;
   s->n++;
   if (kind == LG_TOUCH && s->st) s->st->touches++;
-  if (s->first && kind != LG_TOUCH && t > s->first_after) return 0;
+  if (s->first && kind != LG_TOUCH && t > s->first_after) {
+    if (s->grad) {   /* from the segment's pruned tape: few leaves */
+      double p[3];
+      for (int i = 0; i < 3; i++) p[i] = s->o[i] + t * s->d[i];
+      dt_density_grad(view, p, s->grad);
+    }
+    return 0;
+  }
   return s->n < s->maxout;
 }
 
@@ -308,7 +316,7 @@ static int tiny_rule(search *s, const dt_tape *t, const segment *sg, double G,
   if (pa != pb) {
     (*nroots)++;
     double x = polish(s, t, sg->a, sg->b, sg->fa, sg->fb, sg->dfa, sg->dfb);
-    return emit(s, x, pa ? LG_EXIT : LG_ENTER);
+    return emit(s, t, x, pa ? LG_EXIT : LG_ENTER);
   }
   if (isinf(G)) return 1;
   double m = 0.5 * (sg->a + sg->b);
@@ -320,12 +328,13 @@ static int tiny_rule(search *s, const dt_tape *t, const segment *sg, double G,
   if (pos(fm) != pa) {
     int k1 = pa ? LG_EXIT : LG_ENTER;
     *nroots += 2;
-    if (!emit(s, polish(s, t, sg->a, m, sg->fa, fm, sg->dfa, dfm), k1)) return 0;
-    return emit(s, polish(s, t, m, sg->b, fm, sg->fb, dfm, sg->dfb), -k1);
+    if (!emit(s, t, polish(s, t, sg->a, m, sg->fa, fm, sg->dfa, dfm), k1))
+      return 0;
+    return emit(s, t, polish(s, t, m, sg->b, fm, sg->fb, dfm, sg->dfb), -k1);
   }
   if (fm == 0 || sg->fa == 0 || sg->fb == 0) {
     (*nroots)++;
-    return emit(s, fm == 0 ? m : sg->fa == 0 ? sg->a : sg->b, LG_TOUCH);
+    return emit(s, t, fm == 0 ? m : sg->fa == 0 ? sg->a : sg->b, LG_TOUCH);
   }
   double h1 = m - sg->a, h2 = sg->b - m;
   double lb1 = fmax(envelope_min(sg->fa, sg->dfa, G, h1),
@@ -334,7 +343,7 @@ static int tiny_rule(search *s, const dt_tape *t, const segment *sg, double G,
                     envelope_min(sg->fb, -sg->dfb, G, h2));
   if (lb1 > 0 && lb2 > 0) return 1;
   (*nroots)++;
-  return emit(s, m, LG_TOUCH);
+  return emit(s, t, m, LG_TOUCH);
 }
 
 static void trace(search *s, const segment *sg, const lg_bounds *lb,
@@ -400,7 +409,7 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     if (shorty) {
       if (pos(sg.fa) != pos(sg.fb)) {
         nroots = 1;
-        more = emit(s, polish(s, vp, sg.a, sg.b, sg.fa, sg.fb, sg.dfa, sg.dfb),
+        more = emit(s, vp, polish(s, vp, sg.a, sg.b, sg.fa, sg.fb, sg.dfa, sg.dfb),
                     pos(sg.fa) ? LG_EXIT : LG_ENTER);
       }
       trace(s, &sg, &lb, lhs, nroots ? LG_SEG_ROOT : LG_SEG_NO_ROOT, nc,
@@ -452,7 +461,7 @@ static void ray_leaves_hull(const dt_tape *t, const double o[3],
 static int run(const dt_tape *t, const double o[3], const double d[3],
                const double *iv, int n, double tol, lg_root *out, int maxout,
                lg_stats *stats, const lg_hook *hook, int first,
-               double first_after, int bounded_iv) {
+               double first_after, int bounded_iv, double *grad) {
   if (n <= 0 || maxout <= 0) return 0;
   dt_instr local[LG_LEVEL_CODE], *buf = local;
   dt_ray_leaf lrl[LG_LOCAL_LEAVES], *rl = lrl;
@@ -484,7 +493,7 @@ static int run(const dt_tape *t, const double o[3], const double d[3],
   else
     ray_leaves_hull(t, o, d, rl, &hlo, &hhi);
   search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
-              rl, buf + nc, nlv, nc, first, first_after};
+              rl, buf + nc, nlv, nc, first, first_after, grad};
   for (int i = 0; i < n; i++) {
     double a = iv[2 * i], b = iv[2 * i + 1];
     if (hlo > a) a = hlo;
@@ -504,13 +513,15 @@ int lg_roots(const dt_tape *t, const double o[3], const double d[3],
              double t0, double t1, double tol, lg_root *out, int maxout,
              lg_stats *stats) {
   double iv[2] = {t0, t1};
-  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL, 0, 0, 0);
+  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL, 0, 0, 0,
+             NULL);
 }
 
 static int spans_run(const dt_tape *t, const double o[3], const double d[3],
                      double t0, double t1, const csg_span *spans, int nspans,
                      double tol, lg_root *out, int maxout, lg_stats *stats,
-                     const lg_hook *hook, int first, int bounded_iv) {
+                     const lg_hook *hook, int first, int bounded_iv,
+                     double *grad) {
   double local[2 * 64], *iv = local;
   if (nspans > 64) {
     iv = malloc((size_t)nspans * 2 * sizeof *iv);
@@ -531,7 +542,7 @@ static int spans_run(const dt_tape *t, const double o[3], const double d[3],
     n++;
   }
   int r = run(t, o, d, iv, n, tol, out, maxout, stats, hook, first, t0,
-              bounded_iv);
+              bounded_iv, grad);
   if (iv != local) free(iv);
   return r;
 }
@@ -541,14 +552,15 @@ int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
                    double tol, lg_root *out, int maxout, lg_stats *stats,
                    const lg_hook *hook) {
   return spans_run(t, o, d, t0, t1, spans, nspans, tol, out, maxout, stats,
-                   hook, 0, 0);
+                   hook, 0, 0, NULL);
 }
 
 /* Figure 7 (c): search where outer and not inner. */
 static int bounded(const dt_tape *t, const csg_tape *outer,
                    const csg_tape *inner, const double o[3], const double d[3],
                    double t0, double t1, double tol, lg_root *out, int maxout,
-                   lg_stats *stats, const lg_hook *hook, int first) {
+                   lg_stats *stats, const lg_hook *hook, int first,
+                   double *grad) {
   int no = outer->nleaves + 1, ni = inner ? inner->nleaves + 1 : 0;
   int nsc = csg_scratch_spans(outer);
   if (inner && csg_scratch_spans(inner) > nsc) nsc = csg_scratch_spans(inner);
@@ -567,7 +579,7 @@ static int bounded(const dt_tape *t, const csg_tape *outer,
     if (m >= 0) {
       int k = csg_spans_diff(os, n, is, m, ds);
       r = spans_run(t, o, d, t0, t1, ds, k, tol, out, maxout, stats, hook,
-                    first, 1);
+                    first, 1, grad);
     }
   }
   if (mem != local) free(mem);
@@ -580,13 +592,14 @@ int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
                      lg_root *out, int maxout, lg_stats *stats,
                      const lg_hook *hook) {
   return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, hook,
-                 0);
+                 0, NULL);
 }
 
 int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
                      const csg_tape *inner, const double o[3],
                      const double d[3], double t0, double t1, double tol,
-                     lg_root *out, int maxout, lg_stats *stats, int any) {
+                     lg_root *out, int maxout, lg_stats *stats, int any,
+                     double grad[3]) {
   return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, NULL,
-                 any ? 2 : 1);
+                 any ? 2 : 1, grad);
 }

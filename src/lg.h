@@ -150,10 +150,14 @@ int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
  * only asks whether there is a crossing after t0) a crossing bracketed
  * after t0 is not polished: its reported t is the bracket's far end, in
  * (t0, t1] like the crossing, and the answer (a crossing after t0 or
- * none) is the same. */
+ * none) is the same.  grad (may be NULL) receives, when the search stops
+ * at such a crossing, the density gradient (dt_density_grad) at
+ * o + t d, evaluated on the tape pruned to the crossing's segment (the
+ * leaves that are constant there contribute nothing), for the normal. */
 int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
                      const csg_tape *inner, const double o[3],
                      const double d[3], double t0, double t1, double tol,
-                     lg_root *out, int maxout, lg_stats *stats, int any);
+                     lg_root *out, int maxout, lg_stats *stats, int any,
+                     double grad[3]);
 
 #endif

@@ -232,6 +232,17 @@ int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
   return cnt;
 }
 
+void ray_normal_grad(const double g[3], int flip, double n[3]) {
+  double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+  if (!(len > 0) || !isfinite(len)) {
+    n[0] = n[1] = 0;
+    n[2] = 1;
+    return;
+  }
+  double sgn = flip ? -1 : 1;
+  for (int i = 0; i < 3; i++) n[i] = sgn * g[i] / len;
+}
+
 void ray_normal(const Scene *s, int id, int flip, const double p[3],
                 double n[3]) {
   const ScNode *nd = &s->nodes[id];
@@ -251,12 +262,5 @@ void ray_normal(const Scene *s, int id, int flip, const double p[3],
   default:
     break;
   }
-  double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-  if (!(len > 0) || !isfinite(len)) {
-    n[0] = n[1] = 0;
-    n[2] = 1;
-    return;
-  }
-  double sgn = flip ? -1 : 1;
-  for (int i = 0; i < 3; i++) n[i] = sgn * g[i] / len;
+  ray_normal_grad(g, flip, n);
 }

@@ -54,4 +54,8 @@ void ray_reset(RayCtx *c);
 /* The outward unit normal of node's surface at p (the span end's id). */
 void ray_normal(const Scene *s, int id, int flip, const double p[3],
                 double n[3]);
+
+/* The unit normal along g, an outward (unnormalised) normal, as
+   ray_normal makes it; negated with flip; (0, 0, 1) if g is 0. */
+void ray_normal_grad(const double g[3], int flip, double n[3]);
 #endif

@@ -398,6 +398,8 @@ typedef struct Hit {
   double t;
   int prim;
   int id, flip;   /* the surface: scene node and orientation */
+  int has_grad;   /* a rounded primitive's hit: grad is its density */
+  double grad[3]; /* gradient there, from the root search */
 } Hit;
 
 /* The first surface crossing of one primitive in (t0, t1); with any != 0
@@ -418,6 +420,7 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
     h->t = t;
     h->id = node;
     h->flip = 0;
+    h->has_grad = 0;
     break;
   }
   case SC_ROUNDED: {
@@ -426,14 +429,17 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
     double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
     double tol = fmax(c->tol, 4e-16 * scale) / len;
     int nr = lg_first_bounded(n->tape, n->outer, n->inner, o, d, t0, t1, tol,
-                              roots, 8, &c->stats.lg, any);
+                              roots, 8, &c->stats.lg, any,
+                              any ? NULL : h->grad);
     int k = 0;
     while (k < nr && (roots[k].kind == LG_TOUCH || !(roots[k].t > t0))) k++;
     if (k >= nr) return 0;
     h->t = roots[k].t;
     h->id = node;
     h->flip = 0;
-    break;
+    h->has_grad = !any;   /* the search stopped at roots[k] */
+    h->prim = pi;
+    return 1;
   }
   case SC_SOFT: {
     double t;
@@ -442,10 +448,12 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
     h->t = t;
     h->id = node;
     h->flip = 0;
+    h->has_grad = 0;
     break;
   }
   default: {
     csg_span *sp;
+    h->has_grad = 0;
     ray_reset(c);
     int ns = ray_spans(s, node, o, d, t0, t1, c, &sp);
     int found = 0;
@@ -560,7 +568,12 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
   }
   double p[3], n[3];
   for (int i = 0; i < 3; i++) p[i] = o[i] + h.t * d[i];
-  ray_normal(T->s, h.id, h.flip, p, n);
+  if (h.has_grad) { /* outward is down the density gradient */
+    double g[3] = {-h.grad[0], -h.grad[1], -h.grad[2]};
+    ray_normal_grad(g, h.flip, n);
+  } else {
+    ray_normal(T->s, h.id, h.flip, p, n);
+  }
   if (dot3(n, d) > 0)
     for (int i = 0; i < 3; i++) n[i] = -n[i];
   *z = h.t; /* d is unit length: t is the distance */
