@@ -262,6 +262,7 @@ typedef struct Tracer {
   BvhNode *bvh;
   int nbvh;
   double eye[3], fwd[3], right[3], upv[3];
+  double coord_scale;       /* the largest |coordinate| of the eye and bounds */
   double lights[RENDER_MAX_LIGHTS][3];
   double intensity[RENDER_MAX_LIGHTS];
   int nlights;
@@ -740,6 +741,14 @@ static int setup_camera(Tracer *T, char *err, size_t errlen) {
     }
   }
   memcpy(T->eye, eye, sizeof eye);
+  /* Rounded roots are placed to max(tol, 4e-16 |o|) along a ray from o
+     (ray.c, lg.c): rays start at the eye or at a hit inside the bounds. */
+  T->coord_scale = 1;
+  for (int i = 0; i < 3; i++) {
+    T->coord_scale = fmax(T->coord_scale, fabs(eye[i]));
+    if (!box_is_empty(&all) && isfinite(all.lo[i]) && isfinite(all.hi[i]))
+      T->coord_scale = fmax(T->coord_scale, fmax(fabs(all.lo[i]), fabs(all.hi[i])));
+  }
   for (int i = 0; i < 3; i++) T->fwd[i] = at[i] - eye[i];
   double fl = sqrt(dot3(T->fwd, T->fwd));
   if (!(fl > 0) || !isfinite(fl)) {
@@ -850,6 +859,8 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   rep->spp = rs->spp;
   rep->threads = started + 1;
   rep->tol = rs->tol;
+  rep->coord_scale = T.coord_scale;
+  rep->tol_in_force = fmax(rs->tol, 4e-16 * T.coord_scale);
   rep->prims = T.nprims;
   rep->bounded_prims = T.nbounded;
   for (int i = 0; i < nthreads; i++) {
@@ -908,7 +919,12 @@ void render_report_print(FILE *out, const RenderReport *r, const char *path) {
             (double)r->rounded_hit_evals / r->rounded_hits);
   if (r->soft_solves)
     fprintf(out, "  soft objects: %ld polynomial solves\n", r->soft_solves);
+  if (r->tol_in_force > r->tol)
+    fprintf(out, "  root tolerance %g requested, %.2g in force: doubles "
+            "resolve no finer at coordinates of %.3g (the eye or the "
+            "scene); move them nearer the origin for more\n", r->tol,
+            r->tol_in_force, r->coord_scale);
   fprintf(out, "  root tolerance %g (scene units); %d primitive%s, %d in the "
-          "BVH\n", r->tol, r->prims, r->prims == 1 ? "" : "s",
-          r->bounded_prims);
+          "BVH\n", r->tol_in_force > r->tol ? r->tol_in_force : r->tol,
+          r->prims, r->prims == 1 ? "" : "s", r->bounded_prims);
 }

@@ -64,6 +64,9 @@ typedef struct RenderReport {
   long rounded_hits;         /* primary rays whose hit is a rounded surface */
   long rounded_hit_evals;    /* density evaluations those rays took */
   double tol;
+  double tol_in_force;       /* tol, or what doubles resolve at the scene's
+                                and the eye's coordinates if that is more */
+  double coord_scale;        /* the largest of those coordinates (>= 1) */
   int interrupted;
   int prims, bounded_prims;
 } RenderReport;

@@ -15,6 +15,7 @@
 #include "check.h"
 #include "image.h"
 #include "interp.h"
+#include "render.h"
 #include "render_lang.h"
 #include "value.h"
 
@@ -188,6 +189,53 @@ static void determinism_test(void) {
   img_free(ib);
 }
 
+/* The tolerance in force: the requested one near the origin; what doubles
+   resolve (4e-16 |x|) when the eye or the scene is far from it. */
+static RenderReport tol_rep;
+static int tol_capture(void *ctx, const struct Scene *s,
+                       const struct RenderSettings *rs, const char *path,
+                       char *err, size_t errlen) {
+  (void)ctx; (void)path;
+  RenderSettings r = *rs;
+  r.width = 24;
+  r.height = 16;
+  r.threads = 1;
+  r.progress = 0;
+  Image *im = render_scene(s, &r, &tol_rep, NULL, err, errlen);
+  if (!im) return -1;
+  img_free(im);
+  return 0;
+}
+
+static void tolerance_test(void) {
+  static const double far[] = {0, 1e6, 1e9};
+  for (int i = 0; i < 3; i++) {
+    char src[512], name[96];
+    snprintf(src, sizeof src,
+             "renderWith [Camera (%.17g, 2, 3) (%.17g, 0.5, 0.5) 40] "
+             "\"x.png\" (Shift (%.17g, 0, 0) (Rounded 0.1 UnitCube))\n",
+             far[i] + 2, far[i] + 0.5, far[i]);
+    RenderOverrides o = {0};
+    o.capture = tol_capture;
+    render_set_overrides(I, &o);
+    memset(&tol_rep, 0, sizeof tol_rep);
+    int st = interp_run_string(I, "<tol>", src, MODE_SCRIPT);
+    render_set_overrides(I, NULL);
+    /* The largest coordinate is the eye's, X + 2, or a conservative bound
+       of the cube (X + 1.1 padded by at most a few units at X = 1e9). */
+    long double want = 4e-16L * (far[i] + 2), want_hi = 4e-16L * (far[i] + 10);
+    if (want < 1e-9L) want = want_hi = 1e-9L;
+    snprintf(name, sizeof name, "tolerance in force with the scene at %g", far[i]);
+    if (getenv("QCS_TEST_VERBOSE"))
+      printf("# st %d tol %g in force %.17g want %.17Lg primary %ld\n", st,
+             tol_rep.tol, tol_rep.tol_in_force, want, tol_rep.primary);
+    CHECK(name, st == RUN_OK && tol_rep.tol == 1e-9 &&
+                    tol_rep.tol_in_force >= want * (1 - 1e-15L) &&
+                    tol_rep.tol_in_force <= want_hi * (1 + 1e-15L) &&
+                    tol_rep.primary == 24 * 16);
+  }
+}
+
 static void interrupt_test(void) {
   char out[512];
   snprintf(out, sizeof out, "%s/interrupted.png", tmpdir);
@@ -215,6 +263,7 @@ int main(void) {
     reference_test(scenes[i]);
   if (!getenv("QCS_UPDATE_REFERENCES")) {
     exr_test();
+    tolerance_test();
     determinism_test();
     interrupt_test();
   }
