@@ -55,13 +55,22 @@
 
 #define LG_LOCAL_CODE 512
 #define LG_STACK 256
+/* The most segments one interval's search may split (Figure 9). A ray that
+ * runs within rounding of the 0.5 level over a long stretch (a near-touch
+ * that doubles cannot settle, e.g. a filter radius of 1e15) would split
+ * down to the tolerance all along it; past the budget a segment is decided
+ * by the tiny-segment rule instead, which still finds every sign change
+ * but may miss a pair of crossings closer than the segment. Such segments
+ * are counted in lg_stats.overflows so that callers can say so. */
+#define LG_MAX_SEGMENTS 20000
 
 typedef struct lg_stats {
   long evals;        /* density (+ derivative) evaluations */
   long segments;     /* segments visited */
   long rf_steps;     /* root polishing steps (Newton or bisection) */
   long touches;      /* LG_TOUCH roots reported */
-  long overflows;    /* segments left unsplit because the stack was full */
+  long overflows;    /* segments left unsplit: the stack was full or the
+                        search's LG_MAX_SEGMENTS budget was spent */
 } lg_stats;
 
 enum { LG_EXIT = -1, LG_TOUCH = 0, LG_ENTER = 1 };

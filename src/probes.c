@@ -210,6 +210,13 @@ static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook) {
   ErrFrame f;
   if (ERR_TRY(f)) {
     v = roots_list(I, s, o, d, c, pos);
+    if (c->unresolved_node >= 0)
+      qcs_warning(s->nodes[c->unresolved_node].pos,
+                  "the root search left %ld segment%s of this object "
+                  "undecided (the ray runs within rounding of its surface "
+                  "for a long stretch): crossings that only touch the ray "
+                  "there may be missing", c->stats.lg.overflows,
+                  c->stats.lg.overflows == 1 ? "" : "s");
     err_pop(&f);
     ray_ctx_free(c);
     scene_free(s);

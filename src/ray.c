@@ -17,6 +17,7 @@ RayCtx *ray_ctx_new(const Scene *s, double tol) {
   RayCtx *c = calloc(1, sizeof *c);
   if (!c) return NULL;
   c->tol = tol;
+  c->unresolved_node = -1;
   if (s->max_keys) {
     c->soft = soft_scratch_new(s->max_keys);
     if (!c->soft) {
@@ -133,11 +134,11 @@ static int rounded_spans(const ScNode *n, int id, const double o[3],
                          const double d[3], double t0, double t1, RayCtx *c,
                          csg_span *out) {
   lg_root roots[MAX_LEAF_ROOTS];
-  long before = c->stats.lg.rf_steps + c->stats.lg.segments;
+  long unsplit = c->stats.lg.overflows;
   int nr = lg_roots_bounded(n->tape, n->outer, n->inner, o, d, t0, t1,
                             dist_tol(c, o, d), roots, MAX_LEAF_ROOTS,
                             &c->stats.lg, c->hook);
-  (void)before;
+  if (c->stats.lg.overflows != unsplit) c->unresolved_node = id;
   if (nr < 0) return -1;
   double p[3] = {o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2]};
   int inside = isfinite(t0) ? dt_density(n->tape, p) > 0.5 : 0;

@@ -37,6 +37,8 @@ typedef struct RayCtx {
   double tol;          /* root tolerance as a distance (scene units) */
   RayStats stats;
   const lg_hook *hook; /* optional trace of every root search segment */
+  int unresolved_node; /* a rounded node whose search left segments unsplit
+                          (lg_stats.overflows grew), or -1 */
 } RayCtx;
 
 RayCtx *ray_ctx_new(const Scene *s, double tol);

@@ -429,9 +429,12 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
     double len = sqrt(dot3(d, d));
     double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
     double tol = fmax(c->tol, 4e-16 * scale) / len;
+    long unsplit = c->stats.lg.overflows;
     int nr = lg_first_bounded(n->tape, n->outer, n->inner, o, d, t0, t1, tol,
                               roots, 8, &c->stats.lg, any,
                               any ? NULL : h->grad);
+    if (c->stats.lg.overflows != unsplit && c->unresolved_node < 0)
+      c->unresolved_node = node;
     int k = 0;
     while (k < nr && (roots[k].kind == LG_TOUCH || !(roots[k].t > t0))) k++;
     if (k >= nr) return 0;
@@ -859,6 +862,8 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   rep->spp = rs->spp;
   rep->threads = started + 1;
   rep->tol = rs->tol;
+  rep->unresolved = 0;
+  rep->unresolved_node = -1;
   rep->coord_scale = T.coord_scale;
   rep->tol_in_force = fmax(rs->tol, 4e-16 * T.coord_scale);
   rep->prims = T.nprims;
@@ -874,6 +879,8 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
     if (W->max_work > rep->max_ray_work) rep->max_ray_work = W->max_work;
     rep->rounded_hits += W->rounded_hits;
     rep->rounded_hit_evals += W->rounded_hit_evals;
+    rep->unresolved += W->c->stats.lg.overflows;
+    if (rep->unresolved_node < 0) rep->unresolved_node = W->c->unresolved_node;
   }
   if (abort_flag && *abort_flag && atomic_load(&T.done_tiles) < T.ntiles) {
     rep->interrupted = 1;
@@ -919,11 +926,19 @@ void render_report_print(FILE *out, const RenderReport *r, const char *path) {
             (double)r->rounded_hit_evals / r->rounded_hits);
   if (r->soft_solves)
     fprintf(out, "  soft objects: %ld polynomial solves\n", r->soft_solves);
-  if (r->tol_in_force > r->tol)
+  if (r->tol_in_force > r->tol && r->coord_scale > 1e3)
     fprintf(out, "  root tolerance %g requested, %.2g in force: doubles "
             "resolve no finer at coordinates of %.3g (the eye or the "
             "scene); move them nearer the origin for more\n", r->tol,
             r->tol_in_force, r->coord_scale);
+  else if (r->tol_in_force > r->tol)
+    fprintf(out, "  root tolerance %g requested, %.2g in force: doubles "
+            "resolve no finer (4e-16 x the coordinates, up to %.3g here)\n",
+            r->tol, r->tol_in_force, r->coord_scale);
+  if (r->unresolved)
+    fprintf(out, "  %ld root-search segment%s left undecided (rays within "
+            "rounding of a surface for a long stretch; see the warning)\n",
+            r->unresolved, r->unresolved == 1 ? "" : "s");
   fprintf(out, "  root tolerance %g (scene units); %d primitive%s, %d in the "
           "BVH\n", r->tol_in_force > r->tol ? r->tol_in_force : r->tol,
           r->prims, r->prims == 1 ? "" : "s", r->bounded_prims);

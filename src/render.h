@@ -67,6 +67,10 @@ typedef struct RenderReport {
   double tol_in_force;       /* tol, or what doubles resolve at the scene's
                                 and the eye's coordinates if that is more */
   double coord_scale;        /* the largest of those coordinates (>= 1) */
+  long unresolved;           /* root-search segments left unsplit (lg.h,
+                                LG_MAX_SEGMENTS): a touch may be missing */
+  int unresolved_node;       /* the first scene node where that happened,
+                                or -1 */
   int interrupted;
   int prims, bounded_prims;
 } RenderReport;

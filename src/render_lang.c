@@ -193,6 +193,13 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
   Scene *s = scene_compile(I, obj, pos);
   RenderReport rep;
   Image *im = render_scene(s, &rs, &rep, &qcs_interrupted, err, sizeof err);
+  if (im && rep.unresolved > 0 && rep.unresolved_node >= 0)
+    qcs_warning(s->nodes[rep.unresolved_node].pos,
+                "the root search left %ld segment%s of this object "
+                "undecided (rays that run within rounding of its surface "
+                "for a long stretch): a part that only touches those rays "
+                "may be missing from %s", rep.unresolved,
+                rep.unresolved == 1 ? "" : "s", path);
   scene_free(s);
   if (!im) {
     if (rep.interrupted) {
