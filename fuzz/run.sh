@@ -17,10 +17,10 @@ for t in "$@"; do
   bin=$B/fuzz/fuzz_$t
   [ -x "$bin" ] || { echo "fuzz: $bin is not built (make fuzz-build)" >&2; exit 1; }
   mkdir -p "$B/corpus/$t" "fuzz/corpus/$t"
-  seeds="fuzz/corpus/$t"; dict=""; len=4096
+  seeds="fuzz/corpus/$t"; dict=""; len=4096; TIMEOUT=10
   case $t in
     parse|eval) seeds="$seeds tests/lang tests/bad examples"; dict="-dict=fuzz/qcs.dict" ;;
-    probes) len=512 ;;
+    probes) len=512; TIMEOUT=60 ;;
     image) len=65536 ;;
   esac
   for d in $seeds; do [ -d "$d" ] || seeds=$(echo "$seeds" | sed "s|$d||"); done
@@ -29,7 +29,7 @@ for t in "$@"; do
   log=$B/fuzz-$t.log
   # -fork=1 with -ignore_*: a crash is saved and the run goes on.
   "$bin" "$B/corpus/$t" $seeds $dict -max_len=$len \
-    -max_total_time="$FUZZ_TIME" -timeout=10 -rss_limit_mb=3072 \
+    -max_total_time="$FUZZ_TIME" -timeout=$TIMEOUT -rss_limit_mb=3072 \
     -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
     -close_fd_mask=3 -artifact_prefix="$B/crashes/$t-" >"$log" 2>&1
   runs=$(grep -o '#[0-9]*' "$log" | tail -1 | tr -d '#')
