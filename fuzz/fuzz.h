@@ -16,6 +16,8 @@
 #include <string.h>
 
 #include "interp.h"
+#include "render.h"
+#include "render_lang.h"
 #include "value.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -43,5 +45,25 @@ static inline char *fuzz_text(const uint8_t *data, size_t size) {
 static inline void fuzz_limits(Interp *I) {
   interp_set_max_steps(I, FUZZ_MAX_STEPS);
   interp_set_max_memory(I, FUZZ_MAX_MEMORY);
+}
+/* A render capture hook (render_lang.h) for the targets: renders the
+   compiled scene at 12 x 8, one sample, one thread, and throws the image
+   away, so that nothing is written. */
+static inline int fuzz_tiny_render(void *ctx, const struct Scene *s,
+                                   const struct RenderSettings *rs,
+                                   const char *path, char *err,
+                                   size_t errlen) {
+  (void)ctx; (void)path;
+  RenderSettings small = *rs;
+  small.width = 12;
+  small.height = 8;
+  small.spp = 1;
+  small.threads = 1;
+  small.progress = 0;
+  RenderReport rep;
+  Image *im = render_scene(s, &small, &rep, NULL, err, errlen);
+  if (!im) return -1;
+  img_free(im);
+  return 0;
 }
 #endif

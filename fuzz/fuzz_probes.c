@@ -190,29 +190,12 @@ static void probe(Gen *g) {
   }
 }
 
-static int tiny_render(void *ctx, const struct Scene *s,
-                       const struct RenderSettings *rs, const char *path,
-                       char *err, size_t errlen) {
-  (void)ctx; (void)path;
-  RenderSettings small = *rs;
-  small.width = 12;
-  small.height = 8;
-  small.spp = 1;
-  small.threads = 1;
-  small.progress = 0;
-  RenderReport rep;
-  Image *im = render_scene(s, &small, &rep, NULL, err, errlen);
-  if (!im) return -1;
-  img_free(im);
-  return 0;
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   static Interp *I;
   static RenderOverrides ov;
   if (!I) {
     I = interp_new();
-    ov.capture = tiny_render;
+    ov.capture = fuzz_tiny_render;
     render_set_overrides(I, &ov);
     fuzz_limits(I);
   }
