@@ -365,6 +365,7 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
   segment stack[LG_STACK];
   dt_tape lv[LG_MAX_LEVELS + 1];   /* lv[nlv]: deeper segments' views */
   int sp = 0;
+  long budget = LG_MAX_SEGMENTS;
   segment first = {a, b, 0, 0, 0, 0, 0};
   first.fa = feval(s, t, a, &first.dfa);
   first.fb = feval(s, t, b, &first.dfb);
@@ -401,7 +402,7 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
         lb.split < sg.b - 0.25 * minlen)
       m = lb.split;
     int tiny = len <= minlen || !(m > sg.a && m < sg.b);
-    if (!shorty && !tiny && sp + 2 > LG_STACK) {
+    if (!shorty && !tiny && (sp + 2 > LG_STACK || --budget < 0)) {
       tiny = 1;
       if (s->st) s->st->overflows++;
     }
@@ -577,6 +578,20 @@ static int bounded(const dt_tape *t, const csg_tape *outer,
   } else if (n > 0) {
     int m = inner ? csg_ray_spans(inner, o, d, t0, t1, is, ni, sc, nsc) : 0;
     if (m >= 0) {
+      /* A crossing on a surface the two bounds share (a lone halfspace,
+       * whose 0.5 isosurface is its plane; a sharp leaf's plane) lies on
+       * the inner bound's surface, and rounding may make outer minus inner
+       * empty there (the bounds' few ulps of offset vanish in n.o at the
+       * ray's coordinates): move the inner spans' surface ends in by the
+       * padding spans_run widens by, so such a crossing is searched. */
+      int w = 0;
+      for (int i = 0; i < m; i++) {
+        csg_span s = is[i];
+        if (s.id0 >= 0) s.t0 += tol + 8 * DBL_EPSILON * fabs(s.t0);
+        if (s.id1 >= 0) s.t1 -= tol + 8 * DBL_EPSILON * fabs(s.t1);
+        if (s.t0 < s.t1) is[w++] = s;
+      }
+      m = w;
       int k = csg_spans_diff(os, n, is, m, ds);
       r = spans_run(t, o, d, t0, t1, ds, k, tol, out, maxout, stats, hook,
                     first, 1, grad);
