@@ -20,7 +20,7 @@ for t in "$@"; do
   seeds="fuzz/corpus/$t"; dict=""; len=4096; TIMEOUT=10
   case $t in
     parse|eval) seeds="$seeds tests/lang tests/bad examples"; dict="-dict=fuzz/qcs.dict" ;;
-    probes) len=512; TIMEOUT=60 ;;
+    probes) len=512; TIMEOUT=120 ;;
     image) len=65536 ;;
   esac
   for d in $seeds; do [ -d "$d" ] || seeds=$(echo "$seeds" | sed "s|$d||"); done
