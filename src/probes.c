@@ -139,7 +139,7 @@ static Value *bounds_probe(Interp *I, Value **args, Pos pos, int outer) {
   csg_tape *b = outer ? bnd_outer(tape, t, &flags) : bnd_inner(tape, t, &flags);
   dt_tape_free(tape);
   if (!b) qcs_error(pos, "out of memory");
-  if (flags & BND_RANGE)
+  if ((flags & BND_RANGE) && scene_sum_overlaps(I, args[2], pos))
     scene_warn_once(I, pos, "a Sum in this density tree may exceed 1 where "
                     "its parts overlap (the paper's Figure 15b): the bounds "
                     "hold by interval arithmetic, but seams may bulge");

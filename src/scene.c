@@ -434,6 +434,11 @@ static int sum_overlaps(Compile *C, Value *v) {
   return 1;
 }
 
+int scene_sum_overlaps(Interp *I, Value *tree, Pos pos) {
+  Compile C = {I, NULL, NULL, pos};
+  return sum_overlaps(&C, tree);
+}
+
 static int compile_obj(Compile *C, Value *v);
 
 /* Rounded r tree (also a density tree used as an object: r = 0, so that

@@ -77,6 +77,10 @@ dt_tape *scene_density_tape(Interp *I, Value *tree, double r, Pos pos);
 
 /* A warning at pos, given once per source position per interpreter. */
 void scene_warn_once(Interp *I, Pos pos, const char *msg);
+/* 1 if the two parts of some Sum in the density tree may overlap with
+   positive volume (density above 1 there, the paper's Figure 15b); parts
+   that only touch do not count. */
+int scene_sum_overlaps(Interp *I, Value *tree, Pos pos);
 
 /* Figure 4, PointInObject: 1 if p is inside the compiled object. */
 int scene_inside(const Scene *s, int node, const double p[3]);

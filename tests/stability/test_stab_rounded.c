@@ -411,6 +411,38 @@ static void test_budget(void) {
   scene_free(s);
 }
 
+/* The OuterBounds probe warns about Figure 15b only where summed parts
+ * overlap with volume, as the renderer does: not for parts that touch. */
+static int probe_warns(const char *text) {
+  fflush(stdout);
+  fflush(stderr);
+  int saved_err = dup(2), saved_out = dup(1);
+  FILE *tmp = tmpfile(), *null = fopen("/dev/null", "w");
+  dup2(fileno(tmp), 2);
+  dup2(fileno(null), 1);
+  RunStatus st = interp_run_string(stab_I, "<probe>", text, MODE_SCRIPT);
+  fflush(stdout);
+  fflush(stderr);
+  dup2(saved_err, 2);
+  dup2(saved_out, 1);
+  close(saved_err);
+  close(saved_out);
+  fclose(null);
+  rewind(tmp);
+  char buf[4096];
+  size_t k = fread(buf, 1, sizeof buf - 1, tmp);
+  buf[k] = 0;
+  fclose(tmp);
+  return st != RUN_OK ? -1 : strstr(buf, "Figure 15b") != NULL;
+}
+
+static void test_bounds_warning(void) {
+  CHECK("OuterBounds: no Figure 15b warning for summed cubes that touch",
+        probe_warns("OuterBounds 0.1 0.5 (Sum UnitCube (Shift (1, 0, 0) UnitCube))\n") == 0);
+  CHECK("OuterBounds: a Figure 15b warning for summed cubes that overlap",
+        probe_warns("OuterBounds 0.1 0.5 (Sum UnitCube (Shift (0.5, 0, 0) UnitCube))\n") == 1);
+}
+
 int main(void) {
   char base;
   stab_init("stab-rounded", &base);
@@ -419,5 +451,6 @@ int main(void) {
   test_grazing();
   test_figure15b();
   test_budget();
+  test_bounds_warning();
   CHECK_DONE();
 }
