@@ -107,12 +107,33 @@ static int bind_encode(exr_encode_pipeline_t *enc, const Chan *ch, int nch,
   return 0;
 }
 
+/* OpenEXR before 3.4.8 (Debian 12 has 3.1.5) keeps the zlib output of a
+ * ZIP chunk when it is exactly as long as the raw data, and its reader
+ * then takes those bytes for the raw data (upstream issue 2306): a small
+ * chunk of float pixels could come back as garbage (found by fuzz_image:
+ * a 1 x 1 float image of (1, 0, 0, 0)). The library's compressor is run
+ * through this wrapper, which stores the raw data in that case, as the
+ * format says and as fixed libraries do. */
+typedef struct {
+  exr_result_t (*compress)(exr_encode_pipeline_t *);
+} CompressWrap;
+
+static exr_result_t compress_raw_if_no_gain(exr_encode_pipeline_t *enc) {
+  const CompressWrap *w = enc->encoding_user_data;
+  exr_result_t rv = w->compress(enc);
+  if (rv == EXR_ERR_SUCCESS && enc->compressed_bytes == enc->packed_bytes &&
+      enc->compressed_buffer && enc->compressed_buffer != enc->packed_buffer)
+    memcpy(enc->compressed_buffer, enc->packed_buffer, enc->packed_bytes);
+  return rv;
+}
+
 static exr_result_t write_chunks(exr_context_t ctxt, const Image *im,
                                  const Chan *ch, int nch) {
   int32_t lines = 0;
   exr_result_t rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
   if (rv != EXR_ERR_SUCCESS) return rv;
   exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+  CompressWrap wrap = {NULL};
   int started = 0;
   for (int y = 0; y < im->height && rv == EXR_ERR_SUCCESS; y += lines) {
     exr_chunk_info_t ci;
@@ -126,8 +147,14 @@ static exr_result_t write_chunks(exr_context_t ctxt, const Image *im,
       rv = EXR_ERR_INVALID_ARGUMENT;
       break;
     }
-    if (!enc.convert_and_pack_fn)
+    if (!enc.convert_and_pack_fn) {
       rv = exr_encoding_choose_default_routines(ctxt, 0, &enc);
+      if (rv == EXR_ERR_SUCCESS && enc.compress_fn) {
+        wrap.compress = enc.compress_fn;
+        enc.encoding_user_data = &wrap;
+        enc.compress_fn = compress_raw_if_no_gain;
+      }
+    }
     if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ctxt, 0, &enc);
   }
   if (started) exr_encoding_destroy(ctxt, &enc);
