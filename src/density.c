@@ -284,22 +284,6 @@ static double leaf_va(double a, double *dda) {
   return (1 - a) * (1 - a) * (2 + a) * 0.25;
 }
 
-/* Derivative rules shared by the gradient and ray evaluators: combine
- * (x, dx) below with (y, dy) on top, for k components. */
-static double apply_d(int op, double x, const double *dx, double y,
-                      const double *dy, double *out, int k) {
-  for (int j = 0; j < k; j++) {
-    switch (op) {
-    case DT_SUM: out[j] = dx[j] + dy[j]; break;
-    case DT_PRODUCT: out[j] = dx[j] * y + x * dy[j]; break;
-    case DT_DIFF: out[j] = dx[j] - dy[j]; break;
-    case DT_RDIFF: out[j] = dy[j] - dx[j]; break;
-    default: out[j] = dx[j] * (1 - y) + dy[j] * (1 - x); break;
-    }
-  }
-  return apply(op, x, y);
-}
-
 /* Section 2.4: gradient by the usual differentiation rules. */
 double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
   /* z[k]: the gradient of stack entry k is zero (a leaf outside its
@@ -367,35 +351,20 @@ double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
 }
 
 /* Section 2.4 along a ray: rho(o + s d) and d rho/ds by the chain rule,
- * d alpha/ds = (n.d)/r, so any length of d is handled exactly. */
+ * d alpha/ds = (n.d)/r, so any length of d is handled exactly. The leaves'
+ * distances are tabulated (dt_ray_leaves) and dt_density_rl, the search's
+ * own evaluator, does the rest. */
 double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
                       double s, double *drho_ds) {
-  double v[DT_STACK_MAX], dv[DT_STACK_MAX];
-  int sp = 0;
-  for (int i = 0; i < t->ncode; i++) {
-    const dt_instr *in = &t->code[i];
-    if (in->op == DT_LEAF) {
-      const dt_leaf *lf = &t->leaves[in->arg];
-      double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
-      double dist = leaf_dist(lf, o) + s * nd, dda = 0;
-      if (lf->r > 0) v[sp] = leaf_va(dist * lf->inv_r, &dda);
-      else v[sp] = dt_halfspace(dist, 0);
-      dv[sp] = dda * nd * lf->inv_r;
-      sp++;
-    } else if (in->op == DT_CONST) {
-      v[sp] = in->c;
-      dv[sp] = 0;
-      sp++;
-    } else {
-      sp--;
-      double out;
-      v[sp - 1] = apply_d(in->op, v[sp - 1], &dv[sp - 1], v[sp], &dv[sp],
-                          &out, 1);
-      dv[sp - 1] = out;
-    }
+  dt_ray_leaf local[64], *rl = local;
+  if (t->nleaves > 64) {
+    rl = malloc(sizeof *rl * (size_t)t->nleaves);
+    if (!rl) return NAN;
   }
-  if (drho_ds) *drho_ds = dv[0];
-  return v[0];
+  dt_ray_leaves(t, o, d, rl);
+  double v = dt_density_rl(t, rl, s, drho_ds);
+  if (rl != local) free(rl);
+  return v;
 }
 
 void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],

@@ -690,7 +690,8 @@ static void test_prune(void) {
         double vray = dt_density_ray(tp, o, d, s, &dray);
         double vview = dt_density_rl(&v1, rl, s, &dview);
         pts++;
-        /* promised: dt_density_rl is dt_density_ray to the last bit */
+        /* dt_density_ray is now dt_ray_leaves + dt_density_rl: this guards
+           that wrapper; the references below test the evaluator itself */
         if (!same_bits(vfull, vray) || !same_bits(dfull, dray)) {
           rl_bad++;
           note("density_rl: tree %d ray %d s %.17g: %.17g/%.17g vs "
