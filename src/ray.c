@@ -122,12 +122,10 @@ static int crossings_to_spans(const double *t, const int *kind, int nroots,
   return n;
 }
 
-static double dist_tol(const RayCtx *c, const double o[3], const double d[3]) {
+double ray_dist_tol(const RayCtx *c, const double o[3], const double d[3]) {
   double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
-  /* A distance tolerance in units of t; never below what doubles resolve
-     at the ray's origin. */
-  return fmax(c->tol, 4e-16 * scale) / len;
+  return fmax(c->tol, RAY_TOL_FLOOR * scale) / len;
 }
 
 static int rounded_spans(const ScNode *n, int id, const double o[3],
@@ -136,7 +134,7 @@ static int rounded_spans(const ScNode *n, int id, const double o[3],
   lg_root roots[MAX_LEAF_ROOTS];
   long unsplit = c->stats.lg.overflows;
   int nr = lg_roots_bounded(n->tape, n->outer, n->inner, o, d, t0, t1,
-                            dist_tol(c, o, d), roots, MAX_LEAF_ROOTS,
+                            ray_dist_tol(c, o, d), roots, MAX_LEAF_ROOTS,
                             &c->stats.lg, c->hook);
   if (c->stats.lg.overflows != unsplit) c->unresolved_node = id;
   if (nr < 0) return -1;

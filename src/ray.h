@@ -41,6 +41,14 @@ typedef struct RayCtx {
                           (lg_stats.overflows grew), or -1 */
 } RayCtx;
 
+/* The finest root tolerance doubles allow at coordinates of size scale
+   (>= 1): RAY_TOL_FLOOR * scale. */
+#define RAY_TOL_FLOOR 4e-16
+
+/* The root tolerance in units of t along o + t d: c->tol as a distance,
+   never below what doubles resolve at the ray's origin. */
+double ray_dist_tol(const RayCtx *c, const double o[3], const double d[3]);
+
 RayCtx *ray_ctx_new(const Scene *s, double tol);
 void ray_ctx_free(RayCtx *c);
 

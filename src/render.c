@@ -426,9 +426,7 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
   }
   case SC_ROUNDED: {
     lg_root roots[8];
-    double len = sqrt(dot3(d, d));
-    double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
-    double tol = fmax(c->tol, 4e-16 * scale) / len;
+    double tol = ray_dist_tol(c, o, d);
     long unsplit = c->stats.lg.overflows;
     int nr = lg_first_bounded(n->tape, n->outer, n->inner, o, d, t0, t1, tol,
                               roots, 8, &c->stats.lg, any,
@@ -744,8 +742,8 @@ static int setup_camera(Tracer *T, char *err, size_t errlen) {
     }
   }
   memcpy(T->eye, eye, sizeof eye);
-  /* Rounded roots are placed to max(tol, 4e-16 |o|) along a ray from o
-     (ray.c, lg.c): rays start at the eye or at a hit inside the bounds. */
+  /* Rounded roots are placed to ray_dist_tol: max(tol, RAY_TOL_FLOOR |o|)
+     along a ray from o: rays start at the eye or at a hit inside the bounds. */
   T->coord_scale = 1;
   for (int i = 0; i < 3; i++) {
     T->coord_scale = fmax(T->coord_scale, fabs(eye[i]));
@@ -865,7 +863,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   rep->unresolved = 0;
   rep->unresolved_node = -1;
   rep->coord_scale = T.coord_scale;
-  rep->tol_in_force = fmax(rs->tol, 4e-16 * T.coord_scale);
+  rep->tol_in_force = fmax(rs->tol, RAY_TOL_FLOOR * T.coord_scale);
   rep->prims = T.nprims;
   rep->bounded_prims = T.nbounded;
   for (int i = 0; i < nthreads; i++) {
