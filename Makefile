@@ -30,30 +30,57 @@ ALL_CFLAGS = -std=c11 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -DGC_THREADS \
              $(WARN) $(CFLAGS) $(PKG_CFLAGS) -MMD -MP -Isrc -I$(BUILD)
 LIBS    = $(PKG_LIBS) -lm -lpthread
 
-SRCS    := $(sort $(wildcard src/*.c))
+# (The layer libraries' prerequisites are computed per target.)
+.SECONDEXPANSION:
+
+# The layers, each a folder of src/ and a static library, from the ground
+# up (see README.md, "Layout"); tools/check-layers.sh fails the build on an
+# include that crosses a layer the wrong way.
+LAYERS  := core scene render lang bind study
+LIB_ORDER := study bind lang render scene core
+SRCS    := $(sort $(wildcard $(LAYERS:%=src/%/*.c) src/app/*.c))
 OBJS    := $(SRCS:src/%.c=$(BUILD)/%.o)
-LIBOBJS := $(filter-out $(BUILD)/main.o,$(OBJS))
+APP_OBJS := $(filter $(BUILD)/app/%,$(OBJS))
+layer_objs = $(filter $(BUILD)/$(1)/%,$(OBJS))
+LAYER_LIBS := $(LIB_ORDER:%=$(BUILD)/libqcs%.a)
+CORE_LIB := $(BUILD)/libqcscore.a
 UNIT_SRCS := $(sort $(wildcard tests/unit/test_*.c))
 UNIT_BINS := $(UNIT_SRCS:tests/unit/%.c=$(BUILD)/tests/%)
+# Kernel tests: they link the geometry core alone (no interpreter, no GC).
+KERNEL_TESTS := test_bounds test_density test_poly test_roots test_soft
+KERNEL_BINS := $(KERNEL_TESTS:%=$(BUILD)/tests/%)
 # The numerical stability suite (issue 6): same harness, MPFR references.
 STAB_SRCS := $(sort $(wildcard tests/stability/test_*.c))
 UNIT_BINS += $(STAB_SRCS:tests/stability/%.c=$(BUILD)/tests/%)
 # The fuzz targets of fuzz/ as plain programs that replay fuzz/corpus/.
 REPLAY_BINS := $(patsubst %,$(BUILD)/fuzz/replay_%,parse eval probes image)
 
-.PHONY: all units deps demo test check sanitize install uninstall clean bench update-references gallery
+.PHONY: all units deps demo test check sanitize install uninstall clean bench update-references gallery layers
 
 BIN ?= qcs
 
 all: $(BIN)
 
-$(BIN): $(OBJS)
-	$(CC) $(ALL_CFLAGS) -o $@ $(OBJS) $(LIBS)
+$(BIN): $(APP_OBJS) $(LAYER_LIBS) $(BUILD)/layers.ok
+	$(CC) $(ALL_CFLAGS) -o $@ $(APP_OBJS) $(LAYER_LIBS) $(LIBS)
+
+# One static library per layer.
+$(BUILD)/libqcs%.a: $$(call layer_objs,%)
+	@rm -f $@
+	$(AR) rcs $@ $^
+
+# The layering rule, checked on every build.
+$(BUILD)/layers.ok: tools/check-layers.sh $(wildcard src/*/*.c src/*/*.h)
+	@mkdir -p $(BUILD)
+	@sh tools/check-layers.sh src
+	@touch $@
+
+layers: $(BUILD)/layers.ok
 
 units: $(UNIT_BINS) $(REPLAY_BINS)
 
 $(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc
-	@mkdir -p $(BUILD)
+	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -c -o $@ $<
 
 # The prelude is qcs source, embedded in the binary as a C string.
@@ -61,13 +88,17 @@ $(BUILD)/prelude.inc: stdlib/prelude.qcs tools/embed.sh
 	@mkdir -p $(BUILD)
 	sh tools/embed.sh qcs_prelude_source < $< > $@.tmp && mv $@.tmp $@
 
-$(BUILD)/tests/%: tests/unit/%.c $(LIBOBJS) tests/unit/check.h
+$(KERNEL_BINS): $(BUILD)/tests/%: tests/unit/%.c $(CORE_LIB) tests/unit/check.h
 	@mkdir -p $(BUILD)/tests
-	$(CC) $(ALL_CFLAGS) -Itests/unit -o $@ $< $(LIBOBJS) $(LIBS) -lmpfr -lgmp
+	$(CC) $(ALL_CFLAGS) -Itests/unit -o $@ $< $(CORE_LIB) -lm -lmpfr -lgmp
 
-$(BUILD)/tests/%: tests/stability/%.c $(LIBOBJS) tests/unit/check.h
+$(BUILD)/tests/%: tests/unit/%.c $(LAYER_LIBS) tests/unit/check.h
 	@mkdir -p $(BUILD)/tests
-	$(CC) $(ALL_CFLAGS) -Itests/unit -Itests/stability -o $@ $< $(LIBOBJS) $(LIBS) -lmpfr -lgmp
+	$(CC) $(ALL_CFLAGS) -Itests/unit -o $@ $< $(LAYER_LIBS) $(LIBS) -lmpfr -lgmp
+
+$(BUILD)/tests/%: tests/stability/%.c $(LAYER_LIBS) tests/unit/check.h
+	@mkdir -p $(BUILD)/tests
+	$(CC) $(ALL_CFLAGS) -Itests/unit -Itests/stability -o $@ $< $(LAYER_LIBS) $(LIBS) -lmpfr -lgmp
 
 # deps: install (as root) or name the missing Debian packages.
 deps:
@@ -167,13 +198,13 @@ fuzz-build: deps
 fuzz-bins: $(FUZZ_TARGETS:%=$(BUILD)/fuzz/fuzz_%)
 
 # The same targets without libFuzzer, to replay fuzz/corpus/ in make test.
-$(BUILD)/fuzz/replay_%: fuzz/fuzz_%.c fuzz/replay.c fuzz/fuzz.h $(LIBOBJS)
+$(BUILD)/fuzz/replay_%: fuzz/fuzz_%.c fuzz/replay.c fuzz/fuzz.h $(LAYER_LIBS)
 	@mkdir -p $(BUILD)/fuzz
-	$(CC) $(ALL_CFLAGS) -Ifuzz -o $@ $< fuzz/replay.c $(LIBOBJS) $(LIBS)
+	$(CC) $(ALL_CFLAGS) -Ifuzz -o $@ $< fuzz/replay.c $(LAYER_LIBS) $(LIBS)
 
-$(BUILD)/fuzz/fuzz_%: fuzz/fuzz_%.c fuzz/fuzz.h $(LIBOBJS)
+$(BUILD)/fuzz/fuzz_%: fuzz/fuzz_%.c fuzz/fuzz.h $(LAYER_LIBS)
 	@mkdir -p $(BUILD)/fuzz
-	$(CC) $(ALL_CFLAGS) -fsanitize=fuzzer -Ifuzz -o $@ $< $(LIBOBJS) $(LIBS)
+	$(CC) $(ALL_CFLAGS) -fsanitize=fuzzer -Ifuzz -o $@ $< $(LAYER_LIBS) $(LIBS)
 
 install: qcs
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/qcs \

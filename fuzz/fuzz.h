@@ -15,10 +15,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "interp.h"
-#include "render.h"
-#include "render_lang.h"
-#include "value.h"
+#include "bind/bind.h"
+#include "lang/interp.h"
+#include "render/render.h"
+#include "bind/render_lang.h"
+#include "lang/value.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -59,7 +60,7 @@ static inline int fuzz_tiny_render(void *ctx, const struct Scene *s,
   small.height = 8;
   small.spp = 1;
   small.threads = 1;
-  small.progress = 0;
+  small.progress = NULL;
   RenderReport rep;
   Image *im = render_scene(s, &small, &rep, NULL, err, errlen);
   if (!im) return -1;

@@ -5,13 +5,13 @@
  * away. Probes and values print to stdout (make fuzz closes it). */
 #include "fuzz.h"
 
-#include "render.h"
-#include "render_lang.h"
+#include "render/render.h"
+#include "bind/render_lang.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   static RenderOverrides ov;
   ov.capture = fuzz_tiny_render;
-  Interp *I = interp_new();
+  Interp *I = bind_interp_new();
   render_set_overrides(I, &ov);
   fuzz_limits(I);
   FUZZ_STACK(I);

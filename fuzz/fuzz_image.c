@@ -12,7 +12,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
-#include "image.h"
+#include "render/image.h"
 
 typedef int (*Writer)(const Image *, FILE *, const ImgWriteOptions *,
                       const char *, char *, size_t);

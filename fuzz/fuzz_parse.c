@@ -5,9 +5,9 @@
 
 #include <gc.h>
 
-#include "error.h"
-#include "lex.h"
-#include "parse.h"
+#include "lang/error.h"
+#include "lang/lex.h"
+#include "lang/parse.h"
 
 static Interp *I;
 
@@ -24,7 +24,7 @@ static void parse_as(const Src *src, RunMode mode, int expr) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-  if (!I) I = interp_new();
+  if (!I) I = bind_interp_new();
   FUZZ_STACK(I);
   Src src = {"<fuzz>", fuzz_text(data, size)};
   parse_as(&src, MODE_SCRIPT, 0);

@@ -14,8 +14,8 @@
 #include <stdarg.h>
 #include <stdio.h>
 
-#include "render.h"
-#include "render_lang.h"
+#include "render/render.h"
+#include "bind/render_lang.h"
 
 typedef struct {
   const uint8_t *p;
@@ -194,7 +194,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   static Interp *I;
   static RenderOverrides ov;
   if (!I) {
-    I = interp_new();
+    I = bind_interp_new();
     ov.capture = fuzz_tiny_render;
     render_set_overrides(I, &ov);
     fuzz_limits(I);

@@ -47,11 +47,12 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "eval.h"
-#include "interp.h"
-#include "parse.h"
-#include "ray.h"
-#include "scene.h"
+#include "lang/eval.h"
+#include "bind/bind.h"
+#include "lang/interp.h"
+#include "lang/parse.h"
+#include "scene/ray.h"
+#include "bind/compile.h"
 
 #define STAB_PREC 200
 #define STAB_MAXR 256
@@ -541,7 +542,7 @@ static char stab_error[1100];
 /* base: a local of main, where the C stack begins. */
 static inline void stab_init(const char *prefix, char *base) {
   check_prefix = prefix;
-  stab_I = interp_new();
+  stab_I = bind_interp_new();
   interp_set_stack(stab_I, base, 4u << 20);
 }
 
@@ -561,7 +562,7 @@ static inline Scene *stab_compile(const char *text) {
   if (ERR_TRY(f)) {
     Expr *e = parse_expression(stab_I, src);
     Value *v = eval(stab_I, e, NULL);
-    s = scene_compile(stab_I, v, pos_none);
+    s = compile_scene(stab_I, v, pos_none);
     err_pop(&f);
   } else {
     err_pop(&f);

@@ -14,8 +14,8 @@
  *    reference and work per ray under a cap. */
 #include "stab.h"
 
-#include "bounds.h"
-#include "lg.h"
+#include "core/bounds.h"
+#include "core/lg.h"
 
 /* s with cap(s, r) = t, by bisection in MPFR on [-r, r]. */
 static double ref_disp(double r, double t) {

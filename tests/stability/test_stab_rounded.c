@@ -1,6 +1,6 @@
 /* test_stab_rounded.c: numerical stability of rounded polyhedra through
  * the scene-level ray API (scenes written in qcs, compiled with
- * scene_compile, traced with ray_spans), against the MPFR reference of
+ * compile_scene, traced with ray_spans), against the MPFR reference of
  * stab.h (Lobb eq. (1) as a cap-volume fraction, combined as Figure 4).
  *
  * Cases (issue 6): radii 1e-12 .. 1e3 on a unit cube and Rounded 0;

@@ -7,7 +7,7 @@
  *      src/soft.c src/poly.c -lm -lpthread -o /tmp/bench && /tmp/bench [N...]
  * Options: -t THREADS (default 2), -m MAXOUT for primary rays (default 1;
  * 0 = all crossings, 64). */
-#include "soft.h"
+#include "core/soft.h"
 
 #include <math.h>
 #include <pthread.h>

@@ -10,7 +10,7 @@
 #include <mpfr.h>
 #include <stdint.h>
 
-#include "density.h"
+#include "core/density.h"
 
 #define REF_PREC 320
 enum { R_LEAF, R_SUM, R_PROD, R_DIFF, R_UNION };

@@ -3,10 +3,10 @@
  * independent references of ref_density.h. */
 #include <float.h>
 
-#include "bounds.h"
+#include "core/bounds.h"
 #include "check.h"
-#include "csg.h"
-#include "density.h"
+#include "core/csg.h"
+#include "core/density.h"
 #include "ref_density.h"
 
 /* A sharp reading of an rtree: products are intersections, sums and

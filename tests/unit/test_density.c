@@ -4,7 +4,7 @@
 #include <float.h>
 
 #include "check.h"
-#include "density.h"
+#include "core/density.h"
 #include "ref_density.h"
 
 static const double EPS = DBL_EPSILON;

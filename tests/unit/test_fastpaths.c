@@ -25,13 +25,13 @@
  * the reference, the tree, the ray, every root and the bounds' spans. */
 #include <float.h>
 
-#include "bounds.h"
-#include "csg.h"
-#include "density.h"
-#include "image.h"
-#include "lg.h"
+#include "core/bounds.h"
+#include "core/csg.h"
+#include "core/density.h"
+#include "render/image.h"
+#include "core/lg.h"
 #include "ref_density.h"
-#include "render.h"
+#include "render/render.h"
 #include "../stability/stab.h"
 
 #define EPS DBL_EPSILON
@@ -1174,7 +1174,7 @@ static void test_render(void) {
   rs.width = 72;
   rs.height = 46;
   rs.threads = 2;
-  rs.progress = 0;
+  rs.progress = NULL;
   rs.camera_set = 1;
   double eye[3] = {2.25, 3.2, 5.0}, at[3] = {2.25, 0.5, -0.4};
   memcpy(rs.eye, eye, sizeof eye);

@@ -11,7 +11,7 @@
  * check that no temporary is left and an existing target is untouched.
  * Everything happens in a mkdtemp directory that is removed at the end. */
 #include "check.h"
-#include "image.h"
+#include "render/image.h"
 
 #include <dirent.h>
 #include <errno.h>

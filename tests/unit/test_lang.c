@@ -4,11 +4,12 @@
 #include <stdint.h>
 
 #include "check.h"
-#include "eval.h"
-#include "interp.h"
-#include "lex.h"
-#include "parse.h"
-#include "print.h"
+#include "lang/eval.h"
+#include "bind/bind.h"
+#include "lang/interp.h"
+#include "lang/lex.h"
+#include "lang/parse.h"
+#include "lang/print.h"
 
 static Interp *I;
 
@@ -218,7 +219,7 @@ static void test_print(void) {
 
 int main(void) {
   check_prefix = "lang";
-  I = interp_new();
+  I = bind_interp_new();
   char probe;
   interp_set_stack(I, &probe, 4u << 20);
   test_lexer();

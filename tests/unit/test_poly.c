@@ -8,7 +8,7 @@
  * tolerance beside each root is the first-order forward error of a double
  * evaluation near it: 2 * gamma_2n * sum |c_i||r|^i / |p'(r)| + 4 ulp. */
 #include "check.h"
-#include "poly.h"
+#include "core/poly.h"
 
 #include <float.h>
 #include <mpfr.h>

@@ -13,11 +13,12 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "image.h"
-#include "interp.h"
-#include "render.h"
-#include "render_lang.h"
-#include "value.h"
+#include "render/image.h"
+#include "bind/bind.h"
+#include "lang/interp.h"
+#include "render/render.h"
+#include "bind/render_lang.h"
+#include "lang/value.h"
 
 static Interp *I;
 static char tmpdir[] = "/tmp/qcs-test-render-XXXXXX";
@@ -200,7 +201,7 @@ static int tol_capture(void *ctx, const struct Scene *s,
   r.width = 24;
   r.height = 16;
   r.threads = 1;
-  r.progress = 0;
+  r.progress = NULL;
   Image *im = render_scene(s, &r, &tol_rep, NULL, err, errlen);
   if (!im) return -1;
   img_free(im);
@@ -253,7 +254,7 @@ static void interrupt_test(void) {
 int main(void) {
   check_prefix = "render";
   if (!mkdtemp(tmpdir)) return 1;
-  I = interp_new();
+  I = bind_interp_new();
   char probe;
   interp_set_stack(I, &probe, 4u << 20);
   static const char *const scenes[] = {

@@ -3,11 +3,11 @@
  * references from ref_density.h. */
 #include <float.h>
 
-#include "bounds.h"
+#include "core/bounds.h"
 #include "check.h"
-#include "csg.h"
-#include "density.h"
-#include "lg.h"
+#include "core/csg.h"
+#include "core/density.h"
+#include "core/lg.h"
 #include "ref_density.h"
 
 static void rand_dir(rng_t *g, double len, double d[3]) {

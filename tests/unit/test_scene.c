@@ -13,13 +13,14 @@
 #include <stdarg.h>
 
 #include "check.h"
-#include "csg.h"
-#include "eval.h"
-#include "interp.h"
-#include "parse.h"
-#include "ray.h"
+#include "core/csg.h"
+#include "lang/eval.h"
+#include "bind/bind.h"
+#include "lang/interp.h"
+#include "lang/parse.h"
+#include "scene/ray.h"
 #include "ref_density.h"
-#include "scene.h"
+#include "bind/compile.h"
 
 static Interp *I;
 static char last_error[1100];
@@ -42,7 +43,7 @@ static Scene *compile(const char *text) {
   if (ERR_TRY(f)) {
     Expr *e = parse_expression(I, src);
     Value *v = eval(I, e, NULL);
-    s = scene_compile(I, v, pos_none);
+    s = compile_scene(I, v, pos_none);
     err_pop(&f);
   } else {
     err_pop(&f);
@@ -1231,7 +1232,7 @@ static void test_compile(void) {
 
 int main(void) {
   check_prefix = "scene";
-  I = interp_new();
+  I = bind_interp_new();
   char probe;
   interp_set_stack(I, &probe, 4u << 20);
   test_compile();

@@ -10,7 +10,7 @@
  * between two samples (M DT^2, M a bound on |g''|); for those only the
  * well-conditioned reference crossings are required, not the count. */
 #include "check.h"
-#include "soft.h"
+#include "core/soft.h"
 
 #include <float.h>
 #include <mpfr.h>

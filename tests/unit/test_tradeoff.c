@@ -6,7 +6,7 @@
 #include <stdio.h>
 
 #include "check.h"
-#include "tradeoff.h"
+#include "study/tradeoff.h"
 
 static dt_tape *cube(double r) {
   dt_builder *b = dt_builder_new();

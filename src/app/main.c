@@ -1,0 +1,392 @@
+/* main.c: the command line.
+ *
+ *   qcs                  the REPL
+ *   qcs FILE...          run scripts in order, stopping at the first error
+ *   qcs -e EXPR          evaluate EXPR (prelude loaded), print it, exit
+ *   qcs tradeoff FILE    error against run time over root tolerances
+ *   qcs convolution      the quasi-convolution against the true one
+ *
+ * The interpreter runs on a thread of its own with a large stack, so that
+ * deep (non-tail) recursion in user programs is limited by a clear
+ * "recursion too deep" error rather than by the 8 MB default stack. */
+#include <gc.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "render/image.h"
+#include "bind/bind.h"
+#include "lang/interp.h"
+#include "bind/render_lang.h"
+#include "app/repl.h"
+#include "study/tradeoff.h"
+
+#define STACK_SIZE ((size_t)512 << 20) /* reserved, touched only as used */
+#define STACK_USE ((size_t)256 << 20)  /* ~350000 nested calls: max-stack */
+#define FALLBACK_STACK_USE ((size_t)6 << 20)
+
+typedef struct Options {
+  const char *exprs[64];
+  int nexprs;
+  const char *sets[64];
+  int nsets;
+  char **files;
+  int nfiles;
+  const char *limit_names[16]; /* --max-NAME VALUE, checked, in order */
+  const char *limit_values[16];
+  int nlimits;
+  unsigned long long max_spp, max_pixels; /* as given, or the defaults */
+  int status;
+  size_t stack_use, stack_reserved;
+  RenderOverrides render;
+  int tradeoff;            /* qcs tradeoff: files[0] is the script */
+  TradeoffOptions topt;
+} Options;
+
+static void usage(FILE *out) {
+  fprintf(out,
+          "usage: qcs [options] [FILE...]\n"
+          "\n"
+          "  qcs                 start the REPL\n"
+          "  qcs FILE...         run scripts (top-level expressions are printed)\n"
+          "  qcs -e EXPR         evaluate EXPR with the prelude loaded and print it\n"
+          "\n"
+          "options:\n"
+          "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
+          "  --set NAME=VALUE    replace the top-level definition NAME before\n"
+          "                      the scripts run (VALUE is a qcs expression)\n"
+          "  -o FILE             render to FILE (.exr, .png or .ppm): what the\n"
+          "                      scripts render, or else their `scene`\n"
+          "  --size WxH          image size, overriding the scripts' own\n"
+          "  --spp N             samples per pixel (1, 4, 9, ...: n x n strata)\n"
+          "  --threads N         render threads (default: all cores)\n"
+          "  --tolerance T       root tolerance, a distance (default 1e-9)\n"
+          "  --cost              add the root-finder cost channel to an EXR\n"
+          "  --float             EXR colour as 32-bit floats (default half)\n"
+          "\n"
+          "limits (an evaluation or render that passes one stops with an error;\n"
+          "in the REPL, :set lists and changes them):\n"
+          "  --max-stack SIZE    stack for nested calls, i.e. recursion depth\n"
+          "                      (default 256M; SIZE is a number with K, M, G)\n"
+          "  --max-steps N       evaluation steps of one top-level expression\n"
+          "                      (default 10000000000; 0 for no limit)\n"
+          "  --max-list N        elements of one list (default 10000000; 0: none)\n"
+          "  --max-memory SIZE   memory for values (default 8G, or half the RAM if\n"
+          "                      less; a bare number is megabytes; 0: no limit)\n"
+          "  --max-pixels N|WxH  pixels of one image (default 4096x4096)\n"
+          "  --max-spp N         samples per pixel (default 64, at most 256)\n"
+          "  -h, --help          this help\n"
+          "  -V, --version       the version\n"
+          "\n"
+          "The language is described in lang/ (lang/manual.md); `man qcs`.\n");
+}
+
+static void *run(void *arg) {
+  Options *o = arg;
+  Interp *I = bind_interp_new();
+  render_set_overrides(I, &o->render);
+  char probe;
+  interp_set_stack(I, &probe, o->stack_use);
+  interp_set_stack_reserved(I, o->stack_reserved);
+  for (int i = 0; i < o->nlimits; i++) {
+    char err[300];
+    if (strcmp(o->limit_names[i], "max-stack") &&
+        interp_set_limit(I, o->limit_names[i], o->limit_values[i], err,
+                         sizeof err)) {
+      fprintf(stderr, "qcs: error: --%s\n", err);
+      o->status = 1;
+      return NULL;
+    }
+  }
+  for (int i = 0; i < o->nsets; i++) {
+    const char *eq = strchr(o->sets[i], '=');
+    char name[256];
+    size_t n = (size_t)(eq - o->sets[i]);
+    if (n >= sizeof name) n = sizeof name - 1;
+    memcpy(name, o->sets[i], n);
+    name[n] = 0;
+    if (interp_set_override(I, name, eq + 1) != RUN_OK) {
+      o->status = 1;
+      return NULL;
+    }
+  }
+  if (o->tradeoff) {
+    o->status = tradeoff_file(I, o->files[0], &o->topt);
+    return NULL;
+  }
+  for (int i = 0; i < o->nfiles; i++)
+    if (interp_run_file(I, o->files[i]) != RUN_OK) {
+      o->status = 1;
+      return NULL;
+    }
+  for (int i = 0; i < o->nexprs; i++)
+    if (interp_eval_print(I, o->exprs[i]) != RUN_OK) {
+      o->status = 1;
+      return NULL;
+    }
+  /* -o with scripts that render nothing: render their `scene`. */
+  if (o->render.output && o->render.renders == 0 &&
+      render_lang_scene(I, o->render.output) != RUN_OK) {
+    o->status = 1;
+    return NULL;
+  }
+  if (o->nfiles == 0 && o->nexprs == 0) o->status = repl_run(I);
+  return NULL;
+}
+
+/* ---- qcs tradeoff / qcs convolution (issue 6) ---- */
+
+static void tradeoff_usage(FILE *out) {
+  fputs("usage: qcs tradeoff [--size WxH] [--threads N] [--repeats N] "
+        "[-o PLOT.svg] FILE.qcs\n"
+        "       qcs convolution\n"
+        "\n"
+        "tradeoff: render what FILE renders (or its `scene`) at root "
+        "tolerances\n1e-2 ... 1e-12, best of --repeats runs (default 3) "
+        "each; print time,\nevaluations and error against the 1e-12 rung; "
+        "plot error against time\n(default tradeoff.svg).\n"
+        "convolution: the quasi-convolutional surface against the true\n"
+        "convolution of the polyhedron with the ball, on canonical "
+        "objects.\n", out);
+}
+
+/* Parses the subcommand's arguments into o; -1: exit with status 1,
+   1: exit with status 0, 0: run. */
+static int tradeoff_args(int argc, char **argv, Options *o) {
+  o->tradeoff = 1;
+  for (int i = 2; i < argc; i++) {
+    const char *a = argv[i];
+    int w, h;
+    long n;
+    char c, *end;
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      tradeoff_usage(stdout);
+      return 1;
+    } else if (!strcmp(a, "--size") && i + 1 < argc &&
+               sscanf(argv[i + 1], "%dx%d%c", &w, &h, &c) == 2 && w > 0 &&
+               h > 0) {
+      o->topt.width = w;
+      o->topt.height = h;
+      i++;
+    } else if ((!strcmp(a, "--threads") || !strcmp(a, "--repeats")) &&
+               i + 1 < argc && (n = strtol(argv[i + 1], &end, 10)) >= 1 &&
+               n <= 256 && !*end) {
+      if (a[2] == 't') o->topt.threads = (int)n;
+      else o->topt.repeats = (int)n;
+      i++;
+    } else if (!strcmp(a, "-o") && i + 1 < argc) {
+      o->topt.svg = argv[++i];
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "qcs: error: tradeoff: bad option or argument '%s'\n", a);
+      tradeoff_usage(stderr);
+      return -1;
+    } else {
+      o->files[o->nfiles++] = argv[i];
+    }
+  }
+  if (o->nfiles != 1) {
+    fprintf(stderr, "qcs: error: tradeoff needs one scene file\n");
+    tradeoff_usage(stderr);
+    return -1;
+  }
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static Options o;
+  o.max_spp = QCS_DEFAULT_MAX_SPP;
+  o.max_pixels = QCS_DEFAULT_MAX_PIXELS;
+  o.files = calloc((size_t)argc + 1, sizeof(char *));
+  if (argc > 1 && !strcmp(argv[1], "convolution")) {
+    int help = argc == 3 && !strcmp(argv[2], "--help");
+    if (argc > 2) {
+      tradeoff_usage(help ? stdout : stderr);
+      return help ? 0 : 1;
+    }
+    return conv_report(stdout) ? 1 : 0;
+  }
+  int sub = argc > 1 && !strcmp(argv[1], "tradeoff");
+  if (sub) {
+    int rc = tradeoff_args(argc, argv, &o);
+    if (rc) return rc < 0 ? 1 : 0;
+  }
+  for (int i = 1; i < argc && !sub; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      usage(stdout);
+      return 0;
+    } else if (!strcmp(a, "-V") || !strcmp(a, "--version")) {
+      printf("qcs %s\n", interp_version());
+      return 0;
+    } else if (!strcmp(a, "-e") || !strcmp(a, "--eval")) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "qcs: error: %s needs an expression\n", a);
+        return 1;
+      }
+      if (o.nexprs == 64) {
+        fprintf(stderr, "qcs: error: too many -e options\n");
+        return 1;
+      }
+      o.exprs[o.nexprs++] = argv[++i];
+    } else if (!strcmp(a, "--set")) {
+      if (i + 1 >= argc || !strchr(argv[i + 1], '=')) {
+        fprintf(stderr, "qcs: error: --set needs NAME=VALUE\n");
+        return 1;
+      }
+      if (o.nsets == 64) {
+        fprintf(stderr, "qcs: error: too many --set options\n");
+        return 1;
+      }
+      o.sets[o.nsets++] = argv[++i];
+    } else if (!strncmp(a, "--max-", 6)) {
+      /* --max-NAME VALUE or --max-NAME=VALUE */
+      char name[32], err[300];
+      const char *eq = strchr(a, '='), *val;
+      size_t n = eq ? (size_t)(eq - a - 2) : strlen(a + 2);
+      if (n >= sizeof name) n = sizeof name - 1;
+      memcpy(name, a + 2, n);
+      name[n] = 0;
+      if (eq) val = eq + 1;
+      else if (i + 1 < argc) val = argv[++i];
+      else val = NULL;
+      unsigned long long v;
+      if (interp_limit_parse(name, val ? val : "", &v, err, sizeof err)) {
+        if (!strncmp(err, "unknown", 7)) {
+          const char *dym = strstr(err, "(did you mean ");
+          if (dym)
+            fprintf(stderr, "qcs: error: unknown option '%.*s' (did you "
+                    "mean --%s\n", (int)(eq ? eq - a : (int)strlen(a)), a,
+                    dym + 14);
+          else
+            fprintf(stderr, "qcs: error: unknown option '%.*s' (see qcs "
+                    "--help)\n", (int)(eq ? eq - a : (int)strlen(a)), a);
+        } else if (!val) {
+          fprintf(stderr, "qcs: error: --%s needs a value\n", name);
+        } else {
+          fprintf(stderr, "qcs: error: --%s\n", err);
+        }
+        return 1;
+      }
+      if (o.nlimits == 16) {
+        fprintf(stderr, "qcs: error: too many --max options\n");
+        return 1;
+      }
+      if (!strcmp(name, "max-stack")) o.stack_use = (size_t)v;
+      if (!strcmp(name, "max-spp")) o.max_spp = v;
+      if (!strcmp(name, "max-pixels")) o.max_pixels = v;
+      char *keep = malloc(strlen(name) + 1);
+      if (!keep) return 1;
+      strcpy(keep, name);
+      o.limit_names[o.nlimits] = keep;
+      o.limit_values[o.nlimits++] = val;
+    } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "qcs: error: %s needs a file name\n", a);
+        return 1;
+      }
+      o.render.output = argv[++i];
+    } else if (!strcmp(a, "--size")) {
+      int w, h;
+      char c;
+      if (i + 1 >= argc || sscanf(argv[i + 1], "%dx%d%c", &w, &h, &c) != 2 ||
+          w < 1 || h < 1) {
+        fprintf(stderr, "qcs: error: --size needs WxH, like 600x380\n");
+        return 1;
+      }
+      o.render.width = w;
+      o.render.height = h;
+      i++;
+    } else if (!strcmp(a, "--spp") || !strcmp(a, "--threads")) {
+      char *end;
+      long n = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : -1;
+      if (i + 1 >= argc || *end || n < (a[2] == 's' ? 1 : 1) || n > 256) {
+        fprintf(stderr, "qcs: error: %s needs a whole number from 1 to 256\n", a);
+        return 1;
+      }
+      if (a[2] == 's') o.render.spp = (int)n;
+      else o.render.threads = (int)n;
+      i++;
+    } else if (!strcmp(a, "--tolerance")) {
+      char *end;
+      double t = i + 1 < argc ? strtod(argv[i + 1], &end) : 0;
+      if (i + 1 >= argc || *end || !(t > 0) || t > 1e300) {
+        fprintf(stderr, "qcs: error: --tolerance needs a distance > 0\n");
+        return 1;
+      }
+      o.render.tol = t;
+      i++;
+    } else if (!strcmp(a, "--cost")) {
+      o.render.cost = 1;
+    } else if (!strcmp(a, "--float")) {
+      o.render.float_pixels = 1;
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "qcs: error: unknown option '%s' (see qcs --help)\n", a);
+      return 1;
+    } else {
+      o.files[o.nfiles++] = argv[i];
+    }
+  }
+  if (o.render.output && o.nfiles == 0 && o.nexprs == 0) {
+    fprintf(stderr, "qcs: error: -o needs a scene file to render\n");
+    return 1;
+  }
+  if (o.render.output) {
+    char err[300];
+    if (img_format(o.render.output, err, sizeof err) < 0 ||
+        render_writable(o.render.output, err, sizeof err) < 0) {
+      fprintf(stderr, "qcs: error: -o: %s\n", err);
+      return 1;
+    }
+  }
+  /* Options that pass a limit are refused before anything runs. */
+  if (o.render.spp && (unsigned long long)o.render.spp > o.max_spp) {
+    fprintf(stderr, "qcs: error: --spp %d is over %llu samples per pixel "
+            "(limit max-spp; raise it with --max-spp N)\n", o.render.spp,
+            o.max_spp);
+    return 1;
+  }
+  if (o.render.width && (unsigned long long)o.render.width *
+                                (unsigned long long)o.render.height >
+                            o.max_pixels) {
+    fprintf(stderr, "qcs: error: --size %dx%d is %llu pixels, over %llu "
+            "(limit max-pixels; raise it with --max-pixels N)\n",
+            o.render.width, o.render.height,
+            (unsigned long long)o.render.width *
+                (unsigned long long)o.render.height, o.max_pixels);
+    return 1;
+  }
+  GC_INIT();
+  GC_allow_register_threads();
+  /* Ctrl-C ends a script's evaluation or render with "interrupted" (no
+     partial image is ever left); the REPL installs its own handling. */
+  if (o.nfiles || o.nexprs || o.tradeoff) repl_install_sigint();
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  /* The stack reserved is a third more than max-stack allows, so that
+     what runs below the checks has room; :set max-stack may raise the
+     limit up to three quarters of it. */
+  int asked = o.stack_use != 0;
+  if (!asked) o.stack_use = STACK_USE;
+  o.stack_reserved = o.stack_use / 3 * 4;
+  if (o.stack_reserved < STACK_SIZE) o.stack_reserved = STACK_SIZE;
+  pthread_attr_setstacksize(&attr, o.stack_reserved);
+  pthread_t th;
+  if (pthread_create(&th, &attr, run, &o) != 0) {
+    if (asked) {
+      char sz[32];
+      interp_format_size(sz, sizeof sz, o.stack_use);
+      fprintf(stderr, "qcs: error: --max-stack %s: cannot reserve a stack "
+              "that large\n", sz);
+      return 1;
+    }
+    /* No big stack to be had: run here with the default one. */
+    o.stack_use = o.stack_reserved = FALLBACK_STACK_USE;
+    run(&o);
+  } else {
+    pthread_join(th, NULL);
+  }
+  fflush(stdout);
+  return o.status;
+}

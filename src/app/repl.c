@@ -1,0 +1,852 @@
+/* repl.c: the interactive front end (see repl.h).
+ *
+ * One entry is what the interpreter runs at once: a line, or several lines
+ * joined by '\n' while interp_run_string says RUN_INCOMPLETE, or a
+ * ":{ ... :}" block. The same feed_line() serves the terminal loop and the
+ * plain loop for piped input; only where lines come from differs.
+ *
+ * Signals: the handlers only set flags (for SIGINT also asking the
+ * interpreter to stop) and write a byte to a pipe that the prompt loop
+ * select()s on beside the terminal. So a Ctrl-C at the prompt is handled
+ * between keys, never inside readline, whichever thread the kernel gave
+ * the signal to (main runs the interpreter on a thread of its own, and the
+ * collector has threads too: blocking signals in this thread and waiting
+ * in pselect() would miss them). */
+#include "app/repl.h"
+#include "study/tradeoff.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/select.h>
+#include <unistd.h>
+
+#include <readline/history.h>
+#include <readline/readline.h>
+
+#define PROMPT      "qcs> "
+#define PROMPT_MORE "...> "
+#define HISTORY_FILE "/.qcs_history"
+#define HISTORY_MAX 1000
+#define SOURCE_NAME "<stdin>"
+
+/* Word breaks for name completion: what cannot be part of a name (a name
+   may hold a quote after its first letter: x'). File names after :load
+   break only at blanks and quotes. Not const: readline's word-break hook
+   returns a plain char *. */
+static char name_breaks[] = " \t\n\"\\`@$><=;|&{}()[],.+-*/^%!~#?:";
+static char file_breaks[] = " \t\n\"'";
+
+/* ---- signals ---- */
+
+static volatile sig_atomic_t got_sigint, got_sigwinch, got_sigcont;
+static volatile sig_atomic_t at_prompt;   /* waiting for a key */
+static volatile sig_atomic_t sigint_count; /* Ctrl-Cs during one entry */
+static int stderr_is_tty; /* set before the handler is installed */
+static int wake_pipe[2] = {-1, -1}; /* handlers -> prompt loop */
+
+static void wake(void) {
+  if (wake_pipe[1] >= 0 && write(wake_pipe[1], "", 1) < 0) {
+    /* full: the loop has a byte to wake on already */
+  }
+}
+
+static void on_sigint(int sig) {
+  int saved = errno;
+  got_sigint = 1;
+  interp_request_interrupt();
+  wake();
+  /* An evaluation stuck where the interpreter does not look at the flag
+     must not hold the user hostage. */
+  if (!at_prompt && stderr_is_tty) { /* the tty echoed "^C"; end its line */
+    if (write(STDERR_FILENO, "\n", 1) < 0) { /* nothing to do */ }
+  }
+  if (!at_prompt && ++sigint_count >= 3) {
+    static const char msg[] = "\nqcs: interrupted three times, quitting\n";
+    if (write(STDERR_FILENO, msg, sizeof msg - 1) < 0) { /* nothing to do */ }
+    _exit(128 + SIGINT);
+  }
+  errno = saved;
+}
+
+static void on_sigwinch(int sig) {
+  int saved = errno;
+  got_sigwinch = 1;
+  wake();
+  errno = saved;
+}
+
+static void on_sigcont(int sig) {
+  int saved = errno;
+  got_sigcont = 1;
+  wake();
+  errno = saved;
+}
+
+static int open_wake_pipe(void) {
+  if (wake_pipe[0] >= 0) return 0;
+  if (pipe(wake_pipe) < 0) return -1;
+  for (int i = 0; i < 2; i++) {
+    fcntl(wake_pipe[i], F_SETFL, fcntl(wake_pipe[i], F_GETFL) | O_NONBLOCK);
+    fcntl(wake_pipe[i], F_SETFD, FD_CLOEXEC);
+  }
+  return 0;
+}
+
+static void drain_wake_pipe(void) {
+  char buf[64];
+  while (read(wake_pipe[0], buf, sizeof buf) > 0) continue;
+}
+
+static void set_handler(int sig, void (*fn)(int)) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = fn;
+  sigemptyset(&sa.sa_mask);
+  /* SA_RESTART keeps the interpreter's stdio from failing with EINTR; the
+     prompt loop learns of signals through the pipe. */
+  sa.sa_flags = SA_RESTART;
+  sigaction(sig, &sa, NULL);
+}
+
+void repl_install_sigint(void) {
+  stderr_is_tty = isatty(STDERR_FILENO);
+  set_handler(SIGINT, on_sigint);
+}
+
+/* ---- growing strings ---- */
+
+typedef struct {
+  char *s;
+  size_t len, cap;
+} Buf;
+
+static void buf_add(Buf *b, const char *s, size_t n) {
+  if (b->len + n + 1 > b->cap) {
+    size_t cap = b->cap ? b->cap : 256;
+    while (b->len + n + 1 > cap) cap *= 2;
+    char *p = realloc(b->s, cap);
+    if (!p) {
+      fputs("qcs: out of memory\n", stderr);
+      exit(1);
+    }
+    b->s = p;
+    b->cap = cap;
+  }
+  memcpy(b->s + b->len, s, n);
+  b->len += n;
+  b->s[b->len] = '\0';
+}
+
+static void buf_clear(Buf *b) {
+  b->len = 0;
+  if (b->s) b->s[0] = '\0';
+}
+
+/* ---- REPL state ---- */
+
+typedef struct {
+  Interp *I;
+  int interactive;   /* stdin is a terminal */
+  Buf pending;       /* the unfinished entry, lines joined by '\n' */
+  int in_block;      /* between ":{" and ":}" */
+  long block_line;   /* input line of the ":{", for messages */
+  long line_no;      /* input lines read so far */
+  int had_error;
+  int quit;
+  char **files;      /* what :load ran, for :reload */
+  size_t nfiles;
+  char *histfile;    /* NULL: no history file */
+} Repl;
+
+static Interp *completion_interp; /* readline's callbacks take no user data */
+
+static const char *skip_blanks(const char *s) {
+  while (*s == ' ' || *s == '\t') s++;
+  return s;
+}
+
+static int is_blank(const char *s) { return *skip_blanks(s) == '\0'; }
+
+static int is_blank_text(const char *s) {
+  if (s)
+    for (; *s; s++)
+      if (*s != ' ' && *s != '\t' && *s != '\n' && *s != '\r') return 0;
+  return 1;
+}
+
+/* The line without surrounding blanks is exactly word. */
+static int line_is(const char *line, const char *word) {
+  const char *s = skip_blanks(line);
+  size_t n = strlen(word);
+  return strncmp(s, word, n) == 0 && is_blank(s + n);
+}
+
+/* Run one interpreter call with Ctrl-C armed for it. */
+#define RUN_GUARDED(st, call)                                                  \
+  do {                                                                         \
+    interp_clear_interrupt();                                                  \
+    sigint_count = 0;                                                          \
+    got_sigint = 0;                                                            \
+    (st) = (call);                                                             \
+    got_sigint = 0;                                                            \
+    fflush(stdout);                                                            \
+  } while (0)
+
+static void note_status(Repl *R, RunStatus st) {
+  if (st == RUN_ERROR) R->had_error = 1;
+}
+
+/* ---- commands ---- */
+
+typedef enum { ARG_NONE, ARG_FILE, ARG_ANY } ArgKind;
+
+typedef struct {
+  const char *name;
+  ArgKind arg;
+  int bang;  /* accepts a trailing '!' */
+  void (*run)(Repl *R, const char *arg, int bang);
+  const char *usage, *help;
+} Command;
+
+static void cmd_help(Repl *R, const char *arg, int bang);
+static void cmd_load(Repl *R, const char *arg, int bang);
+static void cmd_reload(Repl *R, const char *arg, int bang);
+static void cmd_browse(Repl *R, const char *arg, int bang);
+static void cmd_quit(Repl *R, const char *arg, int bang);
+static void cmd_tradeoff(Repl *R, const char *arg, int bang);
+static void cmd_set(Repl *R, const char *arg, int bang);
+
+/* Sorted by name; a command may be abbreviated to any unique prefix. */
+static const Command commands[] = {
+  {"browse", ARG_NONE, 1, cmd_browse, ":browse[!]",
+   "list your definitions (! adds the prelude and built-ins)"},
+  {"help", ARG_NONE, 0, cmd_help, ":help", "this text"},
+  {"load", ARG_FILE, 0, cmd_load, ":load FILE",
+   "run a qcs file and remember it for :reload"},
+  {"quit", ARG_NONE, 0, cmd_quit, ":quit", "leave qcs (so does Ctrl-D)"},
+  {"reload", ARG_NONE, 0, cmd_reload, ":reload", "run the loaded files again"},
+  {"set", ARG_ANY, 0, cmd_set, ":set [LIMIT N]",
+   "list the resource limits, or change one (:set max-steps 1000000)"},
+  {"tradeoff", ARG_FILE, 0, cmd_tradeoff, ":tradeoff FILE",
+   "error against run time over root tolerances (writes tradeoff.svg)"},
+};
+#define NCOMMANDS (sizeof commands / sizeof commands[0])
+
+static void cmd_help(Repl *R, const char *arg, int bang) {
+  puts("Commands (any unique prefix will do, e.g. :b for :browse):");
+  for (size_t i = 0; i < NCOMMANDS; i++)
+    printf("  %-16s %s\n", commands[i].usage, commands[i].help);
+  puts("  :{ ... :}        lines in between are one block, run as a script\n"
+       "\n"
+       "Type a definition to add it, or an expression to see its value:\n"
+       "  qcs> f x = x * 2\n"
+       "  qcs> f 21\n"
+       "  42\n"
+       "  qcs> Density 0.1 (0,0,0) UnitCube\n"
+       "An unfinished entry (open bracket, trailing operator, \"g x =\")\n"
+       "continues at the ...> prompt. Ctrl-C stops a running evaluation or\n"
+       "abandons the line being typed; an error never loses earlier\n"
+       "definitions. Tab completes names, commands and file names after\n"
+       ":load. History is kept in ~/.qcs_history.\n"
+       "The language is described in lang/ of the qcs sources; the command\n"
+       "line in qcs(1).\n"
+       "\n"
+       "Limits: an evaluation or render that passes one stops with an error\n"
+       "naming it. :set lists them; :set NAME VALUE changes one:\n"
+       "  max-stack SIZE   stack for nested calls, i.e. recursion depth (256M)\n"
+       "  max-steps N      evaluation steps of one entry (0: no limit)\n"
+       "  max-list N       elements of one list (0: no limit)\n"
+       "  max-memory SIZE  memory for values, e.g. 512M or 2G (0: no limit)\n"
+       "  max-pixels N     pixels of one image, N or WxH (at most 8192x8192)\n"
+       "  max-spp N        samples per pixel of a render (at most 256)\n"
+       "The same limits are options of the command line: --max-steps N, ...");
+}
+
+/* :set lists the limits; :set NAME VALUE changes one. */
+static void cmd_set(Repl *R, const char *arg, int bang) {
+  if (!*arg) {
+    interp_list_limits(R->I, stdout);
+    fflush(stdout);
+    return;
+  }
+  char name[64];
+  size_t n = strcspn(arg, " \t=");
+  const char *val = arg + n;
+  while (*val == ' ' || *val == '\t' || *val == '=') val++;
+  if (n >= sizeof name) n = sizeof name - 1;
+  memcpy(name, arg, n);
+  name[n] = 0;
+  char err[300];
+  if (!*val) {
+    unsigned long long v;
+    if (interp_limit_parse(name, "0", &v, err, sizeof err) &&
+        !strncmp(err, "unknown", 7))
+      fprintf(stderr, "error: %s; :set alone lists the limits\n", err);
+    else
+      fprintf(stderr, "error: :set %s needs a value (usage: :set %s VALUE)\n",
+              name, name);
+    R->had_error = 1;
+    return;
+  }
+  if (interp_set_limit(R->I, name, val, err, sizeof err)) {
+    fprintf(stderr, "error: %s%s\n", err,
+            strncmp(err, "unknown", 7) ? "" : "; :set alone lists the limits");
+    R->had_error = 1;
+  }
+}
+
+static void remember_file(Repl *R, const char *path) {
+  for (size_t i = 0; i < R->nfiles; i++)
+    if (strcmp(R->files[i], path) == 0) return;
+  char **files = realloc(R->files, (R->nfiles + 1) * sizeof *files);
+  char *copy = strdup(path);
+  if (!files || !copy) {
+    fputs("qcs: out of memory\n", stderr);
+    exit(1);
+  }
+  files[R->nfiles++] = copy;
+  R->files = files;
+}
+
+static void cmd_load(Repl *R, const char *arg, int bang) {
+  Buf path = {0};
+  size_t n = strlen(arg);
+  if (n >= 2 && arg[0] == '"' && arg[n - 1] == '"') { /* :load "a b.qcs" */
+    arg++;
+    n -= 2;
+  }
+  if (arg[0] == '~' && (n == 1 || arg[1] == '/') && getenv("HOME")) {
+    buf_add(&path, getenv("HOME"), strlen(getenv("HOME")));
+    arg++;
+    n--;
+  }
+  buf_add(&path, arg, n);
+  /* A file that cannot be read is not remembered; one with an error in it
+     is, so that it can be mended and reloaded. */
+  int readable = access(path.s, R_OK) == 0;
+  RunStatus st;
+  RUN_GUARDED(st, interp_run_file(R->I, path.s));
+  note_status(R, st);
+  if (readable) {
+    remember_file(R, path.s);
+    if (st == RUN_OK && R->interactive) printf("loaded %s\n", path.s);
+  }
+  free(path.s);
+}
+
+/* :tradeoff FILE (issue 6): the file's render captured and measured over
+   the tolerance ladder; see tradeoff.h. */
+static void cmd_tradeoff(Repl *R, const char *arg, int bang) {
+  TradeoffOptions o;
+  memset(&o, 0, sizeof o);
+  int st;
+  interp_clear_interrupt();
+  st = tradeoff_file(R->I, arg, &o);
+  fflush(stdout);
+  if (st) R->had_error = 1;
+}
+
+static void cmd_reload(Repl *R, const char *arg, int bang) {
+  if (R->nfiles == 0) {
+    fputs("error: no files to reload; use :load FILE first\n", stderr);
+    R->had_error = 1;
+    return;
+  }
+  for (size_t i = 0; i < R->nfiles; i++) { /* all, as :load ran them */
+    RunStatus st;
+    RUN_GUARDED(st, interp_run_file(R->I, R->files[i]));
+    note_status(R, st);
+    if (st == RUN_OK && R->interactive) printf("reloaded %s\n", R->files[i]);
+  }
+}
+
+static void cmd_browse(Repl *R, const char *arg, int bang) {
+  interp_browse(R->I, stdout, bang);
+  fflush(stdout);
+}
+
+static void cmd_quit(Repl *R, const char *arg, int bang) { R->quit = 1; }
+
+static void unknown_command(Repl *R, const char *word) {
+  const char *best = NULL;
+  int best_d = 3; /* suggest only close names (lang/error.h's distance) */
+  for (size_t i = 0; i < NCOMMANDS; i++) {
+    int d = edit_distance(word, commands[i].name);
+    if (d < best_d && (size_t)d < strlen(word)) {
+      best = commands[i].name;
+      best_d = d;
+    }
+  }
+  if (best)
+    fprintf(stderr, "error: unknown command ':%s'; did you mean ':%s'?\n",
+            word, best);
+  else
+    fprintf(stderr, "error: unknown command ':%s'; :help lists them\n", word);
+  R->had_error = 1;
+}
+
+/* An exact name wins; otherwise a unique prefix. */
+static const Command *find_command(Repl *R, const char *word) {
+  const Command *found = NULL;
+  size_t n = strlen(word), matches = 0;
+  for (size_t i = 0; i < NCOMMANDS; i++) {
+    if (strcmp(commands[i].name, word) == 0) return &commands[i];
+    if (n > 0 && strncmp(commands[i].name, word, n) == 0) {
+      found = &commands[i];
+      matches++;
+    }
+  }
+  if (matches == 1) return found;
+  if (matches == 0) {
+    unknown_command(R, word);
+    return NULL;
+  }
+  fprintf(stderr, "error: ambiguous command ':%s'; it could be", word);
+  for (size_t i = 0; i < NCOMMANDS; i++)
+    if (strncmp(commands[i].name, word, n) == 0)
+      fprintf(stderr, " :%s", commands[i].name);
+  fputc('\n', stderr);
+  R->had_error = 1;
+  return NULL;
+}
+
+/* line -> ':' word ['!'] [blanks arg] */
+static void run_command(Repl *R, const char *line) {
+  const char *s = skip_blanks(line) + 1;
+  const char *end = s;
+  while (*end && *end != ' ' && *end != '\t') end++;
+  char word[64];
+  size_t n = (size_t)(end - s);
+  if (n >= sizeof word) n = sizeof word - 1;
+  memcpy(word, s, n);
+  word[n] = '\0';
+  int bang = n > 0 && word[n - 1] == '!';
+  if (bang) word[n - 1] = '\0';
+  if (strcmp(word, "?") == 0) strcpy(word, "help");
+
+  /* the argument, without surrounding blanks */
+  const char *arg = skip_blanks(end);
+  size_t alen = strlen(arg);
+  while (alen > 0 && (arg[alen - 1] == ' ' || arg[alen - 1] == '\t')) alen--;
+  char *argcopy = strndup(arg, alen);
+  if (!argcopy) {
+    fputs("qcs: out of memory\n", stderr);
+    exit(1);
+  }
+
+  const Command *c = word[0] ? find_command(R, word) : NULL;
+  if (!word[0]) {
+    fputs("error: a ':' with no command; :help lists them\n", stderr);
+    R->had_error = 1;
+  } else if (!c) {
+    /* reported */
+  } else if (bang && !c->bang) {
+    fprintf(stderr, "error: ':%s' takes no '!'\n", c->name);
+    R->had_error = 1;
+  } else if (c->arg == ARG_NONE && alen > 0) {
+    fprintf(stderr, "error: ':%s' takes no argument (usage: %s)\n", c->name,
+            c->usage);
+    R->had_error = 1;
+  } else if (c->arg == ARG_FILE && alen == 0) {
+    fprintf(stderr, "error: ':%s' needs a file name (usage: %s)\n", c->name,
+            c->usage);
+    R->had_error = 1;
+  } else {
+    c->run(R, argcopy, bang);
+  }
+  free(argcopy);
+}
+
+/* ---- entries ---- */
+
+static void reset_entry(Repl *R) {
+  buf_clear(&R->pending);
+  R->in_block = 0;
+}
+
+/* Give the pending text to the interpreter; keep it if it is unfinished. */
+static void submit(Repl *R, RunMode mode) {
+  RunStatus st;
+  RUN_GUARDED(st, interp_run_string(R->I, SOURCE_NAME, R->pending.s, mode));
+  if (st == RUN_INCOMPLETE) return;
+  note_status(R, st);
+  reset_entry(R);
+}
+
+/* One input line, without its newline. */
+static void feed_line(Repl *R, const char *line) {
+  R->line_no++;
+  if (R->in_block) {
+    /* A block is pasted text: run as a script, items start in column 1. */
+    if (line_is(line, ":}")) {
+      if (!is_blank_text(R->pending.s)) submit(R, MODE_SCRIPT);
+      reset_entry(R);
+      return;
+    }
+    buf_add(&R->pending, line, strlen(line));
+    buf_add(&R->pending, "\n", 1);
+    return;
+  }
+  if (R->pending.len == 0) {
+    if (is_blank(line)) return;
+    if (line_is(line, ":{")) {
+      R->in_block = 1;
+      R->block_line = R->line_no;
+      return;
+    }
+    if (line_is(line, ":}")) {
+      fputs("error: ':}' without an opening ':{'\n", stderr);
+      R->had_error = 1;
+      return;
+    }
+    if (*skip_blanks(line) == ':') {
+      run_command(R, line);
+      return;
+    }
+  } else {
+    buf_add(&R->pending, "\n", 1);
+  }
+  buf_add(&R->pending, line, strlen(line));
+  submit(R, MODE_REPL);
+}
+
+/* Does any line of text start with ':' (a command) in column 1? */
+static int has_command_line(const char *text) {
+  for (const char *s = text;; s++) {
+    if (*s == ':') return 1;
+    if ((s = strchr(s, '\n')) == NULL) return 0;
+  }
+}
+
+/* What readline returns: one line, or several when text was pasted (with
+   bracketed paste the newlines stay in the line). A paste of plain code
+   at the top level is run as a script, like a ':{ ... :}' block, so that
+   it means what it meant in the file it came from; otherwise its lines
+   are fed one by one, as if typed. */
+static void feed_text(Repl *R, const char *text) {
+  if (!strchr(text, '\n')) {
+    feed_line(R, text);
+    return;
+  }
+  if (!R->in_block && R->pending.len == 0 && !has_command_line(text)) {
+    for (const char *s = text; (s = strchr(s, '\n')) != NULL; s++)
+      R->line_no++;
+    R->line_no++;
+    if (!is_blank_text(text)) {
+      buf_add(&R->pending, text, strlen(text));
+      submit(R, MODE_SCRIPT);
+    }
+    reset_entry(R);
+    return;
+  }
+  Buf line = {0};
+  for (const char *s = text; s;) {
+    const char *nl = strchr(s, '\n');
+    size_t n = nl ? (size_t)(nl - s) : strlen(s);
+    buf_clear(&line);
+    buf_add(&line, s, n);
+    feed_line(R, line.s);
+    s = nl ? nl + 1 : NULL;
+  }
+  free(line.s);
+}
+
+/* End of input with an entry still open. */
+static void feed_eof(Repl *R) {
+  if (R->in_block) {
+    fprintf(stderr,
+            SOURCE_NAME ":%ld: error: end of input inside the ':{' block "
+            "opened at line %ld\n", R->line_no, R->block_line);
+    R->had_error = 1;
+  } else if (R->pending.len > 0) {
+    fprintf(stderr, SOURCE_NAME ":%ld: error: end of input inside an "
+            "unfinished entry\n", R->line_no);
+    R->had_error = 1;
+  }
+  reset_entry(R);
+}
+
+/* ---- plain loop: stdin is not a terminal ---- */
+
+static int run_plain(Repl *R) {
+  char *line = NULL;
+  size_t cap = 0;
+  ssize_t n;
+  while (!R->quit && (n = getline(&line, &cap, stdin)) >= 0) {
+    while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r')) line[--n] = 0;
+    feed_line(R, line);
+  }
+  free(line);
+  if (!R->quit) feed_eof(R);
+  fflush(stdout);
+  return R->had_error ? 1 : 0;
+}
+
+/* ---- history ---- */
+
+static void history_open(Repl *R) {
+  const char *home = getenv("HOME");
+  if (!home || !*home) return;
+  Buf path = {0};
+  buf_add(&path, home, strlen(home));
+  buf_add(&path, HISTORY_FILE, strlen(HISTORY_FILE));
+  R->histfile = path.s;
+  using_history();
+  stifle_history(HISTORY_MAX);
+  read_history(R->histfile);
+  /* append_history() does not create the file */
+  int fd = open(R->histfile, O_WRONLY | O_CREAT | O_APPEND, 0600);
+  if (fd >= 0) close(fd);
+  history_truncate_file(R->histfile, HISTORY_MAX);
+}
+
+/* Written line by line, so that a crash loses nothing. */
+static void history_note(Repl *R, const char *line) {
+  if (is_blank(line)) return;
+  HIST_ENTRY *last = history_length > 0 ? history_get(history_base +
+                                                      history_length - 1)
+                                        : NULL;
+  if (last && strcmp(last->line, line) == 0) return;
+  add_history(line);
+  if (R->histfile) append_history(1, R->histfile);
+}
+
+static void history_close(Repl *R) {
+  if (R->histfile) history_truncate_file(R->histfile, HISTORY_MAX);
+  free(R->histfile);
+  R->histfile = NULL;
+}
+
+/* ---- completion ---- */
+
+static char *dup_or_die(const char *s) {
+  char *p = strdup(s); /* readline frees matches with free() */
+  if (!p) {
+    fputs("qcs: out of memory\n", stderr);
+    exit(1);
+  }
+  return p;
+}
+
+static char *command_generator(const char *text, int state) {
+  static size_t i, n;
+  if (state == 0) {
+    i = 0;
+    n = strlen(text);
+  }
+  while (i < NCOMMANDS) {
+    const char *name = commands[i++].name;
+    if (strncmp(name, text, n) == 0) return dup_or_die(name);
+  }
+  return NULL;
+}
+
+/* Names from interp_complete, copied with malloc; names[next..n) are not
+   yet handed to readline, which frees the ones it gets. */
+typedef struct {
+  char **names;
+  size_t n, cap, next;
+} NameList;
+
+static NameList name_matches;
+
+static void collect_name(const char *name, void *ud) {
+  NameList *l = ud;
+  if (l->n == l->cap) {
+    size_t cap = l->cap ? 2 * l->cap : 64;
+    char **p = realloc(l->names, cap * sizeof *p);
+    if (!p) return;
+    l->names = p;
+    l->cap = cap;
+  }
+  l->names[l->n++] = dup_or_die(name);
+}
+
+static void names_clear(NameList *l) {
+  for (size_t k = l->next; k < l->n; k++) free(l->names[k]);
+  l->n = l->next = 0;
+}
+
+static char *name_generator(const char *text, int state) {
+  NameList *l = &name_matches;
+  if (state == 0) {
+    names_clear(l);
+    interp_complete(completion_interp, text, collect_name, l);
+  }
+  return l->next < l->n ? l->names[l->next++] : NULL;
+}
+
+/* If line is ":CMD ..." with CMD naming :load, where its argument starts. */
+static const char *load_argument(const char *line) {
+  const char *s = skip_blanks(line);
+  if (*s++ != ':') return NULL;
+  const char *end = s;
+  while (*end && *end != ' ' && *end != '\t') end++;
+  size_t n = (size_t)(end - s);
+  if (n == 0 || *end == '\0' || n > strlen("load") ||
+      strncmp(s, "load", n) != 0)
+    return NULL;
+  return end;
+}
+
+static char *word_breaks(void) {
+  return load_argument(rl_line_buffer) ? file_breaks : name_breaks;
+}
+
+static char **complete(const char *text, int start, int end) {
+  rl_attempted_completion_over = 1; /* no file names unless asked for */
+  const char *line = rl_line_buffer;
+  const char *first = skip_blanks(line);
+  const char *arg = load_argument(line);
+  if (arg && start >= (int)(arg - line))
+    return rl_completion_matches(text, rl_filename_completion_function);
+  if (*first == ':' && start == (int)(first - line) + 1)
+    return rl_completion_matches(text, command_generator);
+  if (*first == ':') return NULL;
+  return rl_completion_matches(text, name_generator);
+}
+
+/* ---- terminal loop ---- */
+
+typedef enum { READ_LINE, READ_EOF, READ_INTERRUPTED } ReadResult;
+
+static char *read_got;
+static int read_done;
+
+static void on_line(char *line) {
+  read_got = line;
+  read_done = 1;
+  rl_callback_handler_remove(); /* the entry runs outside readline */
+}
+
+/* Whether leaving readline ends the line itself: with bracketed paste on,
+   rl_deprep_terminal() writes "\r", and at end of file also "\n". */
+static int bracketed_paste(void) {
+  const char *v = rl_variable_value("enable-bracketed-paste");
+  return v && strcmp(v, "on") == 0;
+}
+
+/* Ctrl-C at the prompt: show it, drop the line, leave readline. */
+static void abandon_line(void) {
+  FILE *out = rl_outstream ? rl_outstream : stdout;
+  rl_point = rl_end;
+  rl_redisplay();
+  fputs("^C", out);
+  fflush(out);
+  rl_callback_sigcleanup();
+  rl_free_line_state();
+  rl_callback_handler_remove();
+  fputs("\n", out);
+  fflush(out);
+}
+
+static ReadResult read_line(const char *prompt, char **out) {
+  fflush(stdout);
+  drain_wake_pipe();
+  got_sigint = 0;
+  read_done = 0;
+  read_got = NULL;
+  at_prompt = 1;
+  rl_callback_handler_install(prompt, on_line);
+  int fd = fileno(rl_instream ? rl_instream : stdin);
+  int maxfd = fd > wake_pipe[0] ? fd : wake_pipe[0];
+  ReadResult r;
+  for (;;) {
+    if (got_sigint) {
+      got_sigint = 0;
+      abandon_line();
+      r = READ_INTERRUPTED;
+      break;
+    }
+    if (got_sigwinch) {
+      got_sigwinch = 0;
+      rl_resize_terminal();
+    }
+    if (got_sigcont) { /* after Ctrl-Z the shell may have reset the tty */
+      got_sigcont = 0;
+      rl_deprep_terminal();
+      rl_prep_terminal(1);
+      rl_forced_update_display();
+    }
+    if (read_done) {
+      r = read_got ? READ_LINE : READ_EOF;
+      break;
+    }
+    fd_set fds;
+    FD_ZERO(&fds);
+    FD_SET(fd, &fds);
+    FD_SET(wake_pipe[0], &fds);
+    int n = select(maxfd + 1, &fds, NULL, NULL, NULL);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      rl_callback_handler_remove();
+      r = READ_EOF;
+      break;
+    }
+    if (FD_ISSET(wake_pipe[0], &fds)) drain_wake_pipe();
+    /* a signal first: a key waiting behind a Ctrl-C is for the new line */
+    else if (FD_ISSET(fd, &fds)) rl_callback_read_char();
+  }
+  at_prompt = 0;
+  interp_clear_interrupt(); /* a Ctrl-C at the prompt stops nothing later */
+  *out = read_got;
+  return r;
+}
+
+static int run_terminal(Repl *R) {
+  rl_readline_name = "qcs";
+  rl_catch_signals = 0;
+  rl_catch_sigwinch = 0;
+  rl_attempted_completion_function = complete;
+  rl_completion_word_break_hook = word_breaks;
+  rl_basic_word_break_characters = name_breaks;
+  rl_completer_quote_characters = "\"";
+  completion_interp = R->I;
+  if (open_wake_pipe() < 0) {
+    perror("qcs: pipe");
+    return 1;
+  }
+  history_open(R);
+  repl_install_sigint();
+  set_handler(SIGWINCH, on_sigwinch);
+  set_handler(SIGCONT, on_sigcont);
+
+  while (!R->quit) {
+    int more = R->in_block || R->pending.len > 0;
+    char *line;
+    ReadResult r = read_line(more ? PROMPT_MORE : PROMPT, &line);
+    if (r == READ_INTERRUPTED) {
+      reset_entry(R);
+      continue;
+    }
+    if (r == READ_EOF) {
+      if (!bracketed_paste()) putchar('\n');
+      break;
+    }
+    history_note(R, line);
+    feed_text(R, line);
+    free(line);
+  }
+  feed_eof(R);
+  history_close(R);
+  names_clear(&name_matches);
+  free(name_matches.names);
+  name_matches = (NameList){0};
+  fflush(stdout);
+  return 0;
+}
+
+int repl_run(Interp *I) {
+  Repl R = {0};
+  R.I = I;
+  R.interactive = isatty(STDIN_FILENO);
+  int status = R.interactive ? run_terminal(&R) : run_plain(&R);
+  for (size_t i = 0; i < R.nfiles; i++) free(R.files[i]);
+  free(R.files);
+  free(R.pending.s);
+  return status;
+}

@@ -1,0 +1,12 @@
+/* bind.c: the whole language. See bind.h. */
+#include "bind/bind.h"
+
+#include "bind/probes.h"
+#include "bind/render_lang.h"
+
+void bind_install(Interp *I) {
+  probes_install(I);
+  render_install(I);
+}
+
+Interp *bind_interp_new(void) { return interp_new(bind_install); }

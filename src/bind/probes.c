@@ -1,0 +1,326 @@
+/* probes.c: the geometry core as functions of the language. See probes.h.
+ *
+ * Each probe compiles what it is given (scene.c) and calls the kernels
+ * the renderer calls. The compiled scene is freed before the probe
+ * returns, also when an error unwinds (the ScopedScene handler below). */
+#include "bind/probes.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "core/bounds.h"
+#include "core/density.h"
+#include "lang/eval.h"
+#include "core/lg.h"
+#include "lang/print.h"
+#include "scene/ray.h"
+#include "bind/compile.h"
+#include "core/soft.h"
+
+static void get_point(Interp *I, Value *v, Pos pos, const char *what,
+                      double p[3]) {
+  force_vec3(I, v, pos, what, p);
+  if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+    qcs_error(pos, "%s must be finite, not (%g, %g, %g)", what, p[0], p[1],
+              p[2]);
+}
+
+static double get_radius(Interp *I, Value *v, Pos pos) {
+  double r = force_num(I, v, pos, "the radius");
+  if (!isfinite(r) || r < 0)
+    qcs_error(pos, "the radius must be finite and >= 0, not %g", r);
+  return r;
+}
+
+/* Density r p tree: Figure 4. */
+static Value *pr_density(Interp *I, Value **args, Pos pos) {
+  double r = get_radius(I, args[0], pos), p[3];
+  get_point(I, args[1], pos, "the point", p);
+  dt_tape *t = compile_density_tape(I, args[2], r, pos);
+  double rho = dt_density(t, p);
+  dt_tape_free(t);
+  return val_num(rho);
+}
+
+/* Gradient r p tree: Section 2.4. */
+static Value *pr_gradient(Interp *I, Value **args, Pos pos) {
+  double r = get_radius(I, args[0], pos), p[3], g[3];
+  get_point(I, args[1], pos, "the point", p);
+  dt_tape *t = compile_density_tape(I, args[2], r, pos);
+  dt_density_grad(t, p, g);
+  dt_tape_free(t);
+  return val_tuple3(g[0], g[1], g[2]);
+}
+
+/* PointInObject p obj: Figure 4, for every kind of object. */
+static Value *pr_inside(Interp *I, Value **args, Pos pos) {
+  double p[3];
+  get_point(I, args[0], pos, "the point", p);
+  Scene *s = compile_scene(I, args[1], pos);
+  int in = scene_inside(s, s->root, p);
+  scene_free(s);
+  return val_bool(I, in);
+}
+
+/* Displacement r t: eq. (5). */
+static Value *pr_displacement(Interp *I, Value **args, Pos pos) {
+  double r = get_radius(I, args[0], pos);
+  double t = force_num(I, args[1], pos, "the density level");
+  if (!(t >= 0 && t <= 1))
+    qcs_error(pos, "the density level of Displacement must be in [0, 1], "
+              "not %g", t);
+  return val_num(dt_displacement(r, t));
+}
+
+/* Field p soft: Wyvill and Trotman eq. (1), summed over the keys. */
+static Value *pr_field(Interp *I, Value **args, Pos pos) {
+  double p[3];
+  get_point(I, args[0], pos, "the point", p);
+  Scene *s = compile_scene(I, args[1], pos);
+  double f = 0;
+  int found = 0;
+  for (int i = 0; i < s->n; i++)
+    if (s->nodes[i].kind == SC_SOFT) {
+      f += soft_field(s->nodes[i].soft, p);
+      found = 1;
+    }
+  scene_free(s);
+  if (!found)
+    qcs_error(pos, "Field needs a soft object (SoftObject magic [keys])");
+  return val_num(f);
+}
+
+/* A sharp CSG tape back into a scene-object value, for printing. */
+static Value *csg_to_value(Interp *I, const csg_tape *t, Pos pos) {
+  Value **stack = val_array(t->depth + 1);
+  int sp = 0;
+  Sym *s_half = sym_intern(I, "Halfspace", 9), *s_union = sym_intern(I, "Union", 5),
+      *s_inter = sym_intern(I, "Intersection", 12),
+      *s_diff = sym_intern(I, "SetDifference", 13),
+      *s_empty = sym_intern(I, "Empty", 5),
+      *s_all = sym_intern(I, "Everything", 10);
+  for (int i = 0; i < t->ncode; i++) {
+    const csg_instr *in = &t->code[i];
+    Value **a;
+    switch (in->op) {
+    case CSG_PLANE: {
+      const csg_plane *p = &t->planes[in->arg];
+      Value **pl = val_array(2);
+      pl[0] = val_tuple3(p->n[0], p->n[1], p->n[2]);
+      pl[1] = val_num(p->d);
+      a = val_array(1);
+      a[0] = val_tuple(2, pl);
+      stack[sp++] = val_con(s_half, 1, a);
+      break;
+    }
+    case CSG_EMPTY: stack[sp++] = val_con(s_empty, 0, NULL); break;
+    case CSG_ALL: stack[sp++] = val_con(s_all, 0, NULL); break;
+    default: {
+      a = val_array(2);
+      Value *y = stack[--sp], *x = stack[--sp];
+      Sym *c = in->op == CSG_UNION ? s_union : in->op == CSG_INTER ? s_inter : s_diff;
+      a[0] = in->op == CSG_RDIFF ? y : x;
+      a[1] = in->op == CSG_RDIFF ? x : y;
+      stack[sp++] = val_con(c, 2, a);
+    }
+    }
+  }
+  if (sp != 1) qcs_error(pos, "internal error: malformed bound");
+  return stack[0];
+}
+
+static Value *bounds_probe(Interp *I, Value **args, Pos pos, int outer) {
+  double r = get_radius(I, args[0], pos);
+  double t = force_num(I, args[1], pos, "the density threshold");
+  if (!(t >= 0 && t <= 1))
+    qcs_error(pos, "the threshold must be in [0, 1], not %g", t);
+  dt_tape *tape = compile_density_tape(I, args[2], r, pos);
+  int flags = 0;
+  csg_tape *b = outer ? bnd_outer(tape, t, &flags) : bnd_inner(tape, t, &flags);
+  dt_tape_free(tape);
+  if (!b) qcs_error(pos, "out of memory");
+  if ((flags & BND_RANGE) && compile_sum_overlaps(I, args[2], pos))
+    compile_warn_once(I, pos, "a Sum in this density tree may exceed 1 where "
+                    "its parts overlap (the paper's Figure 15b): the bounds "
+                    "hold by interval arithmetic, but seams may bulge");
+  if (flags & BND_FALLBACK)
+    compile_warn_once(I, pos, "no theorem applies to part of this tree: a "
+                    "looser, still safe bound was used there");
+  ErrFrame f;
+  Value *v = NULL;
+  if (ERR_TRY(f)) {
+    v = csg_to_value(I, b, pos);
+    err_pop(&f);
+    csg_tape_free(b);
+  } else {
+    err_pop(&f);
+    csg_tape_free(b);
+    err_rethrow();
+  }
+  return v;
+}
+
+/* OuterBounds r t tree: Figure 8. */
+static Value *pr_outer(Interp *I, Value **args, Pos pos) {
+  return bounds_probe(I, args, pos, 1);
+}
+
+/* InnerBounds r t tree: Appendix, Theorems 4-6. */
+static Value *pr_inner(Interp *I, Value **args, Pos pos) {
+  return bounds_probe(I, args, pos, 0);
+}
+
+/* The direction of a ray: finite and not zero. */
+static void get_dir(Interp *I, Value *v, Pos pos, double d[3]) {
+  get_point(I, v, pos, "the ray direction", d);
+  if (d[0] == 0 && d[1] == 0 && d[2] == 0)
+    qcs_error(pos, "the ray direction cannot be zero");
+}
+
+/* The default root tolerance, as a distance in scene units. */
+#define PROBE_TOL 1e-10
+
+/* Every crossing of node's boundary along o + t d, t >= 0, into a list. */
+static Value *roots_list(Interp *I, const Scene *s, const double o[3],
+                         const double d[3], RayCtx *c, Pos pos) {
+  csg_span *sp;
+  int n = ray_spans(s, s->root, o, d, 0, INFINITY, c, &sp);
+  if (n < 0) qcs_error(pos, "out of memory tracing the ray");
+  Value *list = I->v_nil;
+  for (int i = n - 1; i >= 0; i--) {
+    if (sp[i].id1 >= 0 && isfinite(sp[i].t1))
+      list = val_cons(val_num(sp[i].t1), list);
+    if (sp[i].id0 >= 0 && sp[i].t0 >= 0) list = val_cons(val_num(sp[i].t0), list);
+  }
+  return list;
+}
+
+static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook) {
+  double o[3], d[3];
+  get_point(I, args[1], pos, "the ray origin", o);
+  get_dir(I, args[2], pos, d);
+  Scene *s = compile_scene(I, args[0], pos);
+  RayCtx *c = ray_ctx_new(s, PROBE_TOL);
+  if (!c) {
+    scene_free(s);
+    qcs_error(pos, "out of memory");
+  }
+  c->hook = hook;
+  Value *v = NULL;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    v = roots_list(I, s, o, d, c, pos);
+    if (c->unresolved_node >= 0)
+      qcs_warning(compile_node_pos(s, c->unresolved_node),
+                  "the root search left %ld segment%s of this object "
+                  "undecided (the ray runs within rounding of its surface "
+                  "for a long stretch): crossings that only touch the ray "
+                  "there may be missing", c->stats.lg.overflows,
+                  c->stats.lg.overflows == 1 ? "" : "s");
+    err_pop(&f);
+    ray_ctx_free(c);
+    scene_free(s);
+  } else {
+    err_pop(&f);
+    ray_ctx_free(c);
+    scene_free(s);
+    err_rethrow();
+  }
+  return v;
+}
+
+/* Roots obj o d: every t >= 0 where o + t d crosses obj's surface. */
+static Value *pr_roots(Interp *I, Value **args, Pos pos) {
+  return ray_probe(I, args, pos, NULL);
+}
+
+static const char *const decisions[] = {
+    [LG_SEG_EXCLUDED] = "range misses 0.5",
+    [LG_SEG_FLAT] = "flat (L = 0)",
+    [LG_SEG_NO_ROOT] = "eq.6 false: <= 1 root; no sign change",
+    [LG_SEG_ROOT] = "eq.6 false: <= 1 root; sign change -> polish (Newton/bisection)",
+    [LG_SEG_SPLIT] = "eq.6 true: may hold 2 roots -> split",
+    [LG_SEG_TINY] = "shorter than tolerance",
+};
+
+static void trace_event(void *ctx, const lg_trace_event *ev) {
+  FILE *out = ctx;
+  char a[32], b[32], L[32], G[32];
+  format_real(a, ev->t0);
+  format_real(b, ev->t1);
+  snprintf(L, sizeof L, "%.4g", ev->L);
+  snprintf(G, sizeof G, "%.4g", ev->G);
+  fprintf(out, "  %*s[%s, %s]  rho-0.5 at the ends: %.3g, %.3g  L = %s  G = %s  "
+          "eq.6: %.4g vs %.4g  %s  (%d instr)%s\n",
+          2 * (ev->depth < 20 ? ev->depth : 20), "", a, b, ev->f0, ev->f1, L, G,
+          ev->lhs, ev->t1 - ev->t0,
+          ev->decision >= 0 && ev->decision <= LG_SEG_TINY
+              ? decisions[ev->decision] : "?",
+          ev->ncode, ev->nroots ? "  -> root" : "");
+}
+
+/* Trace obj o d: Roots, printing the root search of every rounded leaf
+   the ray meets (segments, L, G, the eq. (6) decision, roots). */
+static Value *pr_trace(Interp *I, Value **args, Pos pos) {
+  lg_hook hook = {trace_event, stdout};
+  printf("Trace: segments of the guaranteed root search (Figure 9), "
+         "indented by depth\n");
+  Value *v = ray_probe(I, args, pos, &hook);
+  fflush(stdout);
+  return v;
+}
+
+/* LG r tree o d (t0, t1): (M, L, G) over the segment (Section 3.4.1). */
+static Value *pr_lg(Interp *I, Value **args, Pos pos) {
+  double r = get_radius(I, args[0], pos), o[3], d[3];
+  get_point(I, args[2], pos, "the ray origin", o);
+  get_dir(I, args[3], pos, d);
+  Value *seg = force(I, args[4]);
+  if (seg->kind != V_TUPLE || seg->u.tup.n != 2)
+    qcs_error(pos, "the segment is a pair (t0, t1)");
+  double t0 = force_num(I, seg->u.tup.items[0], pos, "t0");
+  double t1 = force_num(I, seg->u.tup.items[1], pos, "t1");
+  if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
+    qcs_error(pos, "the segment (t0, t1) needs finite t0 <= t1");
+  dt_tape *t = compile_density_tape(I, args[1], r, pos);
+  lg_bounds b;
+  lg_eval_bounds(t, o, d, t0, t1, &b);
+  dt_tape_free(t);
+  double M = fmax(fabs(b.lo), fabs(b.hi));
+  return val_tuple3(M, b.L, b.G);
+}
+
+#define PROBES(X)                                                            \
+  X("Density", 3, pr_density,                                                \
+    "Density r p tree: the density of the tree smoothed with radius r at p") \
+  X("Gradient", 3, pr_gradient,                                              \
+    "Gradient r p tree: the density's gradient at p")                        \
+  X("PointInObject", 2, pr_inside,                                           \
+    "PointInObject p obj: is p inside the object?")                          \
+  X("Displacement", 2, pr_displacement,                                      \
+    "Displacement r t: distance from a plane to its t-isosurface, outward")  \
+  X("Field", 2, pr_field, "Field p soft: the soft object's field at p")   \
+  X("OuterBounds", 3, pr_outer,                                              \
+    "OuterBounds r t tree: a sharp object outside which density <= t")       \
+  X("InnerBounds", 3, pr_inner,                                              \
+    "InnerBounds r t tree: a sharp object inside which density >= t")       \
+  X("Roots", 3, pr_roots,                                                    \
+    "Roots obj o d: every t >= 0 where o + t d crosses obj's surface")       \
+  X("Trace", 3, pr_trace,                                                    \
+    "Trace obj o d: Roots, printing the root search step by step")           \
+  X("LG", 5, pr_lg,                                                          \
+    "LG r tree o d (t0, t1): (M, L, G) bounds over the ray segment")
+
+static const Builtin probes[] = {
+#define X(name, arity, fn, doc) {name, arity, fn, doc},
+    PROBES(X)
+#undef X
+};
+
+void probes_install(Interp *I) {
+  for (size_t i = 0; i < sizeof probes / sizeof *probes; i++) {
+    Sym *s = sym_intern(I, probes[i].name, (int)strlen(probes[i].name));
+    s->global = val_builtin(&probes[i]);
+    s->sig = probes[i].doc;
+  }
+}

@@ -1,0 +1,53 @@
+/* render_lang.h: the render builtins of the language (renderWith; the
+ * prelude defines render = renderWith []), and the command line's
+ * overrides of a script's own render settings. */
+#ifndef QCS_RENDER_LANG_H
+#define QCS_RENDER_LANG_H
+
+#include "lang/interp.h"
+#include "lang/value.h"
+
+struct Scene;
+struct RenderSettings;
+
+/* A capture hook (see RenderOverrides.capture): called with the compiled
+   scene and the settings in force instead of rendering and writing. The
+   scene and settings are only borrowed for the call. Returns 0, or -1
+   with a message in err (raised as a qcs error at the render). */
+typedef int (*RenderCapture)(void *ctx, const struct Scene *s,
+                             const struct RenderSettings *rs,
+                             const char *path, char *err, size_t errlen);
+
+typedef struct RenderOverrides {
+  const char *output;   /* -o FILE: replaces every render's file name */
+  int width, height;    /* --size WxH (0: the script's) */
+  int spp;              /* --spp N */
+  int threads;          /* --threads N */
+  double tol;           /* --tolerance T (0: the script's) */
+  int cost;             /* --cost: add the root-finder cost channel */
+  int float_pixels;     /* --float: EXR RGBA as 32-bit floats */
+  int renders;          /* renders done so far */
+  RenderCapture capture;  /* non-NULL: renders call this instead (qcs
+                             tradeoff); nothing is written */
+  void *capture_ctx;
+} RenderOverrides;
+
+void render_install(Interp *I);
+/* 0 if a file can be made at path (its folder exists and may be written
+   in), else -1 with "cannot write PATH: REASON" in err, so that a bad
+   output name is refused before a long render rather than after it. As
+   root a folder's permissions are not enforced; the write itself may
+   still fail, and then leaves nothing behind (see image.h). */
+int render_writable(const char *path, char *err, size_t errlen);
+/* The overrides stay owned by the caller and must outlive I's use. */
+void render_set_overrides(Interp *I, RenderOverrides *o);
+/* The overrides in force (NULL: none). */
+RenderOverrides *render_get_overrides(Interp *I);
+/* Render the top-level `scene` to path (qcs -o FILE with scripts that
+   render nothing); errors point at scene's definition. */
+RunStatus render_lang_scene(Interp *I, const char *path);
+/* Render obj to path with settings (a qcs list, or NULL for none); the
+   value is the file name. Errors are raised with qcs_error at pos. */
+Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
+                    Pos pos);
+#endif

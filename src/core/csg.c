@@ -1,0 +1,534 @@
+/* csg.c: sharp CSG tapes, point classification and Roth span lists. */
+#include "core/csg.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct csg_builder {
+  csg_instr *code;
+  int ncode, capcode;
+  csg_plane *planes;
+  int nplanes, capplanes;
+  int *start;       /* per operand on the symbolic stack: first instr */
+  int nstack, capstack;
+  int err;
+};
+
+csg_builder *csg_builder_new(void) {
+  return calloc(1, sizeof(csg_builder));
+}
+
+void csg_builder_free(csg_builder *b) {
+  if (!b) return;
+  free(b->code);
+  free(b->planes);
+  free(b->start);
+  free(b);
+}
+
+void csg_tape_free(csg_tape *t) {
+  if (!t) return;
+  free(t->code);
+  free(t->planes);
+  free(t->rcode);
+  free(t->gstart);
+  free(t->gplane);
+  free(t->gpl);
+  free(t);
+}
+
+const char *csg_strerror(int err) {
+  switch (err) {
+  case CSG_OK: return "no error";
+  case CSG_EPLANE: return "plane normal must be finite and non-zero";
+  case CSG_EOP: return "set operation needs two operands";
+  case CSG_EUNBALANCED: return "csg tape must hold exactly one object";
+  case CSG_ENOMEM: return "out of memory";
+  }
+  return "unknown csg error";
+}
+
+static int grow(void **p, int *cap, int need, size_t elem) {
+  if (need <= *cap) return 0;
+  int c = *cap ? *cap : 16;
+  while (c < need) c *= 2;
+  void *q = realloc(*p, (size_t)c * elem);
+  if (!q) return -1;
+  *p = q;
+  *cap = c;
+  return 0;
+}
+
+static int push_operand(csg_builder *b, csg_instr in) {
+  if (grow((void **)&b->code, &b->capcode, b->ncode + 1, sizeof *b->code) ||
+      grow((void **)&b->start, &b->capstack, b->nstack + 1, sizeof(int)))
+    return b->err = CSG_ENOMEM;
+  b->start[b->nstack++] = b->ncode;
+  b->code[b->ncode++] = in;
+  return CSG_OK;
+}
+
+int csg_builder_plane(csg_builder *b, const double n[3], double d) {
+  if (b->err) return b->err;
+  double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!isfinite(len) || len == 0 || !isfinite(d)) return CSG_EPLANE;
+  if (grow((void **)&b->planes, &b->capplanes, b->nplanes + 1,
+           sizeof *b->planes))
+    return b->err = CSG_ENOMEM;
+  csg_plane *p = &b->planes[b->nplanes];
+  for (int i = 0; i < 3; i++) p->n[i] = n[i] / len;
+  p->d = d / len;
+  csg_instr in = {CSG_PLANE, b->nplanes++};
+  return push_operand(b, in);
+}
+
+int csg_builder_const(csg_builder *b, csg_op c) {
+  if (b->err) return b->err;
+  if (c != CSG_EMPTY && c != CSG_ALL) return CSG_EOP;
+  csg_instr in = {(int)c, 0};
+  return push_operand(b, in);
+}
+
+/* The constant an operand folded to, or -1. */
+static int operand_const(const csg_builder *b, int k) {
+  int s = b->start[k];
+  int end = k + 1 < b->nstack ? b->start[k + 1] : b->ncode;
+  if (end - s != 1) return -1;
+  int op = b->code[s].op;
+  return op == CSG_EMPTY || op == CSG_ALL ? op : -1;
+}
+
+/* Replace the top two operands by one: keep_x/keep_y keeps that operand's
+ * code alone, else the constant c. */
+static void fold_to(csg_builder *b, int keep, int c) {
+  int sx = b->start[b->nstack - 2], sy = b->start[b->nstack - 1];
+  if (keep == 0) {                /* keep x: drop y's code */
+    b->ncode = sy;
+  } else if (keep == 1) {         /* keep y: move it over x */
+    memmove(&b->code[sx], &b->code[sy],
+            (size_t)(b->ncode - sy) * sizeof *b->code);
+    b->ncode = sx + (b->ncode - sy);
+  } else {
+    b->ncode = sx;
+    b->code[b->ncode].op = c;
+    b->code[b->ncode++].arg = 0;
+  }
+  b->nstack--;
+}
+
+int csg_builder_op(csg_builder *b, csg_op op) {
+  if (b->err) return b->err;
+  if (op != CSG_UNION && op != CSG_INTER && op != CSG_DIFF && op != CSG_RDIFF)
+    return CSG_EOP;
+  if (b->nstack < 2) return CSG_EOP;
+  int cx = operand_const(b, b->nstack - 2), cy = operand_const(b, b->nstack - 1);
+  if (op == CSG_RDIFF) {   /* y - x: fold as a difference with roles swapped */
+    if (cy == CSG_EMPTY || cx == CSG_ALL) {
+      fold_to(b, -1, CSG_EMPTY);
+      return 0;
+    }
+    if (cx == CSG_EMPTY) { fold_to(b, 1, 0); return 0; }
+  } else
+  switch (op) {
+  case CSG_UNION:
+    if (cx == CSG_ALL || cy == CSG_ALL) { fold_to(b, -1, CSG_ALL); return 0; }
+    if (cx == CSG_EMPTY) { fold_to(b, 1, 0); return 0; }
+    if (cy == CSG_EMPTY) { fold_to(b, 0, 0); return 0; }
+    break;
+  case CSG_INTER:
+    if (cx == CSG_EMPTY || cy == CSG_EMPTY) {
+      fold_to(b, -1, CSG_EMPTY);
+      return 0;
+    }
+    if (cx == CSG_ALL) { fold_to(b, 1, 0); return 0; }
+    if (cy == CSG_ALL) { fold_to(b, 0, 0); return 0; }
+    break;
+  default:
+    if (cx == CSG_EMPTY || cy == CSG_ALL) {
+      fold_to(b, -1, CSG_EMPTY);
+      return 0;
+    }
+    if (cy == CSG_EMPTY) { fold_to(b, 0, 0); return 0; }
+    break;
+  }
+  if (grow((void **)&b->code, &b->capcode, b->ncode + 1, sizeof *b->code))
+    return b->err = CSG_ENOMEM;
+  csg_instr in = {(int)op, 0};
+  b->code[b->ncode++] = in;
+  b->nstack--;
+  return CSG_OK;
+}
+
+/* Sethi-Ullman reordering, as in density.c: the operand needing more
+ * stack goes first (a difference then becomes CSG_RDIFF). */
+static int reorder(const csg_instr *in, int n, csg_instr *out, int *depth) {
+  int *left = malloc(((size_t)n * 5 + 2) * sizeof(int));
+  if (!left) return CSG_ENOMEM;
+  int *right = left + n, *need = left + 2 * n, *stk = left + 3 * n;
+  int sp = 0;
+  for (int i = 0; i < n; i++) {
+    if (in[i].op <= CSG_ALL) {
+      left[i] = right[i] = -1;
+      need[i] = 1;
+    } else {
+      right[i] = stk[--sp];
+      left[i] = stk[--sp];
+      int nl = need[left[i]], nr = need[right[i]];
+      need[i] = nl == nr ? nl + 1 : (nl > nr ? nl : nr);
+    }
+    stk[sp++] = i;
+  }
+  *depth = need[n - 1];
+  int no = 0;
+  sp = 0;
+  stk[sp++] = n - 1;
+  while (sp) {
+    int e = stk[--sp];
+    if (e < 0) {
+      int i = ~e;
+      csg_instr o = in[i];
+      if (need[right[i]] > need[left[i]]) {
+        if (o.op == CSG_DIFF) o.op = CSG_RDIFF;
+        else if (o.op == CSG_RDIFF) o.op = CSG_DIFF;
+      }
+      out[no++] = o;
+      continue;
+    }
+    if (left[e] < 0) { out[no++] = in[e]; continue; }
+    int first = left[e], second = right[e];
+    if (need[second] > need[first]) { first = right[e]; second = left[e]; }
+    stk[sp++] = ~e;
+    stk[sp++] = second;
+    stk[sp++] = first;
+  }
+  free(left);
+  return CSG_OK;
+}
+
+/* The ray program of t (csg.h): maximal subtrees of intersected planes
+ * (more than one plane) become CSG_CONVEX groups.  A subtree is the
+ * contiguous stretch of postfix code that ends at its root, so a group's
+ * planes are the CSG_PLANE instructions of that stretch. */
+static int ray_program(csg_tape *t) {
+  int n = t->ncode;
+  int *gend = malloc(((size_t)n + 1) * sizeof(int));
+  t->rcode = malloc(((size_t)n + 1) * sizeof *t->rcode);
+  t->gstart = malloc(((size_t)n + 1) * sizeof(int));
+  t->gplane = malloc(((size_t)n + 1) * sizeof(int));
+  if (!gend || !t->rcode || !t->gstart || !t->gplane) {
+    free(gend);
+    return CSG_ENOMEM;
+  }
+  /* Per operand on the stack: where its code starts, whether it is pure
+   * (planes and intersections only) and where it ends. */
+  int sst[CSG_STACK_MAX + 1], spure[CSG_STACK_MAX + 1], send[CSG_STACK_MAX + 1];
+  int sp = 0;
+  for (int i = 0; i < n; i++) gend[i] = -1;
+  for (int i = 0; i < n; i++) {
+    int op = t->code[i].op;
+    if (op <= CSG_ALL) {
+      sst[sp] = send[sp] = i;
+      spure[sp++] = op == CSG_PLANE;
+      continue;
+    }
+    sp--;
+    int x = sp - 1, y = sp;
+    int p = op == CSG_INTER && spure[x] && spure[y];
+    if (!p) {   /* pure operands of an impure op are maximal */
+      if (spure[x]) gend[sst[x]] = send[x];
+      if (spure[y]) gend[sst[y]] = send[y];
+    }
+    spure[x] = p;
+    send[x] = i;
+  }
+  if (n > 0 && spure[0]) gend[sst[0]] = send[0];
+  int nr = 0, ng = 0, np = 0;
+  for (int i = 0; i < n;) {
+    int e = gend[i];
+    if (e > i) {
+      t->gstart[ng] = np;
+      for (int k = i; k <= e; k++)
+        if (t->code[k].op == CSG_PLANE) t->gplane[np++] = t->code[k].arg;
+      csg_instr in = {CSG_CONVEX, ng++};
+      t->rcode[nr++] = in;
+      i = e + 1;
+    } else {
+      t->rcode[nr++] = t->code[i++];
+    }
+  }
+  t->gstart[ng] = np;
+  t->nrcode = nr;
+  t->ngroups = ng;
+  free(gend);
+  t->gpl = malloc(((size_t)np + 1) * sizeof *t->gpl);
+  if (!t->gpl) return CSG_ENOMEM;
+  for (int k = 0; k < np; k++) {
+    const csg_plane *p = &t->planes[t->gplane[k]];
+    memcpy(t->gpl[k].n, p->n, sizeof p->n);
+    t->gpl[k].d = p->d;
+    t->gpl[k].id = t->gplane[k];
+  }
+  return CSG_OK;
+}
+
+csg_tape *csg_builder_finish(csg_builder *b, int *err) {
+  int e = b->err;
+  if (!e && b->nstack != 1) e = CSG_EUNBALANCED;
+  csg_tape *t = NULL;
+  if (!e) {
+    t = calloc(1, sizeof *t);
+    csg_instr *code = malloc((size_t)b->ncode * sizeof *code);
+    if (!t || !code) {
+      free(code);
+      e = CSG_ENOMEM;
+    } else if ((e = reorder(b->code, b->ncode, code, &t->depth)) != CSG_OK) {
+      free(code);
+    } else {
+      t->code = code;
+      t->ncode = b->ncode;
+      t->planes = b->planes;   /* ownership moves to the tape */
+      t->nplanes = b->nplanes;
+      b->planes = NULL;
+      for (int i = 0; i < t->ncode; i++)
+        if (t->code[i].op <= CSG_ALL) t->nleaves++;
+      if (t->depth > CSG_STACK_MAX) e = CSG_EOP;
+      else e = ray_program(t);
+    }
+    if (e) { csg_tape_free(t); t = NULL; }
+  }
+  if (err) *err = e;
+  csg_builder_free(b);
+  return t;
+}
+
+int csg_is_empty(const csg_tape *t) {
+  return t->ncode == 1 && t->code[0].op == CSG_EMPTY;
+}
+
+int csg_is_all(const csg_tape *t) {
+  return t->ncode == 1 && t->code[0].op == CSG_ALL;
+}
+
+/* Figure 4: PointInObject over a sharp CSG tape. */
+int csg_inside(const csg_tape *t, const double p[3]) {
+  unsigned char st[CSG_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const csg_instr *in = &t->code[i];
+    switch (in->op) {
+    case CSG_PLANE: {
+      const csg_plane *pl = &t->planes[in->arg];
+      st[sp++] = pl->n[0] * p[0] + pl->n[1] * p[1] + pl->n[2] * p[2] < pl->d;
+      break;
+    }
+    case CSG_EMPTY: st[sp++] = 0; break;
+    case CSG_ALL: st[sp++] = 1; break;
+    default: {
+      int y = st[--sp], x = st[sp - 1];
+      switch (in->op) {
+      case CSG_UNION: x = x || y; break;
+      case CSG_INTER: x = x && y; break;
+      case CSG_DIFF: x = x && !y; break;
+      default: x = y && !x; break;
+      }
+      st[sp - 1] = (unsigned char)x;
+    }
+    }
+  }
+  return st[0];
+}
+
+int csg_scratch_spans(const csg_tape *t) {
+  return 2 * t->nleaves + 2;
+}
+
+/* Roth's union: merge by start, coalescing overlapping or touching
+ * spans. */
+int csg_spans_union(const csg_span *a, int na, const csg_span *b, int nb,
+                    csg_span *out) {
+  int i = 0, j = 0, n = 0;
+  while (i < na || j < nb) {
+    const csg_span *s = (j >= nb || (i < na && a[i].t0 <= b[j].t0)) ? &a[i++]
+                                                                    : &b[j++];
+    if (n > 0 && s->t0 <= out[n - 1].t1) {
+      if (s->t1 > out[n - 1].t1) {
+        out[n - 1].t1 = s->t1;
+        out[n - 1].id1 = s->id1;
+        out[n - 1].flip1 = s->flip1;
+      }
+    } else {
+      out[n++] = *s;
+    }
+  }
+  return n;
+}
+
+int csg_spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
+                    csg_span *out) {
+  int i = 0, j = 0, n = 0;
+  while (i < na && j < nb) {
+    const csg_span *lo = a[i].t0 >= b[j].t0 ? &a[i] : &b[j];
+    const csg_span *hi = a[i].t1 <= b[j].t1 ? &a[i] : &b[j];
+    if (lo->t0 < hi->t1) {
+      csg_span s = {lo->t0, hi->t1, lo->id0, hi->id1, lo->flip0, hi->flip1};
+      out[n++] = s;
+    }
+    if (a[i].t1 <= b[j].t1) i++;
+    else j++;
+  }
+  return n;
+}
+
+/* a minus b: each span of a loses the parts covered by b; the cut ends
+ * take b's surfaces with their normals flipped. */
+int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
+                   csg_span *out) {
+  int j = 0, n = 0;
+  for (int i = 0; i < na; i++) {
+    csg_span cur = a[i];
+    while (j < nb && b[j].t1 <= cur.t0) j++;
+    int k = j;
+    while (k < nb && b[k].t0 < cur.t1) {
+      if (b[k].t0 > cur.t0) {
+        csg_span s = cur;
+        s.t1 = b[k].t0;
+        s.id1 = b[k].id0;
+        s.flip1 = (unsigned char)!b[k].flip0;
+        out[n++] = s;
+      }
+      if (b[k].t1 >= cur.t1) { cur.t0 = cur.t1; break; }
+      cur.t0 = b[k].t1;
+      cur.id0 = b[k].id1;
+      cur.flip0 = (unsigned char)!b[k].flip1;
+      k++;
+    }
+    if (cur.t0 < cur.t1) out[n++] = cur;
+  }
+  return n;
+}
+
+/* The one span (or none) of a halfspace; parallel rays are classified by
+ * their origin so no division by zero occurs.  Directions of any length
+ * are fine: t* = -s0/k scales with 1/|d| exactly as the parameter does. */
+static int plane_span(const csg_plane *p, int id, const double o[3],
+                      const double d[3], double s0, double s1, csg_span *out) {
+  double base = p->n[0] * o[0] + p->n[1] * o[1] + p->n[2] * o[2] - p->d;
+  double k = p->n[0] * d[0] + p->n[1] * d[1] + p->n[2] * d[2];
+  csg_span s = {s0, s1, -1, -1, 0, 0};
+  if (k == 0) {
+    if (!(base < 0)) return 0;
+  } else {
+    double ts = -base / k;
+    if (k > 0) {          /* inside before the crossing */
+      if (ts < s1) { s.t1 = ts; s.id1 = id; }
+    } else {              /* inside after it */
+      if (ts > s0) { s.t0 = ts; s.id0 = id; }
+    }
+  }
+  if (!(s.t0 < s.t1)) return 0;
+  *out = s;
+  return 1;
+}
+
+/* The span (or none) of the intersection of group g's planes: the planes'
+ * spans clipped one after another, which is what csg_spans_inter makes of
+ * them in any tree shape (the larger start and the smaller end win, the
+ * earlier operand on ties), without the merges. */
+static int convex_span(const csg_tape *t, int g, const double o[3],
+                       const double d[3], double s0, double s1,
+                       csg_span *out) {
+  double t0 = s0, t1 = s1;
+  int id0 = -1, id1 = -1;
+  const struct csg_gplane *p = t->gpl + t->gstart[g];
+  const struct csg_gplane *end = t->gpl + t->gstart[g + 1];
+  for (; p < end; p++) {
+    int id = p->id;
+    double base = p->n[0] * o[0] + p->n[1] * o[1] + p->n[2] * o[2] - p->d;
+    double kd = p->n[0] * d[0] + p->n[1] * d[1] + p->n[2] * d[2];
+    /* The plane's own span [a, b] within [s0, s1], as plane_span has it. */
+    double a = s0, b = s1;
+    if (kd == 0) {
+      if (!(base < 0)) return 0;
+      continue;
+    }
+    double ts = -base / kd;
+    if (kd > 0) {
+      if (ts < s1) b = ts;
+      if (!(a < b)) return 0;
+      if (b < t1) {
+        t1 = b;
+        id1 = id;
+        if (!(t0 < t1)) return 0;   /* empty: the rest cannot refill it */
+      }
+    } else {
+      if (ts > s0) a = ts;
+      if (!(a < b)) return 0;
+      if (a > t0) {
+        t0 = a;
+        id0 = id;
+        if (!(t0 < t1)) return 0;
+      }
+    }
+  }
+  if (!(t0 < t1)) return 0;
+  csg_span sp = {t0, t1, id0, id1, 0, 0};
+  *out = sp;
+  return 1;
+}
+
+/* Roth's ray casting: one span per halfspace, combined bottom-up with the
+ * span-list set operations. */
+int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
+                  double s0, double s1, csg_span *out, int maxout,
+                  csg_span *scratch, int nscratch) {
+  /* One convex polyhedron (a typical bound): straight to out. */
+  if (t->nrcode == 1 && t->rcode[0].op == CSG_CONVEX && maxout >= 1)
+    return convex_span(t, t->rcode[0].arg, o, d, s0, s1, out);
+  csg_span local[CSG_LOCAL_SPANS];
+  int need = csg_scratch_spans(t);
+  if (!scratch) {
+    scratch = local;
+    nscratch = CSG_LOCAL_SPANS;
+  }
+  if (nscratch < need) return -1;
+  /* The operand lists sit back to back in scratch[0 .. nleaves]; merges go
+   * through the second half and are copied back. */
+  csg_span *tmp = scratch + t->nleaves + 1;
+  int off[CSG_STACK_MAX], cnt[CSG_STACK_MAX], sp = 0, top = 0;
+  for (int i = 0; i < t->nrcode; i++) {
+    const csg_instr *in = &t->rcode[i];
+    if (in->op <= CSG_ALL || in->op == CSG_CONVEX) {
+      int c = 0;
+      if (in->op == CSG_CONVEX)
+        c = convex_span(t, in->arg, o, d, s0, s1, &scratch[top]);
+      else if (in->op == CSG_PLANE)
+        c = plane_span(&t->planes[in->arg], in->arg, o, d, s0, s1,
+                       &scratch[top]);
+      else if (in->op == CSG_ALL && s0 < s1) {
+        csg_span s = {s0, s1, -1, -1, 0, 0};
+        scratch[top] = s;
+        c = 1;
+      }
+      off[sp] = top;
+      cnt[sp++] = c;
+      top += c;
+      continue;
+    }
+    sp--;
+    csg_span *x = &scratch[off[sp - 1]], *y = &scratch[off[sp]];
+    int nx = cnt[sp - 1], ny = cnt[sp], n;
+    switch (in->op) {
+    case CSG_UNION: n = csg_spans_union(x, nx, y, ny, tmp); break;
+    case CSG_INTER: n = csg_spans_inter(x, nx, y, ny, tmp); break;
+    case CSG_DIFF: n = csg_spans_diff(x, nx, y, ny, tmp); break;
+    default: n = csg_spans_diff(y, ny, x, nx, tmp); break;
+    }
+    memcpy(x, tmp, (size_t)n * sizeof *tmp);
+    cnt[sp - 1] = n;
+    top = off[sp - 1] + n;
+  }
+  if (cnt[0] > maxout) return -1;
+  memcpy(out, scratch, (size_t)cnt[0] * sizeof *out);
+  return cnt[0];
+}

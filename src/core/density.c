@@ -1,0 +1,720 @@
+/* density.c: building and evaluating density tapes (paper Section 2). */
+#include "core/density.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct dt_builder {
+  dt_instr *code;
+  int ncode, capcode;
+  dt_leaf *leaves;
+  int nleaves, capleaves;
+  int depth;      /* operands currently on the (symbolic) stack */
+  int err;        /* first error seen; later calls are ignored */
+};
+
+dt_builder *dt_builder_new(void) {
+  return calloc(1, sizeof(dt_builder));
+}
+
+void dt_builder_free(dt_builder *b) {
+  if (!b) return;
+  free(b->code);
+  free(b->leaves);
+  free(b);
+}
+
+void dt_tape_free(dt_tape *t) {
+  if (!t) return;
+  free(t->code);
+  free(t->leaves);
+  if (t->prog) {
+    free(t->prog->pcode);
+    free(t->prog->groups);
+    free(t->prog->gleaf);
+    free(t->prog->gsnip);
+    free(t->prog->gcode);
+    free(t->prog);
+  }
+  free(t);
+}
+
+const char *dt_strerror(int err) {
+  switch (err) {
+  case DT_OK: return "no error";
+  case DT_EPLANE: return "plane normal must be finite and non-zero";
+  case DT_ERADIUS: return "radius must be finite and >= 0";
+  case DT_EOP: return "density operation needs two operands";
+  case DT_EUNBALANCED: return "density tape must hold exactly one tree";
+  case DT_ENOMEM: return "out of memory";
+  }
+  return "unknown density error";
+}
+
+static int push_instr(dt_builder *b, dt_instr in) {
+  if (b->ncode == b->capcode) {
+    int cap = b->capcode ? 2 * b->capcode : 16;
+    dt_instr *p = realloc(b->code, (size_t)cap * sizeof *p);
+    if (!p) return b->err = DT_ENOMEM;
+    b->code = p;
+    b->capcode = cap;
+  }
+  b->code[b->ncode++] = in;
+  return DT_OK;
+}
+
+int dt_builder_leaf(dt_builder *b, const double n[3], double d, double r) {
+  if (b->err) return b->err;
+  double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!isfinite(len) || len == 0 || !isfinite(d)) return DT_EPLANE;
+  if (!isfinite(r) || r < 0) return DT_ERADIUS;
+  if (b->nleaves == b->capleaves) {
+    int cap = b->capleaves ? 2 * b->capleaves : 16;
+    dt_leaf *p = realloc(b->leaves, (size_t)cap * sizeof *p);
+    if (!p) return b->err = DT_ENOMEM;
+    b->leaves = p;
+    b->capleaves = cap;
+  }
+  dt_leaf *lf = &b->leaves[b->nleaves];
+  for (int i = 0; i < 3; i++) lf->n[i] = n[i] / len;
+  lf->d = d / len;
+  lf->r = r;
+  lf->inv_r = r > 0 ? 1 / r : 0;
+  dt_instr in = {DT_LEAF, b->nleaves, 0};
+  if (push_instr(b, in)) return b->err;
+  b->nleaves++;
+  b->depth++;
+  return DT_OK;
+}
+
+int dt_builder_op(dt_builder *b, dt_op op) {
+  if (b->err) return b->err;
+  if (op != DT_SUM && op != DT_PRODUCT && op != DT_DIFF && op != DT_UNION)
+    return DT_EOP;
+  if (b->depth < 2) return DT_EOP;
+  dt_instr in = {(int)op, 0, 0};
+  if (push_instr(b, in)) return b->err;
+  b->depth--;
+  return DT_OK;
+}
+
+/* Interval product [a0,a1]*[b0,b1]. */
+static void imul(double a0, double a1, double b0, double b1,
+                 double *lo, double *hi) {
+  double p[4] = {a0 * b0, a0 * b1, a1 * b0, a1 * b1};
+  *lo = *hi = p[0];
+  for (int i = 1; i < 4; i++) {
+    if (p[i] < *lo) *lo = p[i];
+    if (p[i] > *hi) *hi = p[i];
+  }
+}
+
+/* The range of each op's result from its operands' ranges: x below, y on
+ * top.  Shared by the tape's M bound and (through lg.c's own copy of the
+ * rules) the per-segment bounds. */
+static void range_op(int op, double xl, double xh, double yl, double yh,
+                     double *lo, double *hi) {
+  switch (op) {
+  case DT_SUM: *lo = xl + yl; *hi = xh + yh; break;
+  case DT_DIFF: *lo = xl - yh; *hi = xh - yl; break;
+  case DT_RDIFF: *lo = yl - xh; *hi = yh - xl; break;
+  case DT_PRODUCT: imul(xl, xh, yl, yh, lo, hi); break;
+  default: { /* DT_UNION: 1 - (1-x)(1-y) */
+    double l, h;
+    imul(1 - xh, 1 - xl, 1 - yh, 1 - yl, &l, &h);
+    *lo = 1 - h;
+    *hi = 1 - l;
+  }
+  }
+}
+
+/* Sethi-Ullman reordering: emit the operand that needs more stack first,
+ * so a tree of n leaves needs at most log2(n)+1 slots.  Iterative, since
+ * builder trees may be long chains. */
+static int reorder(const dt_instr *in, int n, dt_instr *out, int *depth) {
+  /* stk needs up to 2 entries per tree level plus one: 2n + 2 ints. */
+  int *left = malloc(((size_t)n * 5 + 2) * sizeof(int));
+  if (!left) return DT_ENOMEM;
+  int *right = left + n, *need = left + 2 * n, *stk = left + 3 * n;
+  int sp = 0;
+  for (int i = 0; i < n; i++) {
+    if (in[i].op == DT_LEAF || in[i].op == DT_CONST) {
+      left[i] = right[i] = -1;
+      need[i] = 1;
+    } else {
+      right[i] = stk[--sp];
+      left[i] = stk[--sp];
+      int nl = need[left[i]], nr = need[right[i]];
+      need[i] = nl == nr ? nl + 1 : (nl > nr ? nl : nr);
+    }
+    stk[sp++] = i;
+  }
+  *depth = need[n - 1];
+  /* Explicit DFS: stk holds nodes, the sign bit of an entry marks "both
+   * children emitted". */
+  int no = 0;
+  sp = 0;
+  stk[sp++] = n - 1;
+  while (sp) {
+    int e = stk[--sp];
+    if (e < 0) {
+      int i = ~e;
+      dt_instr o = in[i];
+      if (need[right[i]] > need[left[i]] && o.op == DT_DIFF) o.op = DT_RDIFF;
+      out[no++] = o;
+      continue;
+    }
+    if (left[e] < 0) { out[no++] = in[e]; continue; }
+    int first = left[e], second = right[e];
+    if (need[second] > need[first]) { first = right[e]; second = left[e]; }
+    stk[sp++] = ~e;
+    stk[sp++] = second;
+    stk[sp++] = first;
+  }
+  free(left);
+  return DT_OK;
+}
+
+static void tape_range(dt_tape *t) {
+  double lo[DT_STACK_MAX], hi[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) { lo[sp] = 0; hi[sp] = 1; sp++; continue; }
+    if (in->op == DT_CONST) { lo[sp] = hi[sp] = in->c; sp++; continue; }
+    sp--;
+    range_op(in->op, lo[sp - 1], hi[sp - 1], lo[sp], hi[sp],
+             &lo[sp - 1], &hi[sp - 1]);
+  }
+  t->lo = lo[0];
+  t->hi = hi[0];
+}
+
+static int prune_program(dt_tape *t);
+
+dt_tape *dt_builder_finish(dt_builder *b, int *err) {
+  int e = b->err;
+  if (!e && b->depth != 1) e = DT_EUNBALANCED;
+  dt_tape *t = NULL;
+  if (!e) {
+    t = calloc(1, sizeof *t);
+    dt_instr *code = malloc((size_t)b->ncode * sizeof *code);
+    if (!t || !code) {
+      free(code);
+      e = DT_ENOMEM;
+    } else if ((e = reorder(b->code, b->ncode, code, &t->depth)) != DT_OK) {
+      free(code);
+    } else {
+      t->code = code;
+      t->ncode = b->ncode;
+      t->leaves = b->leaves;  /* ownership moves to the tape */
+      t->nleaves = b->nleaves;
+      b->leaves = NULL;
+      for (int i = 0; i < t->nleaves; i++)
+        if (t->leaves[i].r > t->rmax) t->rmax = t->leaves[i].r;
+      if (t->depth > DT_STACK_MAX) e = DT_EOP; /* needs > 2^63 leaves */
+      else {
+        tape_range(t);
+        e = prune_program(t);
+      }
+    }
+    if (e) { dt_tape_free(t); t = NULL; }
+  }
+  if (err) *err = e;
+  dt_builder_free(b);
+  return t;
+}
+
+double dt_max(const dt_tape *t) {
+  return t->hi;
+}
+
+/* eq. (2): alpha = s/r; (1-alpha)^2 (2+alpha)/4 inside the filter. */
+double dt_halfspace(double s, double r) {
+  if (r <= 0) return s < 0 ? 1.0 : (s > 0 ? 0.0 : 0.5);
+  double a = s / r;
+  if (a >= 1) return 0;
+  if (a <= -1) return 1;
+  return (1 - a) * (1 - a) * (2 + a) * 0.25;
+}
+
+/* Signed distance of p from a leaf's plane, positive outside. */
+static double leaf_dist(const dt_leaf *lf, const double p[3]) {
+  return lf->n[0] * p[0] + lf->n[1] * p[1] + lf->n[2] * p[2] - lf->d;
+}
+
+/* Apply a binary op to stack values x (below) and y (top). */
+static double apply(int op, double x, double y) {
+  switch (op) {
+  case DT_SUM: return x + y;
+  case DT_PRODUCT: return x * y;
+  case DT_DIFF: return x - y;
+  case DT_RDIFF: return y - x;
+  default: return x + y - x * y;
+  }
+}
+
+/* Figure 4: Density. */
+double dt_density(const dt_tape *t, const double p[3]) {
+  double st[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      st[sp++] = dt_halfspace(leaf_dist(lf, p), lf->r);
+    } else if (in->op == DT_CONST) {
+      st[sp++] = in->c;
+    } else {
+      sp--;
+      st[sp - 1] = apply(in->op, st[sp - 1], st[sp]);
+    }
+  }
+  return st[0];
+}
+
+/* Value and derivative of one leaf as a function of alpha = s/r:
+ * rho = (1-a)^2(2+a)/4, drho/da = 3/4 (a^2 - 1) (Section 2.4). */
+static double leaf_va(double a, double *dda) {
+  if (a >= 1) { *dda = 0; return 0; }
+  if (a <= -1) { *dda = 0; return 1; }
+  *dda = 0.75 * (a * a - 1);
+  return (1 - a) * (1 - a) * (2 + a) * 0.25;
+}
+
+/* Section 2.4: gradient by the usual differentiation rules. */
+double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
+  /* z[k]: the gradient of stack entry k is zero (a leaf outside its
+   * filter, a constant, or ops on such), so the three components need no
+   * arithmetic: at a point on a surface most leaves are constant. */
+  double v[DT_STACK_MAX], g[DT_STACK_MAX][3];
+  unsigned char z[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double s = leaf_dist(lf, p), dda = 0;
+      if (lf->r > 0) v[sp] = leaf_va(s * lf->inv_r, &dda);
+      else v[sp] = dt_halfspace(s, 0);
+      z[sp] = dda == 0;
+      if (!z[sp])
+        for (int j = 0; j < 3; j++) g[sp][j] = dda * lf->inv_r * lf->n[j];
+      sp++;
+    } else if (in->op == DT_CONST) {
+      v[sp] = in->c;
+      z[sp] = 1;
+      sp++;
+    } else {
+      /* apply_d with the op decided once for the three components */
+      sp--;
+      double x = v[sp - 1], y = v[sp], *gx = g[sp - 1];
+      const double *gy = g[sp];
+      int zx = z[sp - 1], zy = z[sp];
+      if (zx && zy) {
+        v[sp - 1] = apply(in->op, x, y);
+        continue;
+      }
+      if (zx) gx[0] = gx[1] = gx[2] = 0;
+      const double zero[3] = {0, 0, 0};
+      if (zy) gy = zero;
+      z[sp - 1] = 0;
+      switch (in->op) {
+      case DT_SUM:
+        for (int j = 0; j < 3; j++) gx[j] = gx[j] + gy[j];
+        v[sp - 1] = x + y;
+        break;
+      case DT_PRODUCT:
+        for (int j = 0; j < 3; j++) gx[j] = gx[j] * y + x * gy[j];
+        v[sp - 1] = x * y;
+        break;
+      case DT_DIFF:
+        for (int j = 0; j < 3; j++) gx[j] = gx[j] - gy[j];
+        v[sp - 1] = x - y;
+        break;
+      case DT_RDIFF:
+        for (int j = 0; j < 3; j++) gx[j] = gy[j] - gx[j];
+        v[sp - 1] = y - x;
+        break;
+      default:
+        for (int j = 0; j < 3; j++) gx[j] = gx[j] * (1 - y) + gy[j] * (1 - x);
+        v[sp - 1] = x + y - x * y;
+        break;
+      }
+    }
+  }
+  if (z[0]) grad[0] = grad[1] = grad[2] = 0;
+  else memcpy(grad, g[0], sizeof g[0]);
+  return v[0];
+}
+
+/* Section 2.4 along a ray: rho(o + s d) and d rho/ds by the chain rule,
+ * d alpha/ds = (n.d)/r, so any length of d is handled exactly. The leaves'
+ * distances are tabulated (dt_ray_leaves) and dt_density_rl, the search's
+ * own evaluator, does the rest. */
+double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
+                      double s, double *drho_ds) {
+  dt_ray_leaf local[64], *rl = local;
+  if (t->nleaves > 64) {
+    rl = malloc(sizeof *rl * (size_t)t->nleaves);
+    if (!rl) return NAN;
+  }
+  dt_ray_leaves(t, o, d, rl);
+  double v = dt_density_rl(t, rl, s, drho_ds);
+  if (rl != local) free(rl);
+  return v;
+}
+
+void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],
+                   dt_ray_leaf *rl) {
+  for (int i = 0; i < t->nleaves; i++) {
+    const dt_leaf *lf = &t->leaves[i];
+    rl[i].base = leaf_dist(lf, o);
+    rl[i].nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+  }
+}
+
+/* dt_density_ray with the leaves' distances from the ray's table: the same
+ * operations in the same order, so the same result to the last bit. */
+double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
+                     double *drho_ds) {
+  double v[DT_STACK_MAX], dv[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double nd = rl[in->arg].nd;
+      double dist = rl[in->arg].base + s * nd, dda = 0;
+      if (lf->r > 0) v[sp] = leaf_va(dist * lf->inv_r, &dda);
+      else v[sp] = dt_halfspace(dist, 0);
+      dv[sp] = dda * nd * lf->inv_r;
+      sp++;
+    } else if (in->op == DT_CONST) {
+      v[sp] = in->c;
+      dv[sp] = 0;
+      sp++;
+    } else {
+      sp--;
+      double x = v[sp - 1], y = v[sp], dx = dv[sp - 1], dy = dv[sp];
+      switch (in->op) {
+      case DT_SUM: dv[sp - 1] = dx + dy; v[sp - 1] = x + y; break;
+      case DT_PRODUCT: dv[sp - 1] = dx * y + x * dy; v[sp - 1] = x * y; break;
+      case DT_DIFF: dv[sp - 1] = dx - dy; v[sp - 1] = x - y; break;
+      case DT_RDIFF: dv[sp - 1] = dy - dx; v[sp - 1] = y - x; break;
+      default:
+        dv[sp - 1] = dx * (1 - y) + dy * (1 - x);
+        v[sp - 1] = x + y - x * y;
+        break;
+      }
+    }
+  }
+  if (drho_ds) *drho_ds = dv[0];
+  return v[0];
+}
+
+/* eq. (5): Displacement.  The paper's trigonometric root
+ * alpha = 2 cos((acos(2 rho - 1) + 4 pi)/3) loses all relative accuracy
+ * near rho = 0 and 1 (acos is infinitely steep at -1 and 1) and rounds the
+ * sign away near 0.5, so we solve the cubic in better-conditioned
+ * variables instead.  By the symmetry rho(-a) = 1 - rho(a) only
+ * tau = min(level, 1 - level) (exact in binary) is needed:
+ *   tau >= 1/4: a^3 - 3a + c = 0, c = 2 - 4 tau (exact), a in [0, 0.35],
+ *               Newton from a = c/3 (the series a = c/3 + c^3/81 + ...);
+ *   tau <  1/4: u = 1 - a solves u^2 (3 - u) = 4 tau, u in (0, 0.66],
+ *               Newton from the series u = s (1 + s/6), s = sqrt(4 tau/3),
+ *               which is already exact to rounding for tau < 1e-200. */
+double dt_displacement(double r, double level) {
+  if (!(level > 0)) return r;
+  if (level >= 1) return -r;
+  double tau = level <= 0.5 ? level : 1 - level;
+  double a;
+  if (tau >= 0.25) {
+    double c = 2 - 4 * tau;
+    a = c / 3;
+    for (int i = 0; i < 6; i++) {
+      double h = (a * a - 3) * a + c, dh = 3 * (a * a - 1);
+      double na = a - h / dh;
+      if (na == a) break;
+      a = na;
+    }
+  } else {
+    double s = sqrt(tau) * 1.1547005383792515; /* sqrt(4/3) */
+    double u = s * (1 + s / 6);
+    if (tau > 1e-200) {
+      for (int i = 0; i < 8; i++) {
+        double g = u * u * (3 - u) - 4 * tau, dg = 3 * u * (2 - u);
+        double nu = u - g / dg;
+        if (nu == u) break;
+        u = nu;
+      }
+    }
+    a = 1 - u;
+  }
+  return level <= 0.5 ? a * r : -a * r;
+}
+
+/* A leaf's value if it is constant over the ray segment, else -1. */
+static inline double leaf_const(const dt_leaf *lf, double base, double nd,
+                         double s0, double s1) {
+  double a = nd == 0 ? base : base + s0 * nd;
+  double b = nd == 0 ? base : base + s1 * nd;
+  double lo = a < b ? a : b, hi = a < b ? b : a;
+  if (lf->r > 0) {
+    if (lo >= lf->r) return 0;
+    if (hi <= -lf->r) return 1;
+  } else {
+    if (lo > 0) return 0;
+    if (hi < 0) return 1;
+  }
+  return -1;
+}
+
+/* The fold stack of the pruning: per operand, a constant (isc, c) or live
+ * code starting at buf[start]. */
+typedef struct {
+  double cst[DT_STACK_MAX];
+  int start[DT_STACK_MAX];
+  unsigned char isc[DT_STACK_MAX];
+  int sp, n;
+} fold_state;
+
+/* Push a leaf or constant that is the constant c (isc) or live. */
+static inline void fold_leaf(fold_state *f, const dt_instr *in, int isc,
+                             double c, dt_instr *buf) {
+  int sp = f->sp++;
+  f->start[sp] = f->n;
+  if (isc) {
+    f->isc[sp] = 1;
+    f->cst[sp] = c;
+  } else {
+    f->isc[sp] = 0;
+    buf[f->n++] = *in;
+  }
+}
+
+/* Combine the top two operands by the binary op in. */
+static inline void fold_op(fold_state *f, const dt_instr *in, dt_instr *buf) {
+  int sp = --f->sp, op = in->op;
+  int xc = f->isc[sp - 1], yc = f->isc[sp];
+  if (xc && yc) {
+    f->cst[sp - 1] = apply(op, f->cst[sp - 1], f->cst[sp]);
+    return;
+  }
+  if (!xc && !yc) {
+    buf[f->n++] = *in;
+    return;
+  }
+  /* Exactly one constant c; the live operand's code is buf[start..n). */
+  double c = xc ? f->cst[sp - 1] : f->cst[sp];
+  int st = xc ? f->start[sp] : f->start[sp - 1];
+  int keep = 0, fold = 0;
+  double fv = 0;
+  switch (op) {
+  case DT_SUM: keep = c == 0; break;
+  case DT_PRODUCT:
+    if (c == 0) { fold = 1; fv = 0; } else keep = c == 1;
+    break;
+  case DT_UNION:
+    if (c == 1) { fold = 1; fv = 1; } else keep = c == 0;
+    break;
+  case DT_DIFF: keep = yc && c == 0; break;   /* x - 0 */
+  case DT_RDIFF: keep = xc && c == 0; break;  /* y - 0 */
+  }
+  f->start[sp - 1] = st;
+  if (fold) {
+    f->n = st;
+    f->isc[sp - 1] = 1;
+    f->cst[sp - 1] = fv;
+  } else if (keep) {
+    f->isc[sp - 1] = 0;
+  } else {
+    /* Emit the constant after the live code: the operands are now in
+     * swapped order, so differences flip. */
+    dt_instr ci = {DT_CONST, 0, c};
+    buf[f->n++] = ci;
+    dt_instr oi = *in;
+    if (xc) {
+      if (op == DT_DIFF) oi.op = DT_RDIFF;
+      else if (op == DT_RDIFF) oi.op = DT_DIFF;
+    }
+    buf[f->n++] = oi;
+    f->isc[sp - 1] = 0;
+  }
+}
+
+/* Per-segment pruning (Section 3.4.1: a leaf contributes nothing to L and
+ * G where the segment misses its filter).  Constants are kept lazily on
+ * the fold stack and only emitted when combined with live code.  A
+ * finished tape is pruned through its prune program (density.h), with the
+ * same result. */
+static int prune(const dt_tape *t, const double o[3], const double d[3],
+                 const dt_ray_leaf *rl, double s0, double s1, dt_instr *buf,
+                 dt_tape *view) {
+  fold_state f;
+  f.sp = f.n = 0;
+  const dt_prune_prog *pp = t->prog;
+  const dt_instr *code = pp ? pp->pcode : t->code;
+  int nc = pp ? pp->npcode : t->ncode;
+  for (int i = 0; i < nc; i++) {
+    const dt_instr *in = &code[i];
+    int op = in->op;
+    if (op == DT_CONST) {
+      fold_leaf(&f, in, 1, in->c, buf);
+    } else if (op == DT_LEAF || op == DT_GROUP) {
+      const dt_group *g = op == DT_GROUP ? &pp->groups[in->arg] : NULL;
+      int nl = g ? g->n : 1;
+      unsigned live = 0;
+      double c = 1;
+      for (int k = 0; k < nl; k++) {
+        int li = g ? pp->gleaf[g->leaf0 + k] : in->arg;
+        const dt_leaf *lf = &t->leaves[li];
+        double base, nd;
+        if (rl) {
+          base = rl[li].base;
+          nd = rl[li].nd;
+        } else {
+          nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+          base = leaf_dist(lf, o);
+        }
+        double lc = leaf_const(lf, base, nd, s0, s1);
+        if (lc == 0) { c = 0; break; }   /* a product with a 0 is 0 */
+        if (lc < 0) live |= 1u << k;
+      }
+      if (!g) {
+        fold_leaf(&f, in, !live || c == 0, c, buf);
+      } else if (c == 0 || !live) {
+        fold_leaf(&f, in, 1, c, buf);
+      } else {
+        int a = pp->gsnip[g->snip0 + live], b = pp->gsnip[g->snip0 + live + 1];
+        f.start[f.sp] = f.n;
+        f.isc[f.sp++] = 0;
+        memcpy(buf + f.n, pp->gcode + a, (size_t)(b - a) * sizeof *buf);
+        f.n += b - a;
+      }
+    } else {
+      fold_op(&f, in, buf);
+    }
+  }
+  int n = f.n;
+  if (f.isc[0]) {
+    dt_instr ci = {DT_CONST, 0, f.cst[0]};
+    n = 0;
+    buf[n++] = ci;
+  }
+  *view = *t;
+  view->code = buf;
+  view->ncode = n;
+  view->prog = NULL;
+  return n;
+}
+
+/* The prune program of a finished tape (density.h). */
+static int prune_program(dt_tape *t) {
+  int n = t->ncode;
+  int *mem = malloc((size_t)n * 5 * sizeof(int) + 1);
+  if (!mem) return DT_ENOMEM;
+  int *start = mem, *nl = mem + n, *pure = mem + 2 * n, *parent = mem + 3 * n;
+  int *groot = mem + 4 * n;   /* at a group's first instruction: its root */
+  int stk[DT_STACK_MAX + 1], sp = 0;
+  for (int i = 0; i < n; i++) {
+    int op = t->code[i].op;
+    parent[i] = groot[i] = -1;
+    start[i] = i;
+    if (op == DT_LEAF || op == DT_CONST) {
+      nl[i] = op == DT_LEAF;
+      pure[i] = op == DT_LEAF;
+    } else {
+      int y = stk[--sp], x = stk[--sp];
+      parent[x] = parent[y] = i;
+      start[i] = start[x];
+      nl[i] = nl[x] + nl[y];
+      pure[i] = op == DT_PRODUCT && pure[x] && pure[y];
+    }
+    stk[sp++] = i;
+  }
+#define CAND(i) (pure[i] && nl[i] >= 2 && nl[i] <= DT_GROUP_MAX)
+  int ng = 0, nleaf = 0;
+  size_t nsnip = 0, ncodes = 0;
+  for (int i = 0; i < n; i++)
+    if (CAND(i) && (parent[i] < 0 || !CAND(parent[i]))) {
+      groot[start[i]] = i;
+      ng++;
+      nleaf += nl[i];
+      nsnip += ((size_t)1 << nl[i]) + 1;
+      ncodes += ((size_t)1 << nl[i]) * (size_t)(i - start[i] + 1);
+    }
+#undef CAND
+  if (!ng) {
+    free(mem);
+    return DT_OK;
+  }
+  dt_prune_prog *pp = t->prog = calloc(1, sizeof *pp);
+  if (!pp) {
+    free(mem);
+    return DT_ENOMEM;
+  }
+  pp->pcode = malloc((size_t)n * sizeof *pp->pcode);
+  pp->groups = malloc((size_t)ng * sizeof *pp->groups);
+  pp->gleaf = malloc((size_t)nleaf * sizeof *pp->gleaf);
+  pp->gsnip = malloc(nsnip * sizeof *pp->gsnip);
+  pp->gcode = malloc(ncodes * sizeof *pp->gcode);
+  if (!pp->pcode || !pp->groups || !pp->gleaf || !pp->gsnip || !pp->gcode) {
+    free(mem);
+    return DT_ENOMEM;   /* the caller frees the tape and its parts */
+  }
+  int np = 0, g = 0, lf = 0, sn = 0, nc = 0;
+  for (int i = 0; i < n;) {
+    int e = groot[i];
+    if (e < 0) {
+      pp->pcode[np++] = t->code[i++];
+      continue;
+    }
+    dt_group *gr = &pp->groups[g];
+    gr->n = nl[e];
+    gr->leaf0 = lf;
+    gr->snip0 = sn;
+    for (int k = i; k <= e; k++)
+      if (t->code[k].op == DT_LEAF) pp->gleaf[lf++] = t->code[k].arg;
+    /* The code each set of live leaves prunes to; the others are 1. */
+    for (unsigned m = 0; m < 1u << gr->n; m++) {
+      pp->gsnip[sn++] = nc;
+      if (!m) continue;   /* all 1: the constant 1, no code */
+      fold_state f;
+      f.sp = f.n = 0;
+      int k = 0;
+      for (int j = i; j <= e; j++) {
+        const dt_instr *in = &t->code[j];
+        if (in->op == DT_LEAF) {
+          fold_leaf(&f, in, !((m >> k) & 1), 1, pp->gcode + nc);
+          k++;
+        } else {
+          fold_op(&f, in, pp->gcode + nc);
+        }
+      }
+      nc += f.n;
+    }
+    pp->gsnip[sn++] = nc;
+    pp->pcode[np++] = (dt_instr){DT_GROUP, g, 0};
+    g++;
+    i = e + 1;
+  }
+  pp->npcode = np;
+  pp->ngroups = ng;
+  free(mem);
+  return DT_OK;
+}
+
+int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
+                 double s0, double s1, dt_instr *buf, dt_tape *view) {
+  int n = prune(t, o, d, NULL, s0, s1, buf, view);
+  tape_range(view);
+  return n;
+}
+
+int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
+                dt_instr *buf, dt_tape *view) {
+  return prune(t, NULL, NULL, rl, s0, s1, buf, view);
+}

@@ -1,0 +1,620 @@
+/* lg.c: LG bounds and the root search of Figure 9 (see lg.h for the
+ * derivations). */
+#include "core/lg.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Upper bounds get this relative headroom against rounding. */
+#define LG_SAFE (1 + 1e-12)
+
+/* x*y for non-negative bounds where 0 * inf means 0 (a factor that is
+ * identically zero contributes nothing). */
+static double mulnn(double x, double y) {
+  return x == 0 || y == 0 ? 0 : x * y;
+}
+
+/* max and min of two numbers that are never NaN (fmax and fmin are calls
+ * into libm). */
+static double max2(double x, double y) { return x > y ? x : y; }
+static double min2(double x, double y) { return x < y ? x : y; }
+
+static double maxabs(double lo, double hi) {
+  return fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi);
+}
+
+/* dt_halfspace(a, 1) for a in [-1, 1], inline. */
+static inline double halfspace1(double a) {
+  if (a >= 1) return 0;
+  if (a <= -1) return 1;
+  return (1 - a) * (1 - a) * (2 + a) * 0.25;
+}
+
+/* eq. (2) and its alpha-derivatives over the segment for one leaf. */
+static void leaf_bounds(const dt_leaf *lf, double base, double nd, double a,
+                        double b, double *lo, double *hi, double *L,
+                        double *G, double *split) {
+  double sa = nd == 0 ? base : base + a * nd;
+  double sb = nd == 0 ? base : base + b * nd;
+  double smin = sa < sb ? sa : sb, smax = sa < sb ? sb : sa;
+  if (lf->r == 0) {
+    if (smin > 0 || smax < 0) {
+      *lo = *hi = smin > 0 ? 0 : 1;
+      *L = *G = 0;
+    } else {
+      *lo = 0;
+      *hi = 1;
+      *L = *G = INFINITY;
+      if (nd != 0) *split = -base / nd;
+    }
+    return;
+  }
+  double amin = smin * lf->inv_r, amax = smax * lf->inv_r;
+  if (amin >= 1 || amax <= -1) {
+    *lo = *hi = amin >= 1 ? 0 : 1;
+    *L = *G = 0;
+    return;
+  }
+  if (amin < -1) amin = -1;
+  if (amax > 1) amax = 1;
+  *lo = halfspace1(amax);
+  *hi = halfspace1(amin);
+  double near = amin <= 0 && amax >= 0 ? 0 : min2(fabs(amin), fabs(amax));
+  double far = max2(fabs(amin), fabs(amax));
+  double k = fabs(nd) * lf->inv_r;
+  *L = 0.75 * (1 - near * near) * k;
+  *G = 1.5 * far * k * k;
+}
+
+/* Section 3.4.1: LG values of a tape over [a, b], the leaves' distances
+ * from rl (dt_ray_leaf) or, without it, from o and d. */
+static void eval_bounds(const dt_tape *t, const dt_ray_leaf *ray,
+                        const double o[3], const double d[3], double a,
+                        double b, lg_bounds *out) {
+  double lo[DT_STACK_MAX], hi[DT_STACK_MAX], L[DT_STACK_MAX], G[DT_STACK_MAX];
+  int sp = 0;
+  out->split = NAN;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double base, nd;
+      if (ray) {
+        base = ray[in->arg].base;
+        nd = ray[in->arg].nd;
+      } else {
+        nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+        base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
+      }
+      leaf_bounds(lf, base, nd, a, b, &lo[sp], &hi[sp], &L[sp], &G[sp],
+                  &out->split);
+      sp++;
+      continue;
+    }
+    if (in->op == DT_CONST) {
+      lo[sp] = hi[sp] = in->c;
+      L[sp] = G[sp] = 0;
+      sp++;
+      continue;
+    }
+    sp--;
+    int x = sp - 1, y = sp;
+    double rl, rh, rL, rG;
+    switch (in->op) {
+    case DT_SUM:
+    case DT_DIFF:
+    case DT_RDIFF:
+      if (in->op == DT_SUM) { rl = lo[x] + lo[y]; rh = hi[x] + hi[y]; }
+      else if (in->op == DT_DIFF) { rl = lo[x] - hi[y]; rh = hi[x] - lo[y]; }
+      else { rl = lo[y] - hi[x]; rh = hi[y] - lo[x]; }
+      rL = L[x] + L[y];
+      rG = G[x] + G[y];
+      break;
+    default: {
+      /* Product x*y, or Union 1 - (1-x)(1-y) = 1 - X*Y with X = 1-x:
+       * (XY)' = X'Y + XY', (XY)'' = X''Y + 2X'Y' + XY''. */
+      int u = in->op == DT_UNION;
+      double xl = u ? 1 - hi[x] : lo[x], xh = u ? 1 - lo[x] : hi[x];
+      double yl = u ? 1 - hi[y] : lo[y], yh = u ? 1 - lo[y] : hi[y];
+      double p[4] = {xl * yl, xl * yh, xh * yl, xh * yh};
+      rl = rh = p[0];
+      for (int k = 1; k < 4; k++) {
+        if (p[k] < rl) rl = p[k];
+        if (p[k] > rh) rh = p[k];
+      }
+      if (u) { double tmp = rl; rl = 1 - rh; rh = 1 - tmp; }
+      double mx = maxabs(xl, xh), my = maxabs(yl, yh);
+      rL = mulnn(L[x], my) + mulnn(mx, L[y]);
+      rG = mulnn(G[x], my) + 2 * mulnn(L[x], L[y]) + mulnn(mx, G[y]);
+    }
+    }
+    lo[x] = rl;
+    hi[x] = rh;
+    L[x] = rL;
+    G[x] = rG;
+  }
+  out->lo = lo[0];
+  out->hi = hi[0];
+  out->L = L[0] * LG_SAFE;
+  out->G = G[0] * LG_SAFE;
+}
+
+void lg_eval_bounds(const dt_tape *t, const double o[3], const double d[3],
+                    double a, double b, lg_bounds *out) {
+  eval_bounds(t, NULL, o, d, a, b, out);
+}
+
+/* x/y for bounds: 0/0 is 0 and x/0 is infinite. */
+static double sdiv(double x, double y) {
+  if (y > 0) return x / y;
+  return x > 0 ? INFINITY : 0;
+}
+
+/* The least distance from an end to a turning point after the first root
+ * (lg.h): f there, df its derivative moving inwards. */
+static double reach(double f, double df, double L, double G) {
+  double g = fabs(f), gp = f >= 0 ? df : -df;
+  double s = 0;
+  if (g > 0) {
+    if (G == 0) s = gp < 0 ? g / -gp : INFINITY;
+    else if (isinf(G)) s = 0;
+    else {
+      double disc = sqrt(gp * gp + 2 * G * g);
+      s = gp >= 0 ? (gp + disc) / G : 2 * g / (disc - gp);
+    }
+  }
+  double r = sdiv(g, L), q = sdiv(fabs(df), G);
+  if (q > r) r = q;
+  return s > r ? s : r;
+}
+
+/* eq. (6), sound form. */
+double lg_multiroot_length(double f0, double df0, double f1, double df1,
+                           double L, double G) {
+  return reach(f0, df0, L, G) + reach(f1, -df1, L, G);
+}
+
+#define LG_LOCAL_LEAVES 64
+#define LG_LEVEL_CODE 4096   /* instructions for the levels' views */
+#define LG_MAX_LEVELS 32
+
+typedef struct {
+  double a, b, fa, dfa, fb, dfb;
+  int depth;
+} segment;
+
+/* Everything one search needs, so helpers stay short. */
+typedef struct {
+  const double *o, *d;
+  double tol;
+  lg_root *out;
+  int n, maxout;
+  lg_stats *st;
+  const lg_hook *hook;
+  const dt_ray_leaf *rl;  /* the leaves along this ray */
+  dt_instr *lvbuf;        /* nlv code buffers of ncode instructions, then */
+  int nlv, ncode;         /* one scratch buffer for deeper segments */
+  int first;          /* stop at the first crossing after first_after; 2:
+                         any point of its bracket will do (polish) */
+  double first_after;
+  double *grad;       /* if not NULL: the gradient at that crossing */
+} search;
+
+static double feval(search *s, const dt_tape *t, double x, double *df) {
+  if (s->st) s->st->evals++;
+  return dt_density_rl(t, s->rl, x, df) - 0.5;
+}
+
+/* Returns 0 when out is full (the search stops). */
+static int emit(search *s, const dt_tape *view, double t, int kind) {
+  if (s->n >= s->maxout) return 0;
+  /* One graze seen from two adjacent tiny segments is one touch. */
+  if (kind == LG_TOUCH && s->n > 0 && t - s->out[s->n - 1].t <= s->tol)
+    return 1;
+  s->out[s->n].t = t;
+  s->out[s->n].kind = kind;
+  s->n++;
+  if (kind == LG_TOUCH && s->st) s->st->touches++;
+  if (s->first && kind != LG_TOUCH && t > s->first_after) {
+    if (s->grad) {   /* from the segment's pruned tape: few leaves */
+      double p[3];
+      for (int i = 0; i < 3; i++) p[i] = s->o[i] + t * s->d[i];
+      dt_density_grad(view, p, s->grad);
+    }
+    return 0;
+  }
+  return s->n < s->maxout;
+}
+
+
+/* The inside predicate: the solid is where the density exceeds 0.5, so a
+ * point where f = rho - 0.5 is exactly 0 is outside (as PointInObject
+ * has it).  Crossings are the changes of this predicate; deciding them by
+ * the sign of f alone would turn a stretch where the density is exactly
+ * 0.5 (a ray in a face plane of a rounded cube) or a graze that the
+ * rounding lifts to exactly 0.5 into a pair of crossings, or classify a
+ * zero by its derivative. */
+static int pos(double f) { return f > 0; }
+
+/* The change of the inside predicate in a bracket [a, b] whose ends
+ * differ (pos(fa) != pos(fb)): Newton steps from the better end, each
+ * kept only if it lands inside the bracket and at least halves the step
+ * before it, else a bisection (the safeguarded Newton of Numerical
+ * Recipes' rtsafe, in place of the paper's regula falsi; both keep the
+ * bracket, this one converges quadratically and uses the derivative every
+ * evaluation computes anyway). Stops when a step is below
+ * max(tol, 4 ulp).  An end where f is exactly 0 is on the surface: the
+ * change is there when it is the outside end next to the bracket's inside
+ * part, so exact zeros (a face plane at density 0.5) come back exactly. */
+static double polish(search *s, const dt_tape *t, double a, double b,
+                     double fa, double fb, double dfa, double dfb) {
+  /* The caller only asks whether there is a crossing after first_after
+   * (a shadow ray): the bracket's far end stands for it. */
+  if (s->first == 2 && a > s->first_after) return b;
+  int pa = pos(fa);
+  if (!pa && fa == 0) return a;    /* entering right after a zero at a */
+  if (pa && fb == 0) return b;     /* leaving at a zero at b */
+  double rtol = max2(s->tol, 4 * DBL_EPSILON * max2(fabs(a), fabs(b)));
+  double x, f, df;
+  if (fabs(fa) < fabs(fb)) x = a, f = fa, df = dfa;
+  else x = b, f = fb, df = dfb;
+  double dx = b - a, dxold = dx;
+  for (int it = 0; it < 200 && b - a > rtol; it++) {
+    double nx = df != 0 && f != 0 ? x - f / df : NAN;
+    if (nx > a && nx < b && fabs(2 * f) <= fabs(dxold * df)) {
+      dxold = dx;
+      dx = x - nx;
+      x = nx;
+    } else {
+      dxold = dx;
+      dx = 0.5 * (b - a);
+      x = a + dx;
+      if (!(x > a && x < b)) break;
+    }
+    if (s->st) s->st->rf_steps++;
+    f = feval(s, t, x, &df);
+    if (pos(f) == pa) a = x, fa = f;
+    else b = x, fb = f;
+    if (f == 0) {
+      /* On the surface: a simple root is exact here, unless f stays 0
+       * on a stretch (then the change is at its far end): look one tol
+       * beyond. */
+      double y = pa ? x - rtol : x + rtol, dfy;
+      if (y > a && y < b) {
+        if (s->st) s->st->rf_steps++;
+        double fy = feval(s, t, y, &dfy);
+        if (pos(fy) != pos(f)) return x;
+        if (pa) b = y, fb = fy; else a = y, fa = fy;
+      } else {
+        return x;
+      }
+      df = 0;   /* bisect from here */
+      continue;
+    }
+    if (fabs(dx) <= rtol) return x;
+  }
+  if (!pa && fa == 0) return a;
+  if (pa && fb == 0) return b;
+  return 0.5 * (a + b);
+}
+
+/* Lower bound of |f| on [a, a+h] from the quadratic envelope at a, f and
+ * df (derivative moving inwards) given: concave, so the least value is at
+ * an end of the interval. */
+static double envelope_min(double f, double df, double G, double h) {
+  double g = fabs(f), gp = f >= 0 ? df : -df;
+  double e = g + gp * h - 0.5 * G * h * h;
+  return e < g ? e : g;
+}
+
+/* The tolerance rule for a segment shorter than tol (lg.h). */
+static int tiny_rule(search *s, const dt_tape *t, const segment *sg, double G,
+                     int *nroots) {
+  int pa = pos(sg->fa), pb = pos(sg->fb);
+  if (pa != pb) {
+    (*nroots)++;
+    double x = polish(s, t, sg->a, sg->b, sg->fa, sg->fb, sg->dfa, sg->dfb);
+    return emit(s, t, x, pa ? LG_EXIT : LG_ENTER);
+  }
+  if (isinf(G)) return 1;
+  double m = 0.5 * (sg->a + sg->b);
+  if ((sg->dfa < 0) != (sg->dfb < 0) && sg->dfa != sg->dfb) {
+    double x = sg->a + (sg->b - sg->a) * sg->dfa / (sg->dfa - sg->dfb);
+    if (x > sg->a && x < sg->b) m = x;
+  }
+  double dfm, fm = feval(s, t, m, &dfm);
+  if (pos(fm) != pa) {
+    int k1 = pa ? LG_EXIT : LG_ENTER;
+    *nroots += 2;
+    if (!emit(s, t, polish(s, t, sg->a, m, sg->fa, fm, sg->dfa, dfm), k1))
+      return 0;
+    return emit(s, t, polish(s, t, m, sg->b, fm, sg->fb, dfm, sg->dfb), -k1);
+  }
+  if (fm == 0 || sg->fa == 0 || sg->fb == 0) {
+    (*nroots)++;
+    return emit(s, t, fm == 0 ? m : sg->fa == 0 ? sg->a : sg->b, LG_TOUCH);
+  }
+  double h1 = m - sg->a, h2 = sg->b - m;
+  double lb1 = fmax(envelope_min(sg->fa, sg->dfa, G, h1),
+                    envelope_min(fm, -dfm, G, h1));
+  double lb2 = fmax(envelope_min(fm, dfm, G, h2),
+                    envelope_min(sg->fb, -sg->dfb, G, h2));
+  if (lb1 > 0 && lb2 > 0) return 1;
+  (*nroots)++;
+  return emit(s, t, m, LG_TOUCH);
+}
+
+static void trace(search *s, const segment *sg, const lg_bounds *lb,
+                  double lhs, int decision, int ncode, int nroots) {
+  if (!s->hook || !s->hook->fn) return;
+  lg_trace_event ev = {sg->a, sg->b, sg->fa, sg->fb, sg->dfa, sg->dfb,
+                       lb->L, lb->G, lb->lo, lb->hi, lhs, decision,
+                       sg->depth, ncode, nroots};
+  s->hook->fn(s->hook->ctx, &ev);
+}
+
+/* Figure 9 over [a, b] of the (span-pruned) tape t.  Returns 0 when the
+ * output is full.  A segment's tape is pruned from its parent's, not from
+ * t: the search is depth first, so when a segment of depth k is popped
+ * the views of levels below k are those of its ancestors (only the
+ * ancestors' other descendants, all deeper, ran since).  Levels from nlv
+ * on prune from the deepest stored one. */
+static int search_interval(search *s, const dt_tape *t, double a, double b) {
+  segment stack[LG_STACK];
+  dt_tape lv[LG_MAX_LEVELS + 1];   /* lv[nlv]: deeper segments' views */
+  int sp = 0;
+  long budget = LG_MAX_SEGMENTS;
+  segment first = {a, b, 0, 0, 0, 0, 0};
+  first.fa = feval(s, t, a, &first.dfa);
+  first.fb = feval(s, t, b, &first.dfb);
+  stack[sp++] = first;
+  while (sp) {
+    segment sg = stack[--sp];
+    if (s->st) s->st->segments++;
+    const dt_tape *vp = t;   /* this segment's view; level 0 is t */
+    if (sg.depth > 0) {
+      int from = sg.depth - 1 < s->nlv - 1 ? sg.depth - 1 : s->nlv - 1;
+      int to = sg.depth < s->nlv ? sg.depth : s->nlv;
+      dt_prune_rl(from ? &lv[from] : t, s->rl, sg.a, sg.b,
+                  s->lvbuf + (size_t)to * s->ncode, &lv[to]);
+      vp = &lv[to];
+    }
+    int nc = vp->ncode;
+    lg_bounds lb;
+    eval_bounds(vp, s->rl, s->o, s->d, sg.a, sg.b, &lb);
+    double margin = 1e-12 * (1 + fabs(lb.lo) + fabs(lb.hi));
+    if (lb.lo > 0.5 + margin || lb.hi < 0.5 - margin) {
+      trace(s, &sg, &lb, INFINITY, LG_SEG_EXCLUDED, nc, 0);
+      continue;
+    }
+    if (lb.L == 0) {
+      trace(s, &sg, &lb, INFINITY, LG_SEG_FLAT, nc, 0);
+      continue;
+    }
+    double len = sg.b - sg.a;
+    double lhs = lg_multiroot_length(sg.fa, sg.dfa, sg.fb, sg.dfb, lb.L, lb.G);
+    int shorty = lhs > len * LG_SAFE;
+    double minlen = max2(s->tol, 16 * DBL_EPSILON * max2(fabs(sg.a), fabs(sg.b)));
+    double m = 0.5 * (sg.a + sg.b);
+    if (!isnan(lb.split) && lb.split > sg.a + 0.25 * minlen &&
+        lb.split < sg.b - 0.25 * minlen)
+      m = lb.split;
+    int tiny = len <= minlen || !(m > sg.a && m < sg.b);
+    if (!shorty && !tiny && (sp + 2 > LG_STACK || --budget < 0)) {
+      tiny = 1;
+      if (s->st) s->st->overflows++;
+    }
+    int nroots = 0, more = 1;
+    if (shorty) {
+      if (pos(sg.fa) != pos(sg.fb)) {
+        nroots = 1;
+        more = emit(s, vp, polish(s, vp, sg.a, sg.b, sg.fa, sg.fb, sg.dfa, sg.dfb),
+                    pos(sg.fa) ? LG_EXIT : LG_ENTER);
+      }
+      trace(s, &sg, &lb, lhs, nroots ? LG_SEG_ROOT : LG_SEG_NO_ROOT, nc,
+            nroots);
+    } else if (tiny) {
+      more = tiny_rule(s, vp, &sg, lb.G, &nroots);
+      trace(s, &sg, &lb, lhs, LG_SEG_TINY, nc, nroots);
+    } else {
+      trace(s, &sg, &lb, lhs, LG_SEG_SPLIT, nc, 0);
+      segment left = sg, right = sg;
+      double fm, dfm;
+      fm = feval(s, vp, m, &dfm);
+      left.b = right.a = m;
+      left.fb = right.fa = fm;
+      left.dfb = right.dfa = dfm;
+      left.depth = right.depth = sg.depth + 1;
+      stack[sp++] = right;
+      stack[sp++] = left;
+    }
+    if (!more) return 0;
+  }
+  return 1;
+}
+
+/* The leaves along the ray (dt_ray_leaves) and the part of the ray where
+ * some filter is touched, [*lo, *hi]: outside it every leaf is constant,
+ * so the density is too. */
+static void ray_leaves_hull(const dt_tape *t, const double o[3],
+                            const double d[3], dt_ray_leaf *rl, double *lo,
+                            double *hi) {
+  double l = INFINITY, h = -INFINITY;
+  for (int i = 0; i < t->nleaves; i++) {
+    const dt_leaf *lf = &t->leaves[i];
+    double base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
+    double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+    rl[i].base = base;
+    rl[i].nd = nd;
+    if (nd == 0) continue;
+    double x = (-lf->r - base) / nd, y = (lf->r - base) / nd;
+    if (x > y) { double tmp = x; x = y; y = tmp; }
+    if (x < l) l = x;
+    if (y > h) h = y;
+  }
+  *lo = l;
+  *hi = h;
+}
+
+/* Search the sorted, disjoint intervals iv[0..n) (pairs of doubles). */
+static int run(const dt_tape *t, const double o[3], const double d[3],
+               const double *iv, int n, double tol, lg_root *out, int maxout,
+               lg_stats *stats, const lg_hook *hook, int first,
+               double first_after, int bounded_iv, double *grad) {
+  if (n <= 0 || maxout <= 0) return 0;
+  dt_instr local[LG_LEVEL_CODE], *buf = local;
+  dt_ray_leaf lrl[LG_LOCAL_LEAVES], *rl = lrl;
+  int nc = t->ncode > 0 ? t->ncode : 1;
+  /* Buffers: the interval's view, nlv levels (the first is the interval's
+   * view itself), one scratch. */
+  int nlv = LG_LEVEL_CODE / nc - 2;
+  if (nlv > LG_MAX_LEVELS) nlv = LG_MAX_LEVELS;
+  if (nlv < 1) nlv = 1;
+  size_t need = (size_t)(nlv + 2) * (size_t)nc;
+  if (need > LG_LEVEL_CODE) {
+    buf = malloc(need * sizeof *buf);
+    if (!buf) return -1;
+  }
+  if (t->nleaves > LG_LOCAL_LEAVES) {
+    rl = malloc((size_t)t->nleaves * sizeof *rl);
+    if (!rl) {
+      if (buf != local) free(buf);
+      return -1;
+    }
+  }
+  /* Intervals from the outer bound (bounded_iv) already lie where the
+   * filters are, unless an end is infinite (an unbounded object): the
+   * clip to the filters' hull, which costs two divisions per leaf, is
+   * only needed for those and for intervals from the caller. */
+  double hlo = -INFINITY, hhi = INFINITY;
+  if (bounded_iv && isfinite(iv[0]) && isfinite(iv[2 * n - 1]))
+    dt_ray_leaves(t, o, d, rl);
+  else
+    ray_leaves_hull(t, o, d, rl, &hlo, &hhi);
+  search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
+              rl, buf + nc, nlv, nc, first, first_after, grad};
+  for (int i = 0; i < n; i++) {
+    double a = iv[2 * i], b = iv[2 * i + 1];
+    if (hlo > a) a = hlo;
+    if (hhi < b) b = hhi;
+    if (!(a <= b)) continue;
+    dt_tape view;
+    dt_prune_rl(t, rl, a, b, buf, &view);
+    if (!search_interval(&s, &view, a, b)) break;
+  }
+  if (buf != local) free(buf);
+  if (rl != lrl) free(rl);
+  return s.n;
+}
+
+/* Figure 9: Roots. */
+int lg_roots(const dt_tape *t, const double o[3], const double d[3],
+             double t0, double t1, double tol, lg_root *out, int maxout,
+             lg_stats *stats) {
+  double iv[2] = {t0, t1};
+  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL, 0, 0, 0,
+             NULL);
+}
+
+static int spans_run(const dt_tape *t, const double o[3], const double d[3],
+                     double t0, double t1, const csg_span *spans, int nspans,
+                     double tol, lg_root *out, int maxout, lg_stats *stats,
+                     const lg_hook *hook, int first, int bounded_iv,
+                     double *grad) {
+  double local[2 * 64], *iv = local;
+  if (nspans > 64) {
+    iv = malloc((size_t)nspans * 2 * sizeof *iv);
+    if (!iv) return -1;
+  }
+  int n = 0;
+  for (int i = 0; i < nspans; i++) {
+    double pad0 = tol + 8 * DBL_EPSILON * fabs(spans[i].t0);
+    double pad1 = tol + 8 * DBL_EPSILON * fabs(spans[i].t1);
+    double a = max2(spans[i].t0 - pad0, t0), b = min2(spans[i].t1 + pad1, t1);
+    if (!(a <= b)) continue;
+    if (n > 0 && a <= iv[2 * n - 1]) {   /* merge widened neighbours */
+      if (b > iv[2 * n - 1]) iv[2 * n - 1] = b;
+      continue;
+    }
+    iv[2 * n] = a;
+    iv[2 * n + 1] = b;
+    n++;
+  }
+  int r = run(t, o, d, iv, n, tol, out, maxout, stats, hook, first, t0,
+              bounded_iv, grad);
+  if (iv != local) free(iv);
+  return r;
+}
+
+int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
+                   double t0, double t1, const csg_span *spans, int nspans,
+                   double tol, lg_root *out, int maxout, lg_stats *stats,
+                   const lg_hook *hook) {
+  return spans_run(t, o, d, t0, t1, spans, nspans, tol, out, maxout, stats,
+                   hook, 0, 0, NULL);
+}
+
+/* Figure 7 (c): search where outer and not inner. */
+static int bounded(const dt_tape *t, const csg_tape *outer,
+                   const csg_tape *inner, const double o[3], const double d[3],
+                   double t0, double t1, double tol, lg_root *out, int maxout,
+                   lg_stats *stats, const lg_hook *hook, int first,
+                   double *grad) {
+  int no = outer->nleaves + 1, ni = inner ? inner->nleaves + 1 : 0;
+  int nsc = csg_scratch_spans(outer);
+  if (inner && csg_scratch_spans(inner) > nsc) nsc = csg_scratch_spans(inner);
+  size_t need = (size_t)(2 * no + 2 * ni + nsc);
+  csg_span local[4 * 64 + 2 * 64 + 8], *mem = local;
+  if (need > sizeof local / sizeof *local) {
+    mem = malloc(need * sizeof *mem);
+    if (!mem) return -1;
+  }
+  csg_span *os = mem, *is = os + no, *ds = is + ni, *sc = ds + no + ni;
+  int n = csg_ray_spans(outer, o, d, t0, t1, os, no, sc, nsc), r = -1;
+  if (n == 0) {   /* the ray misses the outer bound: no crossing */
+    r = 0;
+  } else if (n > 0) {
+    int m = inner ? csg_ray_spans(inner, o, d, t0, t1, is, ni, sc, nsc) : 0;
+    if (m >= 0) {
+      /* A crossing on a surface the two bounds share (a lone halfspace,
+       * whose 0.5 isosurface is its plane; a sharp leaf's plane) lies on
+       * the inner bound's surface, and rounding may make outer minus inner
+       * empty there (the bounds' few ulps of offset vanish in n.o at the
+       * ray's coordinates): move the inner spans' surface ends in by the
+       * padding spans_run widens by, so such a crossing is searched. */
+      int w = 0;
+      for (int i = 0; i < m; i++) {
+        csg_span s = is[i];
+        if (s.id0 >= 0) s.t0 += tol + 8 * DBL_EPSILON * fabs(s.t0);
+        if (s.id1 >= 0) s.t1 -= tol + 8 * DBL_EPSILON * fabs(s.t1);
+        if (s.t0 < s.t1) is[w++] = s;
+      }
+      m = w;
+      int k = csg_spans_diff(os, n, is, m, ds);
+      r = spans_run(t, o, d, t0, t1, ds, k, tol, out, maxout, stats, hook,
+                    first, 1, grad);
+    }
+  }
+  if (mem != local) free(mem);
+  return r;
+}
+
+int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
+                     const csg_tape *inner, const double o[3],
+                     const double d[3], double t0, double t1, double tol,
+                     lg_root *out, int maxout, lg_stats *stats,
+                     const lg_hook *hook) {
+  return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, hook,
+                 0, NULL);
+}
+
+int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
+                     const csg_tape *inner, const double o[3],
+                     const double d[3], double t0, double t1, double tol,
+                     lg_root *out, int maxout, lg_stats *stats, int any,
+                     double grad[3]) {
+  return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, NULL,
+                 any ? 2 : 1, grad);
+}

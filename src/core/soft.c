@@ -1,0 +1,700 @@
+/* soft.c: soft objects -- the field of eq. (1), its gradient, and all ray
+ * crossings by the interval method of Wyvill and Trotman, with a BVH over
+ * the key bounds ("spatial sorting") walked front to back. */
+#include "core/soft.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* eq. (1) as a cubic in s = r^2/R^2: C = 1 + A1 s + A2 s^2 + A3 s^3. */
+#define A1 (-22.0 / 9.0)
+#define A2 (17.0 / 9.0)
+#define A3 (-4.0 / 9.0)
+#define LEAF_MAX 4
+
+/* A key normalised to s(x) = (x-x0)' A (x-x0) + k, A already divided by
+ * R^2 (for a sphere A = I/R^2, k = 0); the key acts where s < 1. */
+typedef struct {
+  double x0[3];
+  double a[6];     /* A: xx yy zz xy xz yz */
+  double k;
+  double w;
+  double cmax;     /* C(k): the key's largest field value */
+  double lo[3], hi[3];  /* bounding box of s < 1 (empty: lo > hi) */
+  int sphere;      /* A = a[0] I */
+  int empty;       /* acts nowhere */
+} skey_t;
+
+typedef struct {
+  double lo[3], hi[3];
+  int first;       /* inner: index of the left child (right = first + 1);
+                      leaf: first key */
+  int count;       /* 0 for an inner node */
+} node_t;
+
+struct soft_obj {
+  skey_t *keys;     /* in BVH leaf order */
+  size_t nkeys;
+  node_t *nodes;
+  int nnodes;
+  double magic;
+  double lo[3], hi[3];
+};
+
+typedef struct { double t; int i; } hent_t;            /* heap entry */
+typedef struct { double te, tx; int i; } kev_t;        /* key events */
+
+struct soft_scratch {
+  size_t cap;      /* keys */
+  hent_t *nheap;   /* BVH nodes by entry, 2 cap */
+  kev_t *kheap;    /* discovered keys by entry, cap */
+  kev_t *act;      /* active keys, cap */
+  double *sq;      /* s(v) coefficients of the active keys, 3 cap */
+};
+
+/* eq. (1) in the factored form C(s) = (1 - s)^2 (1 - 4s/9): the same
+ * polynomial, but with full relative accuracy near the edge of the key's
+ * bound (s -> 1), where the expanded form's cancellation leaves only an
+ * absolute eps. */
+static double cfield(double s)
+{
+  if (s >= 1) return 0;
+  double u = 1 - s;
+  return u * u * (1 - s * (4.0 / 9.0));
+}
+
+static double cslope(double s)  /* dC/ds */
+{
+  return s >= 1 ? 0 : A1 + s * (2 * A2 + s * 3 * A3);
+}
+
+/* ---- building -------------------------------------------------------- */
+
+const char *soft_strerror(int err)
+{
+  switch (err) {
+  case SOFT_OK: return "no error";
+  case SOFT_ERR_RADIUS: return "radius of influence must be finite and > 0";
+  case SOFT_ERR_NONFINITE: return "key has a non-finite centre, matrix entry or weight";
+  case SOFT_ERR_KIND: return "unknown key kind";
+  case SOFT_ERR_UNBOUNDED: return "quadric key is unbounded (its 3x3 block is not positive definite)";
+  case SOFT_ERR_MAGIC: return "magic must be finite and > 0";
+  case SOFT_ERR_NOMEM: return "out of memory";
+  }
+  return "unknown error";
+}
+
+/* Normalise one key; returns an error code. */
+static int make_key(const soft_key *in, skey_t *k)
+{
+  memset(k, 0, sizeof *k);
+  if (!(in->R > 0) || !isfinite(in->R)) return SOFT_ERR_RADIUS;
+  if (!isfinite(in->w)) return SOFT_ERR_NONFINITE;
+  double r2 = in->R * in->R;
+  k->w = in->w;
+  if (in->kind == SOFT_SPHERE) {
+    for (int i = 0; i < 3; i++) {
+      if (!isfinite(in->c[i])) return SOFT_ERR_NONFINITE;
+      k->x0[i] = in->c[i];
+      k->lo[i] = in->c[i] - in->R;
+      k->hi[i] = in->c[i] + in->R;
+    }
+    k->a[0] = k->a[1] = k->a[2] = 1 / r2;
+    k->sphere = 1;
+    k->cmax = 1;
+    return SOFT_OK;
+  }
+  if (in->kind != SOFT_QUADRIC) return SOFT_ERR_KIND;
+  double m[4][4];
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++) {
+      if (!isfinite(in->m[i][j])) return SOFT_ERR_NONFINITE;
+      m[i][j] = 0.5 * (in->m[i][j] + in->m[j][i]);
+    }
+  /* Sylvester: leading minors of the 3x3 block positive. */
+  double d1 = m[0][0], d2 = m[0][0] * m[1][1] - m[0][1] * m[0][1];
+  double c00 = m[1][1] * m[2][2] - m[1][2] * m[1][2];
+  double c01 = m[0][2] * m[1][2] - m[0][1] * m[2][2];
+  double c02 = m[0][1] * m[1][2] - m[0][2] * m[1][1];
+  double det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02;
+  if (!(d1 > 0 && d2 > 0 && det > 0)) return SOFT_ERR_UNBOUNDED;
+  double inv[3][3];  /* A^-1 by the adjugate */
+  inv[0][0] = c00 / det;
+  inv[0][1] = inv[1][0] = c01 / det;
+  inv[0][2] = inv[2][0] = c02 / det;
+  inv[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[0][2]) / det;
+  inv[1][2] = inv[2][1] = (m[0][1] * m[0][2] - m[0][0] * m[1][2]) / det;
+  inv[2][2] = d2 / det;
+  /* centre x0 = -A^-1 b, k = m33 + b.x0 */
+  double kk = m[3][3];
+  for (int i = 0; i < 3; i++) {
+    k->x0[i] = -(inv[i][0] * m[0][3] + inv[i][1] * m[1][3] + inv[i][2] * m[2][3]);
+    kk += m[i][3] * k->x0[i];
+  }
+  k->a[0] = m[0][0] / r2; k->a[1] = m[1][1] / r2; k->a[2] = m[2][2] / r2;
+  k->a[3] = m[0][1] / r2; k->a[4] = m[0][2] / r2; k->a[5] = m[1][2] / r2;
+  k->k = kk / r2;
+  k->cmax = k->k < 1 ? cfield(k->k) : 0;
+  if (!isfinite(k->k) || !(k->k < 1)) {  /* acts nowhere */
+    k->empty = 1;
+    for (int i = 0; i < 3; i++) { k->lo[i] = INFINITY; k->hi[i] = -INFINITY; }
+    return isfinite(k->k) || k->k > 0 ? SOFT_OK : SOFT_ERR_NONFINITE;
+  }
+  /* Ellipsoid (x-x0)'(A/R^2)(x-x0) < 1 - k: half extent on axis i is
+   * sqrt((1 - k) R^2 (A^-1)_ii). Padded a little against rounding. */
+  for (int i = 0; i < 3; i++) {
+    double e = sqrt((1 - k->k) * r2 * inv[i][i]) * (1 + 1e-12);
+    if (!isfinite(e)) return SOFT_ERR_UNBOUNDED;
+    k->lo[i] = k->x0[i] - e;
+    k->hi[i] = k->x0[i] + e;
+  }
+  return SOFT_OK;
+}
+
+/* The BVH is built over an index array (the keys themselves, 152 bytes
+ * each, are moved once at the end into leaf order): the centroid of key
+ * idx[j] on an axis is cen[axis][idx[j]]. */
+typedef struct {
+  soft_obj *o;
+  const skey_t *keys;  /* in input order */
+  int *idx;
+  double *cen[3];
+} bvh_build;
+
+/* Quickselect: order idx[0..n) so that idx[mid] has the median centroid. */
+static void select_median(int *idx, const double *c, int n, int mid)
+{
+  int lo = 0, hi = n - 1;
+  while (lo < hi) {
+    double pv = c[idx[(lo + hi) / 2]];
+    int i = lo, j = hi;
+    while (i <= j) {
+      while (c[idx[i]] < pv) i++;
+      while (c[idx[j]] > pv) j--;
+      if (i <= j) { int t = idx[i]; idx[i] = idx[j]; idx[j] = t; i++; j--; }
+    }
+    if (mid <= j) hi = j;
+    else if (mid >= i) lo = i;
+    else break;
+  }
+}
+
+/* Median split on the longest axis of the centroids; children of a node
+ * are adjacent. Depth is at most ceil(log2 n) + 1. A leaf's box is that of
+ * its keys, an inner node's the union of its children's, so the boxes cost
+ * O(n) in all. */
+static void build_node(bvh_build *b, int ni, int first, int n)
+{
+  soft_obj *o = b->o;
+  const int *idx = b->idx + first;
+  if (n <= LEAF_MAX) {
+    node_t *nd = &o->nodes[ni];
+    for (int i = 0; i < 3; i++) { nd->lo[i] = INFINITY; nd->hi[i] = -INFINITY; }
+    for (int j = 0; j < n; j++) {
+      const skey_t *k = &b->keys[idx[j]];
+      for (int i = 0; i < 3; i++) {
+        if (k->lo[i] < nd->lo[i]) nd->lo[i] = k->lo[i];
+        if (k->hi[i] > nd->hi[i]) nd->hi[i] = k->hi[i];
+      }
+    }
+    nd->first = first;
+    nd->count = n;
+    return;
+  }
+  int axis = 0;
+  double ext[3];
+  for (int i = 0; i < 3; i++) {
+    const double *c = b->cen[i];
+    double clo = INFINITY, chi = -INFINITY;
+    for (int j = 0; j < n; j++) {
+      double x = c[idx[j]];
+      if (x < clo) clo = x;
+      if (x > chi) chi = x;
+    }
+    ext[i] = chi - clo;
+    if (ext[i] > ext[axis]) axis = i;
+  }
+  int half = n / 2;
+  select_median(b->idx + first, b->cen[axis], n, half);
+  int left = o->nnodes;
+  o->nnodes += 2;
+  build_node(b, left, first, half);
+  build_node(b, left + 1, first + half, n - half);
+  node_t *nd = &o->nodes[ni], *l = &o->nodes[left], *r = &o->nodes[left + 1];
+  for (int i = 0; i < 3; i++) {
+    nd->lo[i] = fmin(l->lo[i], r->lo[i]);
+    nd->hi[i] = fmax(l->hi[i], r->hi[i]);
+  }
+  nd->first = left;
+  nd->count = 0;
+}
+
+int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
+               size_t *bad_key)
+{
+  *out = NULL;
+  *bad_key = n;
+  if (!(magic > 0) || !isfinite(magic)) return SOFT_ERR_MAGIC;
+  if (n > (size_t)(1 << 28)) return SOFT_ERR_NOMEM;
+  soft_obj *o = calloc(1, sizeof *o);
+  skey_t *all = malloc((n ? n : 1) * sizeof *all);
+  if (!o || !all) { free(o); free(all); return SOFT_ERR_NOMEM; }
+  o->magic = magic;
+  size_t live = 0;
+  for (size_t i = 0; i < n; i++) {
+    int err = make_key(&keys[i], &all[live]);
+    if (err) { *bad_key = i; free(all); free(o); return err; }
+    if (!all[live].empty && all[live].w != 0) live++;  /* others act nowhere */
+  }
+  o->nkeys = live;
+  o->nodes = malloc((2 * live + 1) * sizeof *o->nodes);
+  bvh_build b = {o, all, malloc((live ? live : 1) * sizeof(int)), {NULL}};
+  for (int i = 0; i < 3; i++) b.cen[i] = malloc((live ? live : 1) * sizeof(double));
+  o->keys = malloc((live ? live : 1) * sizeof *o->keys);
+  if (!o->nodes || !b.idx || !b.cen[0] || !b.cen[1] || !b.cen[2] || !o->keys) {
+    free(o->nodes); free(o->keys); free(b.idx);
+    for (int i = 0; i < 3; i++) free(b.cen[i]);
+    free(all); free(o);
+    return SOFT_ERR_NOMEM;
+  }
+  for (size_t j = 0; j < live; j++) {
+    b.idx[j] = (int)j;
+    for (int i = 0; i < 3; i++) b.cen[i][j] = all[j].x0[i];
+  }
+  o->nnodes = 1;
+  build_node(&b, 0, 0, (int)live);
+  for (size_t j = 0; j < live; j++) o->keys[j] = all[b.idx[j]];
+  free(b.idx);
+  for (int i = 0; i < 3; i++) free(b.cen[i]);
+  free(all);
+  all = o->keys;
+  for (int i = 0; i < 3; i++) { o->lo[i] = INFINITY; o->hi[i] = -INFINITY; }
+  for (size_t j = 0; j < live; j++)
+    if (all[j].w > 0)
+      for (int i = 0; i < 3; i++) {
+        o->lo[i] = fmin(o->lo[i], all[j].lo[i]);
+        o->hi[i] = fmax(o->hi[i], all[j].hi[i]);
+      }
+  *out = o;
+  return SOFT_OK;
+}
+
+void soft_free(soft_obj *obj)
+{
+  if (!obj) return;
+  free(obj->keys);
+  free(obj->nodes);
+  free(obj);
+}
+
+size_t soft_nkeys(const soft_obj *obj) { return obj->nkeys; }
+double soft_magic(const soft_obj *obj) { return obj->magic; }
+
+int soft_bounds(const soft_obj *obj, double lo[3], double hi[3])
+{
+  for (int i = 0; i < 3; i++) { lo[i] = obj->lo[i]; hi[i] = obj->hi[i]; }
+  return obj->lo[0] <= obj->hi[0];
+}
+
+/* ---- field and gradient ---------------------------------------------- */
+
+/* ap = A p for the key's matrix A. */
+static void apply_a(const skey_t *k, const double p[3], double ap[3])
+{
+  if (k->sphere) {
+    for (int i = 0; i < 3; i++) ap[i] = k->a[0] * p[i];
+  } else {
+    ap[0] = k->a[0] * p[0] + k->a[3] * p[1] + k->a[4] * p[2];
+    ap[1] = k->a[3] * p[0] + k->a[1] * p[1] + k->a[5] * p[2];
+    ap[2] = k->a[4] * p[0] + k->a[5] * p[1] + k->a[2] * p[2];
+  }
+}
+
+static double dot3(const double a[3], const double b[3])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* s of eq. (1) (r^2/R^2, or u'Mu/R^2 for a quadric, eq. 5) for key k at the
+ * point whose offset from the centre is p, with A p into ap. */
+static double key_s(const skey_t *k, const double p[3], double ap[3])
+{
+  apply_a(k, p, ap);
+  return dot3(p, ap) + k->k;
+}
+
+/* eq. (1), summed (the paper's "sum of the effects of the individual keys"):
+ * keys found through the BVH, with an explicit stack (depth is bounded by
+ * the median split). */
+static double field_at(const soft_obj *o, const double x[3], double g[3])
+{
+  double f = 0;
+  if (g) g[0] = g[1] = g[2] = 0;
+  if (o->nkeys == 0) return 0;
+  int stack[128], sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0) {
+    const node_t *nd = &o->nodes[stack[--sp]];
+    if (x[0] < nd->lo[0] || x[0] > nd->hi[0] || x[1] < nd->lo[1] ||
+        x[1] > nd->hi[1] || x[2] < nd->lo[2] || x[2] > nd->hi[2])
+      continue;
+    if (nd->count == 0) {
+      stack[sp++] = nd->first;
+      stack[sp++] = nd->first + 1;
+      continue;
+    }
+    for (int j = nd->first; j < nd->first + nd->count; j++) {
+      const skey_t *k = &o->keys[j];
+      double p[3] = {x[0] - k->x0[0], x[1] - k->x0[1], x[2] - k->x0[2]}, ap[3];
+      double s = key_s(k, p, ap);
+      if (s >= 1) continue;
+      f += k->w * cfield(s);
+      if (g) {  /* grad s = 2 A p */
+        double dc = 2 * k->w * cslope(s);
+        for (int i = 0; i < 3; i++) g[i] += dc * ap[i];
+      }
+    }
+  }
+  return f;
+}
+
+double soft_field(const soft_obj *obj, const double p[3])
+{
+  return field_at(obj, p, NULL);
+}
+
+double soft_field_grad(const soft_obj *obj, const double p[3], double g[3])
+{
+  return field_at(obj, p, g);
+}
+
+/* ---- scratch ----------------------------------------------------------- */
+
+soft_scratch *soft_scratch_new(size_t max_keys)
+{
+  soft_scratch *s = calloc(1, sizeof *s);
+  if (!s) return NULL;
+  size_t cap = max_keys ? max_keys : 1;
+  s->cap = cap;
+  s->nheap = malloc((2 * cap + 2) * sizeof *s->nheap);
+  s->kheap = malloc(cap * sizeof *s->kheap);
+  s->act = malloc(cap * sizeof *s->act);
+  s->sq = malloc(3 * cap * sizeof *s->sq);
+  if (!s->nheap || !s->kheap || !s->act || !s->sq) { soft_scratch_free(s); return NULL; }
+  return s;
+}
+
+void soft_scratch_free(soft_scratch *s)
+{
+  if (!s) return;
+  free(s->nheap);
+  free(s->kheap);
+  free(s->act);
+  free(s->sq);
+  free(s);
+}
+
+/* ---- binary min-heaps ---------------------------------------------------- */
+
+static void npush(hent_t *h, int *n, double t, int i)
+{
+  int j = (*n)++;
+  while (j > 0 && h[(j - 1) / 2].t > t) { h[j] = h[(j - 1) / 2]; j = (j - 1) / 2; }
+  h[j].t = t;
+  h[j].i = i;
+}
+
+static hent_t npop(hent_t *h, int *n)
+{
+  hent_t top = h[0], last = h[--*n];
+  int j = 0;
+  for (;;) {
+    int c = 2 * j + 1;
+    if (c >= *n) break;
+    if (c + 1 < *n && h[c + 1].t < h[c].t) c++;
+    if (h[c].t >= last.t) break;
+    h[j] = h[c];
+    j = c;
+  }
+  h[j] = last;
+  return top;
+}
+
+static void kpush(kev_t *h, int *n, kev_t e)
+{
+  int j = (*n)++;
+  while (j > 0 && h[(j - 1) / 2].te > e.te) { h[j] = h[(j - 1) / 2]; j = (j - 1) / 2; }
+  h[j] = e;
+}
+
+static kev_t kpop(kev_t *h, int *n)
+{
+  kev_t top = h[0], last = h[--*n];
+  int j = 0;
+  for (;;) {
+    int c = 2 * j + 1;
+    if (c >= *n) break;
+    if (c + 1 < *n && h[c + 1].te < h[c].te) c++;
+    if (h[c].te >= last.te) break;
+    h[j] = h[c];
+    j = c;
+  }
+  h[j] = last;
+  return top;
+}
+
+/* ---- ray tracing --------------------------------------------------------- */
+
+typedef struct {
+  double o[3], d[3], inv[3];  /* origin, unit direction, 1/direction */
+  double ta, tb;              /* the search range, in units of length */
+} ray_t;
+
+/* Slab test; returns entry in *tn or 0 if the box is missed in [ta, tb]. */
+static int hit_box(const ray_t *r, const double lo[3], const double hi[3],
+                   double *tn)
+{
+  double t0 = r->ta, t1 = r->tb;
+  for (int i = 0; i < 3; i++) {
+    double a = (lo[i] - r->o[i]) * r->inv[i], b = (hi[i] - r->o[i]) * r->inv[i];
+    if (a > b) { double t = a; a = b; b = t; }
+    if (a > t0) t0 = a;
+    if (b < t1) t1 = b;
+  }
+  *tn = t0;
+  return t0 <= t1;
+}
+
+/* eq. (2) into the key's quadric: s(t) = a2 (t - tc)^2 + smin along the
+ * ray; the key acts where s < 1. Returns 0 if the ray misses its bound. */
+static int hit_key(const ray_t *r, const skey_t *k, double *te, double *tx)
+{
+  double p[3] = {r->o[0] - k->x0[0], r->o[1] - k->x0[1], r->o[2] - k->x0[2]};
+  double ad[3], ap[3];
+  apply_a(k, r->d, ad);
+  double a2 = dot3(r->d, ad), b = dot3(p, ad);
+  double tc = -b / a2;
+  double pc[3] = {p[0] + tc * r->d[0], p[1] + tc * r->d[1], p[2] + tc * r->d[2]};
+  double smin = key_s(k, pc, ap);
+  if (!(smin < 1)) return 0;
+  double half = sqrt((1 - smin) / a2);
+  *te = tc - half;
+  *tx = tc + half;
+  return *tx > r->ta && *te < r->tb;
+}
+
+/* eq. (3) for each active key along the interval [tm - h, tm + h]: s(v) =
+ * s0 + s1 v + s2 v^2 with t = tm + h v, built from the key's offset at the
+ * midpoint, so it stays well conditioned however far the interval lies from
+ * the ray origin. Also bounds the field over the interval: C falls as s
+ * grows, and s is convex in v, so each key's field lies between C at the
+ * largest s (an end) and C at the smallest. */
+static void interval_s(const soft_obj *o, const ray_t *r, const kev_t *act,
+                       int nact, double tm, double h, double *sq,
+                       double *flo, double *fhi)
+{
+  double x[3] = {r->o[0] + tm * r->d[0], r->o[1] + tm * r->d[1], r->o[2] + tm * r->d[2]};
+  double lo = 0, hi = 0, wsum = 0;
+  for (int j = 0; j < nact; j++) {
+    const skey_t *k = &o->keys[act[j].i];
+    double p[3] = {x[0] - k->x0[0], x[1] - k->x0[1], x[2] - k->x0[2]}, ap[3], ad[3];
+    double s0 = key_s(k, p, ap);
+    apply_a(k, r->d, ad);
+    double s1 = 2 * h * dot3(r->d, ap), s2 = h * h * dot3(r->d, ad);
+    sq[3 * j] = s0; sq[3 * j + 1] = s1; sq[3 * j + 2] = s2;
+    double smax = s0 + fabs(s1) + s2;
+    double smin = fabs(s1) < 2 * s2 ? s0 - s1 * s1 / (4 * s2) : s0 - fabs(s1) + s2;
+    double cl = cfield(smax), ch = cfield(smin), w = k->w;
+    if (w > 0) { lo += w * cl; hi += w * ch; }
+    else { lo += w * ch; hi += w * cl; }
+    wsum += fabs(w);
+  }
+  *flo = lo - 1e-12 * wsum;  /* margin for the rounding of s and C */
+  *fhi = hi + 1e-12 * wsum;
+}
+
+/* eq. (4): the weighted sum of C(s(v)) over the active keys, minus magic,
+ * as a sextic in v in [-1, 1]. */
+static void interval_poly(const soft_obj *o, const kev_t *act, int nact,
+                          const double *sq, double *c)
+{
+  double w0 = 0, w1[3] = {0, 0, 0}, w2[5] = {0, 0, 0, 0, 0}, w3[7] = {0};
+  for (int j = 0; j < nact; j++) {
+    double w = o->keys[act[j].i].w;
+    double s0 = sq[3 * j], s1 = sq[3 * j + 1], s2 = sq[3 * j + 2];
+    /* s^2 and s^3 of s = s0 + s1 v + s2 v^2 */
+    double q0 = s0 * s0, q1 = 2 * s0 * s1, q2 = s1 * s1 + 2 * s0 * s2,
+           q3 = 2 * s1 * s2, q4 = s2 * s2;
+    w0 += w;
+    w1[0] += w * s0; w1[1] += w * s1; w1[2] += w * s2;
+    w2[0] += w * q0; w2[1] += w * q1; w2[2] += w * q2; w2[3] += w * q3; w2[4] += w * q4;
+    w3[0] += w * q0 * s0;
+    w3[1] += w * (q1 * s0 + q0 * s1);
+    w3[2] += w * (q2 * s0 + q1 * s1 + q0 * s2);
+    w3[3] += w * (q3 * s0 + q2 * s1 + q1 * s2);
+    w3[4] += w * (q4 * s0 + q3 * s1 + q2 * s2);
+    w3[5] += w * (q4 * s1 + q3 * s2);
+    w3[6] += w * q4 * s2;
+  }
+  c[0] = w0 + A1 * w1[0] + A2 * w2[0] + A3 * w3[0] - o->magic;
+  c[1] = A1 * w1[1] + A2 * w2[1] + A3 * w3[1];
+  c[2] = A1 * w1[2] + A2 * w2[2] + A3 * w3[2];
+  c[3] = A2 * w2[3] + A3 * w3[3];
+  c[4] = A2 * w2[4] + A3 * w3[4];
+  c[5] = A3 * w3[5];
+  c[6] = A3 * w3[6];
+}
+
+/* The paper's algorithm: 1. find the intersections with the keys' bounds
+ * and order them along the ray; 2. solve eq. (4) for f = magic in each
+ * interval; 3. keep the solutions inside it. Bounds are discovered front to
+ * back from the BVH: an interval is solved only once every node that could
+ * hold a key entering before its end has been opened. The state (inside or
+ * not) at each interval boundary is computed once and imposed on both
+ * neighbours, so a root on a boundary is found once. */
+int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
+               double t0, double t1, double *out, int maxout,
+               soft_scratch *scratch, soft_stats *stats)
+{
+  soft_stats dummy;
+  if (!stats) { memset(&dummy, 0, sizeof dummy); stats = &dummy; }
+  stats->rays++;
+  double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(len > 0) || !isfinite(len)) {  /* maybe only overflowed: rescale */
+    double m = fmax(fabs(d[0]), fmax(fabs(d[1]), fabs(d[2])));
+    if (!(m > 0) || !isfinite(m)) return -1;
+    double e[3] = {d[0] / m, d[1] / m, d[2] / m};
+    len = m * sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    if (!(len > 0) || !isfinite(len)) return -1;
+  }
+  if (!isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]) || t0 != t0 || t1 != t1)
+    return -1;
+  /* No keys (SoftObject m []): nothing to cross, and no scratch needed. */
+  if (maxout <= 0 || obj->nkeys == 0 || !(t0 < t1)) return 0;
+  if (!scratch || scratch->cap < obj->nkeys) return -1;
+
+  /* Work in units of length along the unit direction (tau = t |d|). */
+  ray_t r;
+  for (int i = 0; i < 3; i++) {
+    r.o[i] = o[i];
+    r.d[i] = d[i] / len;
+    double di = fabs(r.d[i]) < 1e-300 ? copysign(1e-300, r.d[i]) : r.d[i];
+    r.inv[i] = 1 / di;
+  }
+  r.ta = t0 * len;
+  r.tb = t1 * len;
+
+  hent_t *nheap = scratch->nheap;
+  kev_t *kheap = scratch->kheap, *act = scratch->act;
+  int nn = 0, nk = 0, na = 0, nout = 0;
+  double tn;
+  if (hit_box(&r, obj->nodes[0].lo, obj->nodes[0].hi, &tn)) npush(nheap, &nn, tn, 0);
+
+  double cur = r.ta;
+  int state = -1;          /* at cur: 1 inside, 0 outside, -1 not yet known */
+  double prev_h = 0;       /* half-width of the last solved interval */
+  long last_from = -1;     /* interval index of the last crossing */
+  long iv = 0;
+  double amin = INFINITY;  /* earliest exit among the active keys */
+  for (;;) {
+    double tfront = nn ? nheap[0].t : INFINITY;
+    double tnext = r.tb;
+    if (nk && kheap[0].te < tnext) tnext = kheap[0].te;
+    if (amin < tnext) tnext = amin;
+    if (tfront < tnext) {  /* a key may still enter before tnext: discover */
+      hent_t e = npop(nheap, &nn);
+      const node_t *nd = &obj->nodes[e.i];
+      stats->nodes++;
+      if (nd->count == 0) {
+        for (int c = 0; c < 2; c++) {
+          const node_t *ch = &obj->nodes[nd->first + c];
+          if (hit_box(&r, ch->lo, ch->hi, &tn)) npush(nheap, &nn, fmax(tn, cur), nd->first + c);
+        }
+      } else {
+        for (int j = nd->first; j < nd->first + nd->count; j++) {
+          kev_t ev;
+          if (!hit_key(&r, &obj->keys[j], &ev.te, &ev.tx) || ev.tx <= cur) continue;
+          stats->keys++;
+          ev.te = fmax(ev.te, cur);
+          ev.i = j;
+          kpush(kheap, &nk, ev);
+        }
+      }
+      continue;
+    }
+    if (!isfinite(tnext)) {  /* nothing active, nothing left to find */
+      if (state == 1 && na == 0 && iv > 0 && nout < maxout) out[nout++] = cur / len;
+      break;
+    }
+
+    /* The interval [cur, tnext]: the active set is fixed inside it. */
+    if (tnext > cur && na > 0) {
+      double tm = 0.5 * (cur + tnext), h = 0.5 * (tnext - cur), c[7];
+      stats->intervals++;
+      iv++;
+      double flo, fhi;
+      int settled = 0;  /* no crossing possible in the interval */
+      interval_s(obj, &r, act, na, tm, h, scratch->sq, &flo, &fhi);
+      if (state < 0 && (flo > obj->magic || fhi <= obj->magic)) state = flo > obj->magic;
+      if ((fhi <= obj->magic && state == 0) || (flo > obj->magic && state == 1))
+        settled = 1;  /* the field stays on one side of magic */
+      if (!settled) {
+        interval_poly(obj, act, na, scratch->sq, c);
+        if (state < 0) state = poly_eval(c, 6, -1.0, NULL) > 0;
+        double s1 = fabs(c[1]) + fabs(c[2]) + fabs(c[3]) + fabs(c[4]) + fabs(c[5]) + fabs(c[6]);
+        if (fabs(c[0]) > s1 * (1 + 1e-12) + 1e-300 && (c[0] > 0) == state)
+          settled = 1;  /* |p(v) - p(0)| < |p(0)| on [-1, 1] */
+      }
+      if (settled) {
+        stats->skipped++;
+      } else {
+        int sb = poly_eval(c, 6, 1.0, NULL) > 0;
+        double v[POLY_MAX_DEG];
+        int nv = poly_crossings(c, 6, -1.0, 1.0, state, sb, 0, v, &stats->poly);
+        for (int j = 0; j < nv; j++) {
+          double t = tm + h * v[j];
+          /* A root on the boundary with the two neighbouring sextics
+           * disagreeing in the last bit shows as a pair of crossings
+           * straddling it: the pair cancels (the state is unchanged). */
+          double tol = 1e-10 * (h + prev_h) + 8 * DBL_EPSILON * fabs(cur);
+          if (j == 0 && nout > 0 && last_from == iv - 1 &&
+              fabs(out[nout - 1] * len - cur) <= tol && fabs(t - cur) <= tol) {
+            nout--;
+            continue;
+          }
+          if (nout < maxout) out[nout++] = t / len;
+          last_from = iv;
+        }
+        state = sb;
+        prev_h = h;
+        if (nout >= maxout) break;
+      }
+    } else if (na == 0 && tnext > cur) {
+      /* no key acts on a stretch: field 0 < magic (not at an empty
+         [cur, cur], where keys holding the origin are about to be
+         opened). If the last interval ended "inside" (its end state is the
+         sign of a sextic whose value there is rounding noise when magic
+         is tiny: the field vanishes at a key's bound), the exit is at its
+         end: crossings must alternate. */
+      if (state == 1 && iv > 0) {
+        if (nout < maxout) out[nout++] = cur / len;
+        last_from = iv;
+        if (nout >= maxout) { state = 0; break; }
+      }
+      state = 0;
+    }
+    cur = tnext;
+    if (cur >= r.tb) break;
+    /* events at cur: exits, then entries */
+    for (int j = 0; j < na;) {
+      if (act[j].tx <= cur) act[j] = act[--na];
+      else j++;
+    }
+    while (nk && kheap[0].te <= cur) act[na++] = kpop(kheap, &nk);
+    amin = INFINITY;
+    for (int j = 0; j < na; j++) if (act[j].tx < amin) amin = act[j].tx;
+  }
+  return nout;
+}

@@ -1,0 +1,101 @@
+/* soft.h: soft objects (Wyvill and Trotman, "Ray-Tracing Soft Objects"):
+ * the surface field == magic of a sum of weighted key fields, and every ray
+ * crossing of it, found by solving the sextic of eq. (4) between
+ * consecutive entries/exits of the keys' bounds along the ray.
+ *
+ * Memory: soft_build copies the keys into a soft_obj it mallocs (with its
+ * BVH over the key bounds); the caller owns it and releases it with
+ * soft_free. It is read-only afterwards, so any number of threads may query
+ * it at once. Each tracing thread owns one soft_scratch (soft_scratch_new /
+ * soft_scratch_free), sized for the largest object it will trace; soft_roots
+ * allocates nothing per ray. Counters go to a caller-provided soft_stats
+ * (one per thread; the caller zeroes and sums them). No global state. */
+#ifndef QCS_SOFT_H
+#define QCS_SOFT_H
+
+#include <stddef.h>
+
+#include "core/poly.h"
+
+enum { SOFT_SPHERE = 0, SOFT_QUADRIC = 1 };
+
+/* One key point. A SPHERE key at c contributes w * C(r^2 / R^2), r the
+ * distance to c. A QUADRIC key uses u'Mu, u = (x, y, z, 1), in place of
+ * r^2 (eq. 5); only the symmetric part of M matters. It must be bounded:
+ * the upper-left 3x3 block of M must be positive definite (ellipsoids;
+ * cylinders and cones are rejected). Writing u'Mu = (x-x0)'A(x-x0) + k, the
+ * key acts inside the ellipsoid (x-x0)'A(x-x0) < R^2 - k; if k >= R^2 it
+ * acts nowhere, and if k < 0 its field exceeds w at the centre. R > 0, all
+ * values finite; w may be negative (negative keys only subtract). */
+typedef struct {
+  int kind;          /* SOFT_SPHERE or SOFT_QUADRIC */
+  double c[3];       /* SPHERE: centre */
+  double m[4][4];    /* QUADRIC: the matrix M */
+  double R;          /* radius of influence */
+  double w;          /* weight */
+} soft_key;
+
+/* Errors of soft_build. */
+enum {
+  SOFT_OK = 0,
+  SOFT_ERR_RADIUS,     /* R <= 0 or not finite */
+  SOFT_ERR_NONFINITE,  /* a centre, matrix entry or weight not finite */
+  SOFT_ERR_KIND,       /* kind is neither SOFT_SPHERE nor SOFT_QUADRIC */
+  SOFT_ERR_UNBOUNDED,  /* quadric whose 3x3 block is not positive definite */
+  SOFT_ERR_MAGIC,      /* magic <= 0 or not finite (empty space would be
+                          inside) */
+  SOFT_ERR_NOMEM
+};
+
+typedef struct soft_obj soft_obj;
+typedef struct soft_scratch soft_scratch;
+
+typedef struct {
+  long rays;        /* soft_roots calls */
+  long nodes;       /* BVH nodes visited */
+  long keys;        /* keys whose bound the ray met */
+  long intervals;   /* intervals between consecutive bound events */
+  long skipped;     /* intervals settled by a bound without a solve */
+  poly_stats poly;  /* polynomial solves, Laguerre, fallbacks */
+} soft_stats;
+
+/* Build from n keys (copied). magic is the surface value (0.5 is Wyvill's
+ * usual choice; must be > 0). On error returns the code, sets *bad_key to
+ * the offending key's index (n for an error not about a key) and *out to
+ * NULL. */
+int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
+               size_t *bad_key);
+void soft_free(soft_obj *obj);
+const char *soft_strerror(int err);
+
+size_t soft_nkeys(const soft_obj *obj);
+double soft_magic(const soft_obj *obj);
+
+/* Axis-aligned box holding the object's inside (field > magic): the union
+ * of the bounds of the positive keys. Returns 0 (and lo > hi) if empty. */
+int soft_bounds(const soft_obj *obj, double lo[3], double hi[3]);
+
+/* eq. (1) summed over the keys: the field at p. */
+double soft_field(const soft_obj *obj, const double p[3]);
+
+/* Field at p and its gradient g (the outward normal is -g/|g|). */
+double soft_field_grad(const soft_obj *obj, const double p[3], double g[3]);
+
+/* Scratch for one thread, enough for objects of up to max_keys keys. */
+soft_scratch *soft_scratch_new(size_t max_keys);
+void soft_scratch_free(soft_scratch *s);
+
+/* The crossings of the surface by the ray o + t d, t0 < t < t1 (t1 may be
+ * INFINITY), ascending, into out[0..maxout-1]; returns their number, or -1
+ * if d is zero or not finite, o or t0/t1 is NaN, or the scratch is too
+ * small. d may have any
+ * length. Crossings alternate between entering and leaving; the state
+ * before the first is that of o + t0 d (inside iff soft_field > magic).
+ * Touches (even-multiplicity roots) are not reported. The search runs
+ * front to back and stops at the maxout-th crossing, so maxout = 1 costs
+ * only what the nearest hit costs. */
+int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
+               double t0, double t1, double *out, int maxout,
+               soft_scratch *scratch, soft_stats *stats);
+
+#endif

@@ -1,0 +1,114 @@
+/* ast.h: the syntax tree of qcs programs.
+ *
+ * Expressions, patterns and definitions, each carrying the Pos of the
+ * source that made it. Names are interned Syms (see value.h), so the
+ * evaluator compares pointers. Nodes are allocated in the GC heap by the
+ * parser and shared freely (closures made on one REPL line keep pointing at
+ * that line's AST). */
+#ifndef QCS_AST_H
+#define QCS_AST_H
+
+#include "lang/error.h"
+#include "lang/lex.h"
+
+typedef struct Sym Sym;
+typedef struct Expr Expr;
+typedef struct Pat Pat;
+typedef struct Def Def;
+
+typedef enum {
+  E_NUM, E_STR, E_BOOL, E_VAR, E_APP, E_LAMBDA, E_LET, E_IF, E_TUPLE,
+  E_LIST, E_RANGE, E_BINOP, E_NEG, E_WILD, E_DEFBODY
+} ExprKind;
+
+/* A qualifier of a list comprehension: a generator `pat <- e` or a guard. */
+typedef struct Qual {
+  Pat *pat; /* NULL for a guard */
+  Expr *e;
+} Qual;
+
+struct Expr {
+  ExprKind kind;
+  Pos pos;
+  union {
+    double num;
+    const char *str;
+    int b;
+    Sym *var;
+    struct { Expr *fn; int n; Expr **args; } app;
+    Def *lambda;                                  /* one clause, no name */
+    struct { int n; Def **defs; Expr *body; } let;
+    struct { Expr *c, *t, *f; } cond;
+    struct { int n; Expr **items; } tuple;        /* E_TUPLE and E_LIST */
+    struct { Expr *from, *then, *to; } range;     /* then, to may be NULL */
+    struct { TokKind op; Expr *a, *b; } bin;
+    Expr *neg;
+    Def *def;             /* E_DEFBODY: a 0-ary binding's clauses */
+  } u;
+};
+
+typedef enum {
+  P_VAR, P_WILD, P_NUM, P_STR, P_BOOL, P_CON, P_TUPLE, P_NIL, P_CONS, P_LIST
+} PatKind;
+
+struct Pat {
+  PatKind kind;
+  Pos pos;
+  union {
+    Sym *var;
+    double num;
+    const char *str;
+    int b;
+    struct { Sym *con; int n; Pat **args; } con;  /* resolved when matched */
+    struct { int n; Pat **items; } tuple;         /* P_TUPLE and P_LIST */
+    struct { Pat *head, *tail; } cons;
+  } u;
+};
+
+/* One clause: patterns, then guarded bodies (guard NULL = unconditional),
+   with where-bindings in scope of guards and bodies. */
+typedef struct Clause {
+  Pos pos;
+  int npats;
+  Pat **pats;
+  int nbodies;
+  Expr **guards;
+  Expr **bodies;
+  int nwhere;
+  Def **where;
+} Clause;
+
+/* A definition: a named function or value with one or more clauses, or a
+   pattern binding `(a, b) = e` (pat != NULL, one clause, no patterns). */
+struct Def {
+  Sym *name;     /* NULL for lambdas and pattern bindings */
+  Pos pos;
+  int arity;
+  int nclauses;
+  Clause **clauses;
+  Pat *pat;      /* pattern binding */
+  const char *sig; /* its type signature's text, if one was given */
+};
+
+/* Type declarations: constructors with their arities. */
+typedef struct ConDecl {
+  Sym *name;
+  Pos pos;
+  int arity;
+} ConDecl;
+
+typedef enum { ITEM_DEF, ITEM_EXPR, ITEM_TYPE, ITEM_SIG } ItemKind;
+
+typedef struct Item {
+  ItemKind kind;
+  Pos pos;
+  Def *def;
+  Expr *expr;
+  Sym *type;          /* ITEM_TYPE: the type's name */
+  int ncons;          /* ITEM_TYPE: 0 for a synonym */
+  ConDecl *cons;
+  Sym *signame;       /* ITEM_SIG */
+  const char *sigtext;
+} Item;
+
+#endif

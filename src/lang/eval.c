@@ -1,0 +1,1031 @@
+/* eval.c: the lazy evaluator. See eval.h. */
+#include "lang/eval.h"
+
+#include <gc.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "lang/parse.h"
+#include "lang/print.h"
+
+/* ---- checks ---- */
+
+_Noreturn void eval_limit_error(Interp *I, Pos pos, const char *limit,
+                                const char *fmt, ...) {
+  char msg[700];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  const char *arg =
+      !strcmp(limit, "max-stack") || !strcmp(limit, "max-memory") ? "SIZE"
+                                                                  : "N";
+  qcs_error(pos.line ? pos : I->item_pos, "%s (limit %s; raise it with :set "
+            "%s %s or --%s %s)", msg, limit, limit, arg, limit, arg);
+}
+
+void eval_stack_error(Interp *I, Pos pos, const char *what,
+                      const char *after) {
+  char sz[32];
+  interp_format_size(sz, sizeof sz, I->stack_limit);
+  eval_limit_error(I, pos, "max-stack", "%s more than %s of stack%s", what, sz,
+                   after);
+}
+
+/* Runs at every evaluation step: no system calls, no allocation. */
+void eval_check(Interp *I, Pos pos) {
+  char probe;
+  if (atomic_load_explicit(&qcs_interrupted, memory_order_relaxed)) {
+    atomic_store(&qcs_interrupted, 0);
+    qcs_error(pos.line ? pos : I->item_pos, "interrupted");
+  }
+  if ((size_t)(I->stack_base - &probe) > I->stack_limit)
+    eval_stack_error(I, pos, "recursion too deep: nested calls use",
+                     "; is a base case missing?");
+  if (++I->steps > I->max_steps && I->max_steps)
+    eval_limit_error(I, pos, "max-steps", "evaluation stopped after %llu steps",
+                     I->max_steps);
+  if (I->max_memory && ++I->memcheck >= 4096) {
+    I->memcheck = 0;
+    size_t used = GC_get_heap_size() - GC_get_free_bytes();
+    if (used > I->max_memory) {
+      GC_gcollect();
+      used = GC_get_heap_size() - GC_get_free_bytes();
+      if (used > I->max_memory) {
+        char sz[32];
+        interp_format_size(sz, sizeof sz, I->max_memory);
+        eval_limit_error(I, pos, "max-memory", "evaluation stopped: values "
+                         "use more than %s of memory", sz);
+      }
+    }
+  }
+}
+
+void eval_alloc_check(Interp *I, Pos pos, size_t bytes) {
+  if (!I->max_memory) return;
+  size_t used = GC_get_heap_size() - GC_get_free_bytes();
+  if (bytes > I->max_memory || used + bytes > I->max_memory) {
+    GC_gcollect();
+    used = GC_get_heap_size() - GC_get_free_bytes();
+    if (bytes > I->max_memory || used + bytes > I->max_memory) {
+      char sz[32];
+      interp_format_size(sz, sizeof sz, I->max_memory);
+      eval_limit_error(I, pos, "max-memory", "evaluation stopped: values "
+                       "would use more than %s of memory", sz);
+    }
+  }
+}
+
+void eval_list_limit(Interp *I, Pos pos, unsigned long long n) {
+  eval_limit_error(I, pos, "max-list", "a list longer than %llu elements",
+                   n - 1);
+}
+
+/* ---- trace ---- */
+
+static void trace_set(Interp *I, int depth, const char *name, Pos pos) {
+  if (depth < TRACE_MAX) {
+    I->trace[depth].name = name;
+    I->trace[depth].pos = pos;
+  }
+  I->ntrace = depth + 1;
+}
+
+/* ---- variables ---- */
+
+static _Noreturn void unknown_name(Interp *I, Sym *s, Env *env, Pos pos) {
+  const char *best = NULL;
+  int bestd = 3;
+  for (Env *e = env; e; e = e->up)
+    for (int i = 0; i < e->n; i++) {
+      int d = edit_distance(s->name, e->names[i]->name);
+      if (d < bestd) bestd = d, best = e->names[i]->name;
+    }
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *g = I->symtab[h]; g; g = g->next)
+      if ((g->global || g->con_arity >= 0) && g->name[0] != '%') {
+        int d = edit_distance(s->name, g->name);
+        if (d < bestd) bestd = d, best = g->name;
+      }
+  if (best) qcs_error(pos, "unknown name '%s' (did you mean '%s'?)", s->name, best);
+  qcs_error(pos, "unknown name '%s'", s->name);
+}
+
+Value *eval_con_value(Interp *I, Sym *s) {
+  if (!s->con_value) {
+    if (s->con_arity == 0) {
+      s->con_value = val_con(s, 0, NULL);
+    } else {
+      Value *v = val_cell();
+      v->kind = V_FUNC;
+      v->u.fn.kind = F_CON;
+      v->u.fn.arity = s->con_arity;
+      v->u.fn.u.con = s;
+      s->con_value = v;
+    }
+  }
+  return s->con_value;
+}
+
+static Value *lookup(Interp *I, Sym *s, Env *env, Pos pos) {
+  for (Env *e = env; e; e = e->up)
+    for (int i = e->n - 1; i >= 0; i--)
+      if (e->names[i] == s) return e->vals[i];
+  if (s->con_arity >= 0) return eval_con_value(I, s);
+  /* The prelude's code sees the prelude's definitions, so a user's own
+     `floor` (the scenes' name for the ground plane) cannot break fract. */
+  if (pos.src == I->prelude_src && pos.src && s->prelude_value)
+    return s->prelude_value;
+  if (s->global) return s->global;
+  unknown_name(I, s, env, pos);
+}
+
+/* ---- thunks ---- */
+
+static Value *mk_thunk(Expr *e, Env *env) {
+  Value *v = val_cell();
+  v->kind = V_THUNK;
+  v->u.thunk.e = e;
+  v->u.thunk.env = env;
+  return v;
+}
+
+/* Cheap eagerness: the value of e if it is arithmetic on Reals that are
+   already known (literals, variables bound to evaluated Reals). Computing
+   it now cannot fail or loop, so laziness is unchanged, and an accumulator
+   such as `count (n - 1) (acc + 1)` stays a number instead of growing a
+   chain of a million thunks that would then be forced recursively. */
+static int known_num(Interp *I, Expr *e, Env *env, double *out) {
+  char probe; /* a chain of a million '+' is left to eval, which checks */
+  if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
+  switch (e->kind) {
+  case E_NUM:
+    *out = e->u.num;
+    return 1;
+  case E_VAR: {
+    Value *v = NULL;
+    for (Env *f = env; f && !v; f = f->up)
+      for (int i = f->n - 1; i >= 0; i--)
+        if (f->names[i] == e->u.var) {
+          v = f->vals[i];
+          break;
+        }
+    if (!v || v->kind != V_NUM) return 0;
+    *out = v->u.num;
+    return 1;
+  }
+  case E_NEG:
+    if (!known_num(I, e->u.neg, env, out)) return 0;
+    *out = -*out;
+    return 1;
+  case E_BINOP: {
+    double a, b;
+    TokKind op = e->u.bin.op;
+    if (op != T_PLUS && op != T_MINUS && op != T_STAR && op != T_SLASH &&
+        op != T_CARET)
+      return 0;
+    if (!known_num(I, e->u.bin.a, env, &a) || !known_num(I, e->u.bin.b, env, &b))
+      return 0;
+    *out = op == T_PLUS ? a + b : op == T_MINUS ? a - b : op == T_STAR ? a * b
+         : op == T_SLASH ? a / b : pow(a, b);
+    return 1;
+  }
+  default:
+    return 0;
+  }
+}
+
+Value *delay(Interp *I, Expr *e, Env *env) {
+  double x;
+  if ((e->kind == E_BINOP || e->kind == E_NEG) && known_num(I, e, env, &x))
+    return val_num(x);
+  switch (e->kind) {
+  case E_NUM: return val_num(e->u.num);
+  case E_STR: return val_str(e->u.str);
+  case E_BOOL: return val_bool(I, e->u.b);
+  case E_VAR: return lookup(I, e->u.var, env, e->pos);
+  default: return mk_thunk(e, env);
+  }
+}
+
+Value *delay_apply(Value *f, int n, Value **args) {
+  Value *v = val_cell();
+  v->kind = V_APTHUNK;
+  v->u.pap.fn = f;
+  v->u.pap.n = n;
+  v->u.pap.args = args;
+  return v;
+}
+
+static void forcing_push(Interp *I, Value *v) {
+  if (I->nforcing == I->capforcing) {
+    int cap = I->capforcing ? I->capforcing * 2 : 256;
+    Forcing *f = GC_MALLOC(sizeof(Forcing) * (size_t)cap);
+    if (I->nforcing) memcpy(f, I->forcing, sizeof(Forcing) * (size_t)I->nforcing);
+    I->forcing = f;
+    I->capforcing = cap;
+  }
+  I->forcing[I->nforcing].v = v;
+  I->forcing[I->nforcing].saved = *v;
+  I->nforcing++;
+}
+
+static int match(Interp *I, Pat *p, Value *v, Env *frame);
+
+void eval_restore(Interp *I, int nforcing) {
+  while (I->nforcing > nforcing) {
+    I->nforcing--;
+    *I->forcing[I->nforcing].v = I->forcing[I->nforcing].saved;
+  }
+}
+
+static Value *force_patsel(Interp *I, Value *v) {
+  Pat *pat = v->u.patsel.pat;
+  Sym *var = v->u.patsel.var;
+  Value *whole = v->u.patsel.whole;
+  Env *tmp = env_new(NULL, 4);
+  if (!match(I, pat, whole, tmp)) {
+    char buf[200];
+    val_brief(force(I, whole), buf, sizeof buf);
+    qcs_error(pat->pos, "the pattern does not match the value %s", buf);
+  }
+  for (int i = 0; i < tmp->n; i++)
+    if (tmp->names[i] == var) return force(I, tmp->vals[i]);
+  qcs_error(pat->pos, "internal error: pattern variable lost");
+}
+
+Value *force(Interp *I, Value *v) {
+  switch (v->kind) {
+  case V_THUNK:
+  case V_APTHUNK:
+  case V_PATSEL: {
+    forcing_push(I, v);
+    Value saved = *v;
+    v->kind = V_BLACKHOLE;
+    Value *r;
+    if (saved.kind == V_THUNK)
+      r = eval(I, saved.u.thunk.e, saved.u.thunk.env);
+    else if (saved.kind == V_APTHUNK)
+      r = apply(I, saved.u.pap.fn, saved.u.pap.n, saved.u.pap.args, pos_none);
+    else {
+      v->u = saved.u;
+      r = force_patsel(I, v);
+    }
+    *v = *r;
+    I->nforcing--;
+    return v;
+  }
+  case V_BLACKHOLE:
+    qcs_error(v->u.thunk.e && v->u.thunk.e->pos.line ? v->u.thunk.e->pos
+                                                     : pos_none,
+              "this value depends on itself (an infinite loop)");
+  default:
+    return v;
+  }
+}
+
+/* ---- checked forcing ---- */
+
+static _Noreturn void type_error(Interp *I, Value *v, Pos pos, const char *want,
+                                 const char *what) {
+  char buf[160];
+  val_brief(v, buf, sizeof buf);
+  qcs_error(pos, "%s must be %s, not %s: %s", what, want, val_describe(v), buf);
+}
+
+double force_num(Interp *I, Value *v, Pos pos, const char *what) {
+  v = force(I, v);
+  if (v->kind != V_NUM) type_error(I, v, pos, "a Real", what);
+  return v->u.num;
+}
+
+int force_bool(Interp *I, Value *v, Pos pos, const char *what) {
+  v = force(I, v);
+  if (v->kind != V_BOOL) type_error(I, v, pos, "a Bool", what);
+  return v->u.b;
+}
+
+const char *force_str(Interp *I, Value *v, Pos pos, const char *what) {
+  v = force(I, v);
+  if (v->kind != V_STR) type_error(I, v, pos, "a String", what);
+  return v->u.str;
+}
+
+void force_vec3(Interp *I, Value *v, Pos pos, const char *what, double out[3]) {
+  v = force(I, v);
+  if (v->kind != V_TUPLE || v->u.tup.n != 3)
+    type_error(I, v, pos, "a 3-tuple of Reals", what);
+  for (int i = 0; i < 3; i++)
+    out[i] = force_num(I, v->u.tup.items[i], pos, what);
+}
+
+/* ---- pattern matching ---- */
+
+static int match(Interp *I, Pat *p, Value *v, Env *frame) {
+  switch (p->kind) {
+  case P_VAR:
+    env_bind(frame, p->u.var, v);
+    return 1;
+  case P_WILD:
+    return 1;
+  case P_NUM:
+    v = force(I, v);
+    return v->kind == V_NUM && v->u.num == p->u.num;
+  case P_STR:
+    v = force(I, v);
+    return v->kind == V_STR && !strcmp(v->u.str, p->u.str);
+  case P_BOOL:
+    v = force(I, v);
+    return v->kind == V_BOOL && v->u.b == p->u.b;
+  case P_CON: {
+    Sym *c = p->u.con.con;
+    if (c->con_arity < 0)
+      qcs_error(p->pos, "'%s' in a pattern is not a constructor", c->name);
+    if (c->con_arity != p->u.con.n)
+      qcs_error(p->pos, "constructor %s takes %d argument%s, this pattern "
+                "gives %d", c->name, c->con_arity,
+                c->con_arity == 1 ? "" : "s", p->u.con.n);
+    v = force(I, v);
+    if (v->kind != V_CON || v->u.con.con != c) return 0;
+    for (int i = 0; i < p->u.con.n; i++)
+      if (!match(I, p->u.con.args[i], v->u.con.args[i], frame)) return 0;
+    return 1;
+  }
+  case P_TUPLE:
+    v = force(I, v);
+    if (v->kind != V_TUPLE || v->u.tup.n != p->u.tuple.n) return 0;
+    for (int i = 0; i < p->u.tuple.n; i++)
+      if (!match(I, p->u.tuple.items[i], v->u.tup.items[i], frame)) return 0;
+    return 1;
+  case P_NIL:
+    v = force(I, v);
+    return v->kind == V_NIL;
+  case P_CONS:
+    v = force(I, v);
+    if (v->kind != V_CONS) return 0;
+    return match(I, p->u.cons.head, v->u.cons.head, frame) &&
+           match(I, p->u.cons.tail, v->u.cons.tail, frame);
+  case P_LIST:
+    for (int i = 0; i < p->u.tuple.n; i++) {
+      v = force(I, v);
+      if (v->kind != V_CONS) return 0;
+      if (!match(I, p->u.tuple.items[i], v->u.cons.head, frame)) return 0;
+      v = v->u.cons.tail;
+    }
+    return force(I, v)->kind == V_NIL;
+  }
+  return 0;
+}
+
+/* ---- definitions and clauses ---- */
+
+static void pat_bind_vars(Pat *p, Value *whole, Env *frame, Pat *top) {
+  switch (p->kind) {
+  case P_VAR: {
+    Value *v = val_cell();
+    v->kind = V_PATSEL;
+    v->u.patsel.pat = top;
+    v->u.patsel.var = p->u.var;
+    v->u.patsel.whole = whole;
+    env_bind(frame, p->u.var, v);
+    break;
+  }
+  case P_CON:
+    for (int i = 0; i < p->u.con.n; i++)
+      pat_bind_vars(p->u.con.args[i], whole, frame, top);
+    break;
+  case P_TUPLE:
+  case P_LIST:
+    for (int i = 0; i < p->u.tuple.n; i++)
+      pat_bind_vars(p->u.tuple.items[i], whole, frame, top);
+    break;
+  case P_CONS:
+    pat_bind_vars(p->u.cons.head, whole, frame, top);
+    pat_bind_vars(p->u.cons.tail, whole, frame, top);
+    break;
+  default:
+    break;
+  }
+}
+
+static Value *mk_fn(Def *d, Env *env) {
+  Value *v = val_cell();
+  v->kind = V_FUNC;
+  v->u.fn.kind = F_DEF;
+  v->u.fn.arity = d->arity;
+  v->u.fn.u.def = d;
+  v->u.fn.env = env;
+  return v;
+}
+
+static Expr *defbody_expr(Def *d) {
+  Expr *e = GC_MALLOC(sizeof *e);
+  e->kind = E_DEFBODY;
+  e->pos = d->pos;
+  e->u.def = d;
+  return e;
+}
+
+/* Bind local definitions (where, let) in frame; they may refer to each
+   other and to themselves. */
+static void bind_defs(Interp *I, int n, Def **defs, Env *frame) {
+  (void)I;
+  for (int i = 0; i < n; i++) {
+    Def *d = defs[i];
+    if (d->pat) {
+      Value *whole = mk_thunk(defbody_expr(d), frame);
+      pat_bind_vars(d->pat, whole, frame, d->pat);
+    } else if (d->arity > 0) {
+      env_bind(frame, d->name, mk_fn(d, frame));
+    } else {
+      Clause *c = d->clauses[0];
+      Expr *body = (d->nclauses == 1 && c->nbodies == 1 && !c->guards[0] &&
+                    c->nwhere == 0)
+                       ? c->bodies[0]
+                       : defbody_expr(d);
+      env_bind(frame, d->name, mk_thunk(body, frame));
+    }
+  }
+}
+
+Value *eval_global_value(Interp *I, Def *d) {
+  if (d->arity > 0) return mk_fn(d, NULL);
+  (void)I;
+  return mk_thunk(defbody_expr(d), NULL);
+}
+
+/* Forces v a few levels deep for an error message; an error on the way
+   is swallowed (the value then shows as "..." where it failed). */
+static void force_some(Interp *I, Value *v, int depth) {
+  if (depth <= 0) return;
+  int nforcing = I->nforcing, ntrace = I->ntrace;
+  ErrInfo saved = *err_info();
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    v = force(I, v);
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    eval_restore(I, nforcing);
+    I->ntrace = ntrace;
+    *err_info() = saved;
+    return;
+  }
+  *err_info() = saved;
+  if (v->kind == V_TUPLE)
+    for (int i = 0; i < v->u.tup.n; i++) force_some(I, v->u.tup.items[i], depth - 1);
+  else if (v->kind == V_CON)
+    for (int i = 0; i < v->u.con.n; i++) force_some(I, v->u.con.args[i], depth - 1);
+  else if (v->kind == V_CONS)
+    force_some(I, v->u.cons.head, depth - 1);
+}
+
+static void brief_args(Interp *I, int n, Value **args, char *buf, size_t size) {
+  size_t len = 0;
+  buf[0] = 0;
+  for (int i = 0; i < n && len + 4 < size; i++) {
+    if (i) {
+      snprintf(buf + len, size - len, ", ");
+      len = strlen(buf);
+    }
+    force_some(I, args[i], 3);
+    val_brief(args[i], buf + len, size - len);
+    len = strlen(buf);
+  }
+}
+
+/* Choose the clause of d that matches args and the body whose guard holds;
+   returns the body and its environment for the caller to evaluate. */
+static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
+                           Pos pos, Env **out_env) {
+  for (int c = 0; c < d->nclauses; c++) {
+    Clause *cl = d->clauses[c];
+    Env *frame = env_new(env, cl->npats + cl->nwhere + 1);
+    int ok = 1;
+    for (int i = 0; i < cl->npats && ok; i++)
+      ok = match(I, cl->pats[i], args[i], frame);
+    if (!ok) continue;
+    if (cl->nwhere) bind_defs(I, cl->nwhere, cl->where, frame);
+    for (int b = 0; b < cl->nbodies; b++) {
+      Expr *g = cl->guards[b];
+      if (!g || force_bool(I, eval(I, g, frame), g->pos, "a guard")) {
+        *out_env = frame;
+        return cl->bodies[b];
+      }
+    }
+  }
+  char buf[400];
+  brief_args(I, d->arity, args, buf, sizeof buf);
+  if (d->name && !strcmp(d->name->name, "case"))
+    qcs_error(pos, "no alternative of this case matches %s", buf);
+  if (d->name)
+    qcs_error(pos, "no clause of %s matches the argument%s %s", d->name->name,
+              d->arity == 1 ? "" : "s", buf);
+  if (d->arity == 0)
+    qcs_error(pos, "no guard holds in this definition");
+  qcs_error(pos, "no clause of this lambda matches %s", buf);
+}
+
+/* ---- application ---- */
+
+/* A position in the user's code for something the prelude builds: the
+   innermost call from outside the prelude (a Rounded rebuilt by Shift is
+   reported where the user wrote Shift). */
+Pos eval_user_pos(Interp *I, Pos pos) {
+  if (!pos.src || strcmp(pos.src->name, "<prelude>")) return pos;
+  int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
+  for (int i = n - 1; i >= 0; i--) {
+    const Pos *t = &I->trace[i].pos;
+    if (t->src && strcmp(t->src->name, "<prelude>")) return *t;
+  }
+  return pos;
+}
+
+/* Apply f to n arguments. Returns 1 with (*body, *benv) set when the result
+   is a function body to evaluate in tail position, or 0 with *result. */
+static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
+                Value **result, Expr **body, Env **benv, int depth) {
+  /* A function given more arguments than it takes applies its result to
+     the rest: if that is no function, the message says so by name. */
+  const char *over_name = NULL;
+  int over_arity = 0;
+  for (;;) {
+    f = force(I, f);
+    if (f->kind == V_PAP) {
+      Value **all = val_array(f->u.pap.n + n);
+      memcpy(all, f->u.pap.args, sizeof(Value *) * (size_t)f->u.pap.n);
+      memcpy(all + f->u.pap.n, args, sizeof(Value *) * (size_t)n);
+      args = all;
+      n += f->u.pap.n;
+      f = f->u.pap.fn;
+      continue;
+    }
+    if (f->kind != V_FUNC) {
+      char buf[160];
+      val_brief(f, buf, sizeof buf);
+      if (over_name)
+        qcs_error(pos, "%s takes %d argument%s, but it is given %d (its "
+                  "result, %s, is not a function: %s)", over_name, over_arity,
+                  over_arity == 1 ? "" : "s", over_arity + n, val_describe(f),
+                  buf);
+      qcs_error(pos, "%s is not a function, but it is applied to %d "
+                "argument%s: %s", val_describe(f), n, n == 1 ? "" : "s", buf);
+    }
+    int a = f->u.fn.arity;
+    if (n < a) {
+      Value *p = val_cell();
+      p->kind = V_PAP;
+      p->u.pap.fn = f;
+      p->u.pap.n = n;
+      p->u.pap.args = args;
+      *result = p;
+      return 0;
+    }
+    Value *r;
+    switch (f->u.fn.kind) {
+    case F_CON: {
+      Sym *c = f->u.fn.u.con;
+      if (n > a)
+        qcs_error(pos, "constructor %s takes %d argument%s, but it is given "
+                  "%d", c->name, a, a == 1 ? "" : "s", n);
+      Value **cargs = val_array(a);
+      memcpy(cargs, args, sizeof(Value *) * (size_t)a);
+      *result = val_con(c, a, cargs);
+      if (pos.src) { /* scene errors found later point back here */
+        Pos *p = GC_MALLOC(sizeof *p);
+        *p = eval_user_pos(I, pos);
+        (*result)->u.con.pos = p;
+      }
+      return 0;
+    }
+    case F_BUILTIN:
+      trace_set(I, depth, f->u.fn.u.bi->name, pos);
+      r = f->u.fn.u.bi->fn(I, args, pos);
+      break;
+    case F_DEF: {
+      Def *d = f->u.fn.u.def;
+      trace_set(I, depth, d->name ? d->name->name : "a lambda", pos);
+      Env *env;
+      Expr *b = select_clause(I, d, f->u.fn.env, args, pos, &env);
+      if (n == a) {
+        *body = b;
+        *benv = env;
+        return 1;
+      }
+      r = eval(I, b, env);
+      break;
+    }
+    default:
+      qcs_error(pos, "internal error: bad function kind");
+    }
+    if (n == a) {
+      *result = r;
+      return 0;
+    }
+    if (f->u.fn.kind == F_DEF && f->u.fn.u.def->name) {
+      over_name = f->u.fn.u.def->name->name;
+      over_arity = a;
+    } else if (f->u.fn.kind == F_BUILTIN) {
+      over_name = f->u.fn.u.bi->name;
+      over_arity = a;
+    } else {
+      over_name = NULL;
+    }
+    f = r;
+    args += a;
+    n -= a;
+  }
+}
+
+Value *apply(Interp *I, Value *f, int n, Value **args, Pos pos) {
+  Value *r;
+  Expr *body;
+  Env *env;
+  int depth = I->ntrace;
+  if (call(I, f, n, args, pos, &r, &body, &env, depth)) r = eval(I, body, env);
+  I->ntrace = depth;
+  return r;
+}
+
+/* ---- operators ---- */
+
+static int values_equal(Interp *I, Value *a, Value *b, Pos pos);
+
+static Value *arith(Interp *I, TokKind op, Value *a, Value *b, Pos pos);
+
+static Value *vec_map2(Interp *I, TokKind op, Value *a, Value *b, Pos pos) {
+  if (a->u.tup.n != b->u.tup.n)
+    qcs_error(pos, "'%s' on tuples of different sizes (%d and %d)",
+              op_text(op), a->u.tup.n, b->u.tup.n);
+  int n = a->u.tup.n;
+  Value **it = val_array(n);
+  for (int i = 0; i < n; i++)
+    it[i] = arith(I, op, force(I, a->u.tup.items[i]),
+                  force(I, b->u.tup.items[i]), pos);
+  return val_tuple(n, it);
+}
+
+static Value *vec_scale(Interp *I, TokKind op, Value *t, Value *s, int s_first,
+                        Pos pos) {
+  int n = t->u.tup.n;
+  Value **it = val_array(n);
+  for (int i = 0; i < n; i++) {
+    Value *x = force(I, t->u.tup.items[i]);
+    it[i] = s_first ? arith(I, op, s, x, pos) : arith(I, op, x, s, pos);
+  }
+  return val_tuple(n, it);
+}
+
+/* + - * / ^ on Reals, and elementwise on tuples (vectors): t+t, t-t,
+   s*t, t*s, t/s. */
+static Value *arith(Interp *I, TokKind op, Value *a, Value *b, Pos pos) {
+  if (a->kind == V_NUM && b->kind == V_NUM) {
+    double x = a->u.num, y = b->u.num;
+    switch (op) {
+    case T_PLUS: return val_num(x + y);
+    case T_MINUS: return val_num(x - y);
+    case T_STAR: return val_num(x * y);
+    case T_SLASH: return val_num(x / y);
+    case T_CARET: return val_num(pow(x, y));
+    default: break;
+    }
+  }
+  if (a->kind == V_TUPLE && b->kind == V_TUPLE &&
+      (op == T_PLUS || op == T_MINUS))
+    return vec_map2(I, op, a, b, pos);
+  if (a->kind == V_NUM && b->kind == V_TUPLE && op == T_STAR)
+    return vec_scale(I, op, b, a, 1, pos);
+  if (a->kind == V_TUPLE && b->kind == V_NUM && (op == T_STAR || op == T_SLASH))
+    return vec_scale(I, op, a, b, 0, pos);
+  char ba[120], bb[120];
+  val_brief(a, ba, sizeof ba);
+  val_brief(b, bb, sizeof bb);
+  qcs_error(pos, "'%s' cannot combine %s (%s) and %s (%s)", op_text(op),
+            val_describe(a), ba, val_describe(b), bb);
+}
+
+static int values_equal(Interp *I, Value *a, Value *b, Pos pos) {
+  eval_check(I, pos);
+  a = force(I, a);
+  b = force(I, b);
+  if (a->kind == V_NIL || a->kind == V_CONS) {
+    unsigned long long n = 0;
+    while (a->kind == V_CONS && b->kind == V_CONS) {
+      eval_check(I, pos);
+      eval_list_count(I, pos, ++n);
+      if (!values_equal(I, a->u.cons.head, b->u.cons.head, pos)) return 0;
+      a = force(I, a->u.cons.tail);
+      b = force(I, b->u.cons.tail);
+    }
+    return a->kind == V_NIL && b->kind == V_NIL;
+  }
+  if (a->kind != b->kind) return 0;
+  switch (a->kind) {
+  case V_NUM: return a->u.num == b->u.num;
+  case V_BOOL: return a->u.b == b->u.b;
+  case V_STR: return !strcmp(a->u.str, b->u.str);
+  case V_TUPLE:
+    if (a->u.tup.n != b->u.tup.n) return 0;
+    for (int i = 0; i < a->u.tup.n; i++)
+      if (!values_equal(I, a->u.tup.items[i], b->u.tup.items[i], pos)) return 0;
+    return 1;
+  case V_CON:
+    if (a->u.con.con != b->u.con.con) return 0;
+    for (int i = 0; i < a->u.con.n; i++)
+      if (!values_equal(I, a->u.con.args[i], b->u.con.args[i], pos)) return 0;
+    return 1;
+  case V_FOREIGN: return a->u.foreign.ptr == b->u.foreign.ptr;
+  default:
+    qcs_error(pos, "functions cannot be compared");
+  }
+}
+
+static int compare(Interp *I, Value *a, Value *b, Pos pos, TokKind op) {
+  a = force(I, a);
+  b = force(I, b);
+  if (a->kind == V_NUM && b->kind == V_NUM)
+    return a->u.num < b->u.num ? -1 : a->u.num > b->u.num ? 1 : 0;
+  if (a->kind == V_STR && b->kind == V_STR) return strcmp(a->u.str, b->u.str);
+  char ba[120], bb[120];
+  val_brief(a, ba, sizeof ba);
+  val_brief(b, bb, sizeof bb);
+  qcs_error(pos, "'%s' compares two Reals or two Strings, not %s (%s) and %s "
+            "(%s)", op_text(op), val_describe(a), ba, val_describe(b), bb);
+}
+
+static Value *append(Interp *I, Value *a, Value *b, Pos pos);
+
+static Value *bi_append_k(Interp *I, Value **args, Pos pos) {
+  return append(I, args[0], args[1], pos);
+}
+static const Builtin append_builtin = {"++", 2, bi_append_k, NULL};
+
+/* xs ++ ys, lazily: the tail is a delayed append. */
+static Value *append(Interp *I, Value *a, Value *b, Pos pos) {
+  a = force(I, a);
+  if (a->kind == V_STR) {
+    const char *y = force_str(I, b, pos, "the right side of ++ on strings");
+    size_t la = strlen(a->u.str), lb = strlen(y);
+    eval_alloc_check(I, pos, la + lb + 1);
+    char *s = GC_MALLOC_ATOMIC(la + lb + 1);
+    if (!s) qcs_error(pos, "out of memory for a string of %zu bytes",
+                      la + lb + 1);
+    memcpy(s, a->u.str, la);
+    memcpy(s + la, y, lb + 1);
+    return val_str(s);
+  }
+  if (a->kind == V_NIL) {
+    Value *r = force(I, b);
+    if (r->kind != V_NIL && r->kind != V_CONS)
+      qcs_error(pos, "'++' joins two lists or two Strings, not a list and %s",
+                val_describe(r));
+    return r;
+  }
+  if (a->kind != V_CONS)
+    qcs_error(pos, "'++' joins two lists or two Strings, not %s",
+              val_describe(a));
+  Value **args = val_array(2);
+  args[0] = a->u.cons.tail;
+  args[1] = b;
+  return val_cons(a->u.cons.head,
+                  delay_apply(val_builtin(&append_builtin), 2, args));
+}
+
+static Value *index_list(Interp *I, Value *xs, Value *nv, Pos pos) {
+  double n = force_num(I, nv, pos, "the index of !!");
+  if (n < 0 || n != floor(n))
+    qcs_error(pos, "'!!' needs a whole index >= 0, not %.17g", n);
+  Value *v = force(I, xs);
+  if (v->kind != V_CONS && v->kind != V_NIL) {
+    char b[120];
+    val_brief(v, b, sizeof b);
+    qcs_error(pos, "'!!' indexes a list, not %s: %s", val_describe(v), b);
+  }
+  for (double i = 0; i < n; i++) {
+    if (v->kind != V_CONS) break;
+    eval_check(I, pos);
+    eval_list_count(I, pos, (unsigned long long)i + 1);
+    v = force(I, v->u.cons.tail);
+  }
+  if (v->kind != V_CONS)
+    qcs_error(pos, "index %.17g is past the end of the list", n);
+  return force(I, v->u.cons.head);
+}
+
+static Value *binop(Interp *I, Expr *e, Env *env) {
+  TokKind op = e->u.bin.op;
+  Pos pos = e->pos;
+  switch (op) {
+  case T_AND: case T_KAND:
+    if (!force_bool(I, eval(I, e->u.bin.a, env), e->u.bin.a->pos,
+                    "the left side of &&"))
+      return I->v_false;
+    return val_bool(I, force_bool(I, eval(I, e->u.bin.b, env), e->u.bin.b->pos,
+                                  "the right side of &&"));
+  case T_OR: case T_KOR:
+    if (force_bool(I, eval(I, e->u.bin.a, env), e->u.bin.a->pos,
+                   "the left side of ||"))
+      return I->v_true;
+    return val_bool(I, force_bool(I, eval(I, e->u.bin.b, env), e->u.bin.b->pos,
+                                  "the right side of ||"));
+  case T_COLON:
+    return val_cons(delay(I, e->u.bin.a, env), delay(I, e->u.bin.b, env));
+  case T_APPEND:
+    return append(I, delay(I, e->u.bin.a, env), delay(I, e->u.bin.b, env), pos);
+  case T_INDEX:
+    return index_list(I, delay(I, e->u.bin.a, env), delay(I, e->u.bin.b, env),
+                      pos);
+  case T_EQ:
+    return val_bool(I, values_equal(I, eval(I, e->u.bin.a, env),
+                                    eval(I, e->u.bin.b, env), pos));
+  case T_NE:
+    return val_bool(I, !values_equal(I, eval(I, e->u.bin.a, env),
+                                     eval(I, e->u.bin.b, env), pos));
+  case T_LT: case T_LE: case T_GT: case T_GE: {
+    int c = compare(I, eval(I, e->u.bin.a, env), eval(I, e->u.bin.b, env), pos,
+                    op);
+    int r = op == T_LT ? c < 0 : op == T_LE ? c <= 0 : op == T_GT ? c > 0 : c >= 0;
+    return val_bool(I, r);
+  }
+  default: {
+    Value *a = eval(I, e->u.bin.a, env);
+    Value *b = eval(I, e->u.bin.b, env);
+    return arith(I, op, a, b, pos);
+  }
+  }
+}
+
+/* ---- ranges ---- */
+
+/* [from, from+step .. to]: element k is from + k*step (no drift); a Real
+   range stops past to + step/2, as Haskell's does. */
+/* args: from, step, to (NULL: no end), k, and the range's position (a
+   foreign Pos, for max-list errors found when a later element is
+   forced). */
+static Value *bi_range_k(Interp *I, Value **args, Pos pos) {
+  double from = args[0]->u.num, step = args[1]->u.num;
+  double k = args[3]->u.num;
+  double x = from + k * step;
+  if (args[2]) {
+    double to = args[2]->u.num;
+    /* Whole-number ranges stop at `to` exactly ([10, 8 .. 1] ends at 2);
+       others allow half a step of rounding, as Haskell's Double ranges. */
+    int whole = from == floor(from) && step == floor(step) && to == floor(to);
+    double limit = whole ? to : to + step / 2;
+    if (step > 0 ? x > limit : x < limit) return I->v_nil;
+  }
+  const Pos *rpos = args[4]->u.foreign.ptr;
+  eval_list_count(I, *rpos, (unsigned long long)k + 1);
+  Value **next = val_array(5);
+  next[0] = args[0];
+  next[1] = args[1];
+  next[2] = args[2];
+  next[3] = val_num(k + 1);
+  next[4] = args[4];
+  static const Builtin range_builtin = {"enumFromThenTo", 5, bi_range_k, NULL};
+  (void)pos;
+  return val_cons(val_num(x), delay_apply(val_builtin(&range_builtin), 5, next));
+}
+
+static Value *range(Interp *I, Expr *e, Env *env) {
+  Pos pos = e->pos;
+  double from = force_num(I, eval(I, e->u.range.from, env), pos,
+                          "the start of a range");
+  double step = 1;
+  if (e->u.range.then)
+    step = force_num(I, eval(I, e->u.range.then, env), pos,
+                     "the second element of a range") - from;
+  Value **args = val_array(5);
+  args[0] = val_num(from);
+  args[1] = val_num(step);
+  if (e->u.range.to) {
+    args[2] = val_num(force_num(I, eval(I, e->u.range.to, env), pos,
+                                "the end of a range"));
+    if (step == 0) qcs_error(pos, "a range with step 0 never ends");
+  }
+  if (!isfinite(from) || !isfinite(step))
+    qcs_error(pos, "a range needs finite bounds");
+  args[3] = val_num(0);
+  Pos *rpos = GC_MALLOC(sizeof *rpos);
+  *rpos = pos;
+  args[4] = val_foreign(rpos, "position");
+  return bi_range_k(I, args, pos);
+}
+
+/* ---- the evaluator ---- */
+
+Value *eval(Interp *I, Expr *e, Env *env) {
+  int depth = I->ntrace;
+  /* Trace slots: the first call made here, then the latest tail call. */
+  int tslot = depth;
+  Value *result;
+  for (;;) {
+    eval_check(I, e->pos);
+    switch (e->kind) {
+    case E_NUM:
+      result = val_num(e->u.num);
+      goto done;
+    case E_STR:
+      result = val_str(e->u.str);
+      goto done;
+    case E_BOOL:
+      result = val_bool(I, e->u.b);
+      goto done;
+    case E_VAR:
+      result = force(I, lookup(I, e->u.var, env, e->pos));
+      goto done;
+    case E_WILD:
+      qcs_error(e->pos, "'_' stands only in patterns");
+    case E_APP: {
+      Value *f = eval(I, e->u.app.fn, env);
+      int n = e->u.app.n;
+      Value **args = val_array(n);
+      for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
+      Expr *body;
+      Env *benv;
+      if (call(I, f, n, args, e->pos, &result, &body, &benv, tslot)) {
+        tslot = depth + 1;
+        e = body;
+        env = benv;
+        continue;
+      }
+      goto done;
+    }
+    case E_LAMBDA:
+      result = mk_fn(e->u.lambda, env);
+      goto done;
+    case E_LET: {
+      Env *frame = env_new(env, e->u.let.n + 1);
+      bind_defs(I, e->u.let.n, e->u.let.defs, frame);
+      env = frame;
+      e = e->u.let.body;
+      continue;
+    }
+    case E_DEFBODY: {
+      Env *benv;
+      Expr *body = select_clause(I, e->u.def, env, NULL, e->pos, &benv);
+      env = benv;
+      e = body;
+      continue;
+    }
+    case E_IF:
+      e = force_bool(I, eval(I, e->u.cond.c, env), e->u.cond.c->pos,
+                     "the condition of if")
+              ? e->u.cond.t
+              : e->u.cond.f;
+      continue;
+    case E_TUPLE: {
+      int n = e->u.tuple.n;
+      Value **items = val_array(n);
+      for (int i = 0; i < n; i++) items[i] = delay(I, e->u.tuple.items[i], env);
+      result = val_tuple(n, items);
+      goto done;
+    }
+    case E_LIST: {
+      result = I->v_nil;
+      for (int i = e->u.tuple.n - 1; i >= 0; i--)
+        result = val_cons(delay(I, e->u.tuple.items[i], env), result);
+      goto done;
+    }
+    case E_RANGE:
+      result = range(I, e, env);
+      goto done;
+    case E_BINOP:
+      result = binop(I, e, env);
+      goto done;
+    case E_NEG: {
+      Value *x = eval(I, e->u.neg, env);
+      if (x->kind == V_NUM) {
+        result = val_num(-x->u.num);
+      } else if (x->kind == V_TUPLE) {
+        result = vec_scale(I, T_STAR, x, val_num(-1), 1, e->pos);
+      } else {
+        char b[120];
+        val_brief(x, b, sizeof b);
+        qcs_error(e->pos, "unary '-' needs a Real or a tuple, not %s (%s)",
+                  val_describe(x), b);
+      }
+      goto done;
+    }
+    }
+    qcs_error(e->pos, "internal error: unknown expression kind %d", e->kind);
+  }
+done:
+  I->ntrace = depth;
+  return result;
+}
+
+/* ---- brief descriptions ---- */
+
+void val_brief(Value *v, char *buf, size_t size) {
+  FILE *f = fmemopen(buf, size, "w");
+  if (!f) {
+    snprintf(buf, size, "?");
+    return;
+  }
+  print_brief(f, v, 3);
+  fclose(f);
+  buf[size - 1] = 0;
+}

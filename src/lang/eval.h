@@ -1,0 +1,79 @@
+/* eval.h: the lazy evaluator.
+ *
+ * eval() reduces an expression to weak-head normal form; force() does the
+ * same for a value that may be a thunk, updating the thunk in place (call
+ * by need). Arguments and bindings are delayed, never evaluated before they
+ * are needed. Tail calls (function bodies, if, let, guards) reuse the C
+ * frame, so loops written as recursion run in constant C stack; deep
+ * non-tail recursion is stopped with "recursion too deep" before the C
+ * stack runs out. Errors are raised with qcs_error (see error.h). */
+#ifndef QCS_EVAL_H
+#define QCS_EVAL_H
+
+#include "lang/interp.h"
+#include "lang/value.h"
+
+Value *eval(Interp *I, Expr *e, Env *env);
+Value *force(Interp *I, Value *v);
+/* A value for e in env without evaluating it (a thunk unless trivial). */
+Value *delay(Interp *I, Expr *e, Env *env);
+/* f applied to n arguments, reduced to weak-head normal form. */
+Value *apply(Interp *I, Value *f, int n, Value **args, Pos pos);
+/* A lazy application: a thunk that computes f args when forced. */
+Value *delay_apply(Value *f, int n, Value **args);
+
+/* Forcing helpers that check the kind, with an error at pos naming what
+   was expected (`what` is e.g. "the radius of Rounded"). */
+double force_num(Interp *I, Value *v, Pos pos, const char *what);
+int force_bool(Interp *I, Value *v, Pos pos, const char *what);
+const char *force_str(Interp *I, Value *v, Pos pos, const char *what);
+/* A 3-tuple of Reals. */
+void force_vec3(Interp *I, Value *v, Pos pos, const char *what, double out[3]);
+
+/* A global's value as installed from its definition. */
+Value *eval_global_value(Interp *I, Def *d);
+/* The constructor `s` as a value (a function of its arity, or itself). */
+Value *eval_con_value(Interp *I, Sym *s);
+
+/* After an error: put back every thunk that was being forced (above
+   nforcing entries), so a later evaluation retries it instead of seeing a
+   false "depends on itself". */
+void eval_restore(Interp *I, int nforcing);
+
+/* Recursion-depth, step and interrupt checks (also used by builtins that
+   loop). */
+void eval_check(Interp *I, Pos pos);
+
+/* An error for a resource limit hit (see interp.h): the message, then
+   "(limit NAME; raise it with :set NAME N or --NAME N)". Without a
+   position at hand, the top-level item's is used. */
+_Noreturn void eval_limit_error(Interp *I, Pos pos, const char *limit,
+                                const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+/* "WHAT more than SIZE of stackAFTER" as a max-stack error. */
+_Noreturn void eval_stack_error(Interp *I, Pos pos, const char *what,
+                                const char *after);
+/* Before one large allocation (a String): bytes more would pass
+   max-memory -> the limit's error. */
+void eval_alloc_check(Interp *I, Pos pos, size_t bytes);
+/* Counts element n (1-based) of a list against max-list. */
+_Noreturn void eval_list_limit(Interp *I, Pos pos, unsigned long long n);
+static inline void eval_list_count(Interp *I, Pos pos, unsigned long long n) {
+  if (n > I->max_list && I->max_list) eval_list_limit(I, pos, n);
+}
+/* The stack check alone (the parser and the static checker use it). */
+static inline void eval_stack_check(Interp *I, Pos pos, const char *what) {
+  char probe;
+  if ((size_t)(I->stack_base - &probe) > I->stack_limit)
+    eval_stack_error(I, pos, what, "");
+}
+
+/* For a position inside the prelude, the innermost call from the user's
+   code in the call trace (an error raised by the prelude is reported
+   where the user called it); other positions are returned as they are. */
+Pos eval_user_pos(Interp *I, Pos pos);
+
+/* The brief, non-forcing description of a value for error messages:
+   thunks show as "...", long lists and deep trees are cut. */
+void val_brief(Value *v, char *buf, size_t size);
+#endif

@@ -1,0 +1,810 @@
+/* interp.c: running source text. See interp.h.
+ *
+ * A run parses the whole text first (a syntax error runs nothing), checks
+ * every name it uses (an unknown name is reported before anything is
+ * evaluated, with a suggestion), installs the definitions, and then
+ * evaluates the top-level expressions in order. */
+#include "lang/interp.h"
+
+#include <errno.h>
+#include <gc.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "lang/builtins.h"
+#include "lang/eval.h"
+#include "lang/parse.h"
+#include "lang/print.h"
+
+#include "prelude.inc"
+
+#ifndef QCS_VERSION
+#define QCS_VERSION "0.1"
+#endif
+
+static int run_counter;
+
+/* ---- error display ---- */
+
+static void report_error(Interp *I) {
+  ErrInfo *e = err_info();
+  /* Found where no position was at hand (a lazy list's tail, printing):
+     the top-level expression being run. */
+  if (!e->pos.line && I->item_pos.line) e->pos = I->item_pos;
+  I->item_pos = pos_none;
+  err_report(stderr, "error", e->pos, e->msg);
+  int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
+  int lines = 0, i = n - 1;
+  /* Innermost first; a run of identical entries (deep recursion) is
+     shown once with its count. */
+  while (i >= 0 && lines < 8) {
+    TraceEntry *t = &I->trace[i];
+    int same = 1;
+    while (i - same >= 0 && I->trace[i - same].name == t->name &&
+           I->trace[i - same].pos.line == t->pos.line &&
+           I->trace[i - same].pos.col == t->pos.col &&
+           I->trace[i - same].pos.src == t->pos.src)
+      same++;
+    const char *name = t->name[0] == '%' ? "a list comprehension" : t->name;
+    if (t->pos.src && t->pos.line)
+      fprintf(stderr, "  in %s, called at %s:%d:%d", name,
+              t->pos.src->name, t->pos.line, t->pos.col);
+    else
+      fprintf(stderr, "  in %s", name);
+    if (same > 1) fprintf(stderr, " (%d times)", same);
+    fputc('\n', stderr);
+    i -= same;
+    lines++;
+  }
+  if (i >= 0) fprintf(stderr, "  ... and %d more calls\n", i + 1);
+}
+
+/* Put back every thunk that was being forced when the error struck, so
+   a later evaluation retries it instead of seeing a false loop. */
+static void unwind(Interp *I, int nforcing) {
+  eval_restore(I, nforcing);
+  I->ntrace = 0;
+  qcs_interrupted = 0;
+}
+
+/* ---- the static check ---- */
+
+typedef struct Scope {
+  struct Scope *up;
+  int n, cap;
+  Sym **names;
+} Scope;
+
+typedef struct Check {
+  Interp *I;
+  Item **items;
+  int nitems;
+  int depth;  /* of check_expr calls: one per 8 KB of max-stack at most */
+} Check;
+
+static void scope_add(Scope *s, Sym *name) {
+  if (s->n == s->cap) {
+    s->cap = s->cap ? 2 * s->cap : 8;
+    Sym **a = GC_MALLOC(sizeof(Sym *) * (size_t)s->cap);
+    if (s->n) memcpy(a, s->names, sizeof(Sym *) * (size_t)s->n);
+    s->names = a;
+  }
+  s->names[s->n++] = name;
+}
+
+static void pat_scope(Check *C, Pat *p, Scope *s) {
+  switch (p->kind) {
+  case P_VAR: scope_add(s, p->u.var); break;
+  case P_CON:
+    if (p->u.con.con->con_arity < 0) {
+      qcs_error(p->pos, "'%s' in a pattern is not a constructor",
+                p->u.con.con->name);
+    }
+    if (p->u.con.con->con_arity != p->u.con.n)
+      qcs_error(p->pos, "constructor %s takes %d argument%s, this pattern "
+                "gives %d", p->u.con.con->name, p->u.con.con->con_arity,
+                p->u.con.con->con_arity == 1 ? "" : "s", p->u.con.n);
+    for (int i = 0; i < p->u.con.n; i++) pat_scope(C, p->u.con.args[i], s);
+    break;
+  case P_TUPLE: case P_LIST:
+    for (int i = 0; i < p->u.tuple.n; i++) pat_scope(C, p->u.tuple.items[i], s);
+    break;
+  case P_CONS:
+    pat_scope(C, p->u.cons.head, s);
+    pat_scope(C, p->u.cons.tail, s);
+    break;
+  default: break;
+  }
+}
+
+static int defined_in_batch(Check *C, Sym *s) {
+  for (int i = 0; i < C->nitems; i++)
+    if (C->items[i]->kind == ITEM_DEF && C->items[i]->def->name == s) return 1;
+  return 0;
+}
+
+static _Noreturn void check_unknown(Check *C, Sym *s, Scope *sc, Pos pos) {
+  const char *best = NULL;
+  int bestd = s->name[1] ? 3 : 1;
+  for (Scope *x = sc; x; x = x->up)
+    for (int i = 0; i < x->n; i++) {
+      int d = edit_distance(s->name, x->names[i]->name);
+      if (d < bestd && x->names[i]->name[0] != '%')
+        bestd = d, best = x->names[i]->name;
+    }
+  for (int i = 0; i < C->nitems; i++)
+    if (C->items[i]->kind == ITEM_DEF && C->items[i]->def->name) {
+      int d = edit_distance(s->name, C->items[i]->def->name->name);
+      if (d < bestd) bestd = d, best = C->items[i]->def->name->name;
+    }
+  Interp *I = C->I;
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *g = I->symtab[h]; g; g = g->next)
+      if ((g->global || g->con_arity >= 0) && g->name[0] != '%') {
+        int d = edit_distance(s->name, g->name);
+        if (d < bestd) bestd = d, best = g->name;
+      }
+  if (best) qcs_error(pos, "unknown name '%s' (did you mean '%s'?)", s->name, best);
+  qcs_error(pos, "unknown name '%s'", s->name);
+}
+
+static void check_expr(Check *C, Expr *e, Scope *sc);
+static void check_defs(Check *C, int n, Def **defs, Scope *sc);
+
+static void check_var(Check *C, Sym *s, Scope *sc, Pos pos) {
+  for (Scope *x = sc; x; x = x->up)
+    for (int i = 0; i < x->n; i++)
+      if (x->names[i] == s) return;
+  if (s->con_arity >= 0 || s->global || defined_in_batch(C, s)) return;
+  check_unknown(C, s, sc, pos);
+}
+
+static void check_def(Check *C, Def *d, Scope *sc) {
+  for (int c = 0; c < d->nclauses; c++) {
+    Clause *cl = d->clauses[c];
+    Scope s = {sc, 0, 0, NULL};
+    for (int i = 0; i < cl->npats; i++) pat_scope(C, cl->pats[i], &s);
+    if (cl->nwhere) {
+      for (int i = 0; i < cl->nwhere; i++) {
+        Def *w = cl->where[i];
+        if (w->pat) pat_scope(C, w->pat, &s);
+        else scope_add(&s, w->name);
+      }
+      check_defs(C, cl->nwhere, cl->where, &s);
+    }
+    for (int b = 0; b < cl->nbodies; b++) {
+      if (cl->guards[b]) check_expr(C, cl->guards[b], &s);
+      check_expr(C, cl->bodies[b], &s);
+    }
+  }
+}
+
+static void check_defs(Check *C, int n, Def **defs, Scope *sc) {
+  for (int i = 0; i < n; i++) check_def(C, defs[i], sc);
+}
+
+/* The AST's depth is bounded here, before anything runs: a chain of a
+   million '+' would otherwise recurse a million deep in eval. */
+static void check_expr_body(Check *C, Expr *e, Scope *sc);
+static void check_expr(Check *C, Expr *e, Scope *sc) {
+  if ((size_t)++C->depth > C->I->stack_limit >> 13)
+    eval_limit_error(C->I, e->pos, "max-stack",
+                     "expression nested too deeply to evaluate");
+  eval_stack_check(C->I, e->pos,
+                   "expression nested too deeply: checking it needs");
+  check_expr_body(C, e, sc);
+  C->depth--;
+}
+
+static void check_expr_body(Check *C, Expr *e, Scope *sc) {
+  switch (e->kind) {
+  case E_VAR: check_var(C, e->u.var, sc, e->pos); break;
+  case E_WILD: qcs_error(e->pos, "'_' stands only in patterns");
+  case E_APP:
+    check_expr(C, e->u.app.fn, sc);
+    for (int i = 0; i < e->u.app.n; i++) check_expr(C, e->u.app.args[i], sc);
+    break;
+  case E_LAMBDA: check_def(C, e->u.lambda, sc); break;
+  case E_LET: {
+    Scope s = {sc, 0, 0, NULL};
+    for (int i = 0; i < e->u.let.n; i++) {
+      Def *w = e->u.let.defs[i];
+      if (w->pat) pat_scope(C, w->pat, &s);
+      else scope_add(&s, w->name);
+    }
+    check_defs(C, e->u.let.n, e->u.let.defs, &s);
+    check_expr(C, e->u.let.body, &s);
+    break;
+  }
+  case E_IF:
+    check_expr(C, e->u.cond.c, sc);
+    check_expr(C, e->u.cond.t, sc);
+    check_expr(C, e->u.cond.f, sc);
+    break;
+  case E_TUPLE: case E_LIST:
+    for (int i = 0; i < e->u.tuple.n; i++) check_expr(C, e->u.tuple.items[i], sc);
+    break;
+  case E_RANGE:
+    check_expr(C, e->u.range.from, sc);
+    if (e->u.range.then) check_expr(C, e->u.range.then, sc);
+    if (e->u.range.to) check_expr(C, e->u.range.to, sc);
+    break;
+  case E_BINOP:
+    check_expr(C, e->u.bin.a, sc);
+    check_expr(C, e->u.bin.b, sc);
+    break;
+  case E_NEG: check_expr(C, e->u.neg, sc); break;
+  case E_DEFBODY: check_def(C, e->u.def, sc); break;
+  default: break;
+  }
+}
+
+/* ---- running ---- */
+
+static void install_type(Interp *I, Item *it) {
+  for (int i = 0; i < it->ncons; i++) {
+    Sym *s = it->cons[i].name;
+    s->con_arity = it->cons[i].arity;
+    s->con_type = it->type;
+    s->con_value = NULL;
+    s->global = NULL;
+    s->def = NULL;
+    s->user = !I->loading_prelude;
+    s->def_pos = it->cons[i].pos;
+  }
+}
+
+/* Re-create every user-defined value from its definition, so that values
+   computed from a definition the REPL has just replaced are computed
+   again (a scene follows its parameters). */
+static void refresh_values(Interp *I) {
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next)
+      if (s->user && s->def && s->def->arity == 0 && !s->overridden)
+        s->global = eval_global_value(I, s->def);
+}
+
+static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
+                           const char *runname) {
+  int runid = ++run_counter;
+  Check C = {I, items, n, 0};
+  /* Duplicate definitions within one script are mistakes. */
+  for (int i = 0; i < n; i++) {
+    if (items[i]->kind != ITEM_DEF) continue;
+    Def *d = items[i]->def;
+    for (int j = 0; j < i; j++)
+      if (items[j]->kind == ITEM_DEF && items[j]->def->name == d->name)
+        qcs_error(d->pos, "%s is already defined at %d:%d (the clauses of a "
+                  "function must be together)", d->name->name,
+                  items[j]->def->pos.line, items[j]->def->pos.col);
+  }
+  for (int i = 0; i < n; i++)
+    if (items[i]->kind == ITEM_TYPE) install_type(I, items[i]);
+  for (int i = 0; i < n; i++) {
+    if (items[i]->kind == ITEM_DEF) {
+      Def *d = items[i]->def;
+      Scope top = {NULL, 0, 0, NULL};
+      check_def(&C, d, &top);
+    } else if (items[i]->kind == ITEM_EXPR) {
+      check_expr(&C, items[i]->expr, NULL);
+    }
+  }
+  int redefined = 0;
+  for (int i = 0; i < n; i++) {
+    Item *it = items[i];
+    if (it->kind == ITEM_SIG) {
+      it->signame->sig = it->sigtext;
+    } else if (it->kind == ITEM_DEF) {
+      Sym *s = it->def->name;
+      if (s->overridden) continue;
+      if (s->def && s->user) redefined = 1;
+      s->def = it->def;
+      s->global = eval_global_value(I, it->def);
+      s->user = !I->loading_prelude;
+      s->def_pos = it->def->pos;
+      s->def_file = runname;
+      (void)runid;
+    }
+  }
+  if (redefined && mode == MODE_REPL) refresh_values(I);
+  for (int i = 0; i < n; i++) {
+    if (items[i]->kind != ITEM_EXPR) continue;
+    /* max-steps counts per top-level expression */
+    I->steps = 0;
+    I->item_pos = items[i]->expr->pos;
+    Value *v = eval(I, items[i]->expr, NULL);
+    print_value(I, stdout, v);
+    fputc('\n', stdout);
+    fflush(stdout);
+  }
+  return RUN_OK;
+}
+
+RunStatus interp_run_string(Interp *I, const char *name, const char *text,
+                            RunMode mode) {
+  Src *src = GC_MALLOC(sizeof *src);
+  char *nm = GC_MALLOC_ATOMIC(strlen(name) + 1);
+  strcpy(nm, name);
+  size_t len = strlen(text);
+  char *tx = GC_MALLOC_ATOMIC(len + 1);
+  memcpy(tx, text, len + 1);
+  src->name = nm;
+  src->text = tx;
+  if (I->loading_prelude) I->prelude_src = src;
+  I->item_pos = pos_none;
+  int nforcing = I->nforcing;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    int n;
+    Item **items = parse_program(I, src, mode, &n);
+    RunStatus st = run_items(I, items, n, mode, nm);
+    err_pop(&f);
+    return st;
+  }
+  err_pop(&f);
+  fflush(stdout);
+  if (err_info()->incomplete && mode == MODE_REPL) {
+    unwind(I, nforcing);
+    return RUN_INCOMPLETE;
+  }
+  report_error(I);
+  unwind(I, nforcing);
+  return RUN_ERROR;
+}
+
+/* Reads a whole file; NULL with errno set on failure. */
+static char *read_file(const char *path, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  size_t cap = 4096, n = 0;
+  char *buf = malloc(cap);
+  for (;;) {
+    if (n + 1 >= cap) {
+      char *nb = realloc(buf, cap *= 2);
+      if (!nb) {
+        free(buf);
+        fclose(f);
+        errno = ENOMEM;
+        return NULL;
+      }
+      buf = nb;
+    }
+    size_t r = fread(buf + n, 1, cap - n - 1, f);
+    n += r;
+    if (r == 0) break;
+  }
+  int err = ferror(f);
+  fclose(f);
+  if (err) {
+    free(buf);
+    errno = EIO;
+    return NULL;
+  }
+  buf[n] = 0;
+  *len = n;
+  return buf;
+}
+
+RunStatus interp_run_file(Interp *I, const char *path) {
+  size_t len;
+  char *text = read_file(path, &len);
+  if (!text) {
+    fprintf(stderr, "qcs: error: cannot read %s: %s\n", path, strerror(errno));
+    return RUN_ERROR;
+  }
+  /* A NUL byte would silently end the text: say where it is. */
+  size_t nul = strlen(text);
+  if (nul < len) {
+    int line = 1, col = 1;
+    for (size_t i = 0; i < nul; i++) {
+      if (text[i] == '\n') line++, col = 1;
+      else col++;
+    }
+    fprintf(stderr, "%s:%d:%d: error: NUL byte in source\n", path, line, col);
+    free(text);
+    return RUN_ERROR;
+  }
+  RunStatus st = interp_run_string(I, path, text, MODE_SCRIPT);
+  free(text);
+  return st;
+}
+
+RunStatus interp_eval_print(Interp *I, const char *text) {
+  Src *src = GC_MALLOC(sizeof *src);
+  src->name = "<-e>";
+  char *tx = GC_MALLOC_ATOMIC(strlen(text) + 1);
+  strcpy(tx, text);
+  src->text = tx;
+  I->item_pos = pos_none;
+  int nforcing = I->nforcing;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    int n;
+    Item **items = parse_program(I, src, MODE_REPL, &n);
+    RunStatus st = run_items(I, items, n, MODE_REPL, "<-e>");
+    err_pop(&f);
+    return st;
+  }
+  err_pop(&f);
+  fflush(stdout);
+  report_error(I);
+  unwind(I, nforcing);
+  return RUN_ERROR;
+}
+
+RunStatus interp_run_item(Interp *I, Pos pos,
+                          Value *(*fn)(Interp *I, void *ud), void *ud) {
+  int nforcing = I->nforcing;
+  I->steps = 0;
+  I->item_pos = pos;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    Value *v = fn(I, ud);
+    if (v) {
+      print_value(I, stdout, v);
+      fputc('\n', stdout);
+    }
+    fflush(stdout);
+    err_pop(&f);
+    return RUN_OK;
+  }
+  err_pop(&f);
+  fflush(stdout);
+  report_error(I);
+  unwind(I, nforcing);
+  return RUN_ERROR;
+}
+
+RunStatus interp_set_override(Interp *I, const char *name, const char *expr) {
+  Src *src = GC_MALLOC(sizeof *src);
+  char *nm = GC_MALLOC_ATOMIC(strlen(name) + 16);
+  snprintf(nm, strlen(name) + 16, "--set %s", name);
+  src->name = nm;
+  char *tx = GC_MALLOC_ATOMIC(strlen(expr) + 1);
+  strcpy(tx, expr);
+  src->text = tx;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    const char *p = name;
+    int ok = *p && ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z'));
+    for (; *p && ok; p++)
+      ok = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') ||
+           (*p >= '0' && *p <= '9') || *p == '_' || *p == '\'';
+    if (!ok) qcs_error(pos_none, "--set needs NAME=VALUE with a plain name, "
+                       "not '%s'", name);
+    Expr *e = parse_expression(I, src);
+    Check C = {I, NULL, 0, 0};
+    check_expr(&C, e, NULL);
+    Sym *s = sym_intern(I, name, (int)strlen(name));
+    if (s->con_arity >= 0)
+      qcs_error(pos_none, "--set cannot replace the constructor %s", name);
+    s->global = delay(I, e, NULL);
+    s->overridden = 1;
+    s->user = 1;
+    err_pop(&f);
+    return RUN_OK;
+  }
+  err_pop(&f);
+  report_error(I);
+  return RUN_ERROR;
+}
+
+/* ---- completion and browsing ---- */
+
+void interp_complete(Interp *I, const char *prefix,
+                     void (*emit)(const char *name, void *ud), void *ud) {
+  size_t len = strlen(prefix);
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next)
+      if ((s->global || s->con_arity >= 0) && s->name[0] != '%' &&
+          !strncmp(s->name, prefix, len))
+        emit(s->name, ud);
+}
+
+static int cmp_sym(const void *a, const void *b) {
+  return strcmp((*(Sym *const *)a)->name, (*(Sym *const *)b)->name);
+}
+
+void interp_browse(Interp *I, FILE *out, int all) {
+  Sym **list = GC_MALLOC(sizeof(Sym *) * (I->nsyms + 1));
+  size_t n = 0;
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next)
+      if ((s->global || s->con_arity >= 0) && s->name[0] != '%' &&
+          (all || s->user))
+        list[n++] = s;
+  qsort(list, n, sizeof *list, cmp_sym);
+  for (size_t i = 0; i < n; i++) {
+    Sym *s = list[i];
+    if (s->con_arity >= 0) {
+      fprintf(out, "%s  -- constructor of %s, %d argument%s\n", s->name,
+              s->con_type ? s->con_type->name : "?", s->con_arity,
+              s->con_arity == 1 ? "" : "s");
+    } else if (s->sig) {
+      fprintf(out, "%s :: %s\n", s->name, s->sig);
+    } else if (s->def) {
+      fprintf(out, "%s  -- %d argument%s, defined at %s:%d\n", s->name,
+              s->def->arity, s->def->arity == 1 ? "" : "s",
+              s->def_pos.src ? s->def_pos.src->name : "?", s->def_pos.line);
+    } else {
+      fprintf(out, "%s\n", s->name);
+    }
+  }
+}
+
+int interp_has_global(Interp *I, const char *name) {
+  Sym *s = sym_intern(I, name, (int)strlen(name));
+  return s->global != NULL;
+}
+
+void interp_request_interrupt(void) { qcs_interrupted = 1; }
+void interp_clear_interrupt(void) { qcs_interrupted = 0; }
+
+/* ---- start-up ---- */
+
+Interp *interp_new(void (*install)(Interp *I)) {
+  static int gc_ready;
+  if (!gc_ready) {
+    GC_INIT();
+    /* The collector's own warnings ("repeated allocation of very large
+       block") mean nothing to a user; limits say what went wrong. */
+    GC_set_warn_proc(GC_ignore_warn_proc);
+    /* Start with a heap of 256 MB (an eighth of the memory on a small
+       machine): address space whose pages are touched only as values fill
+       them, so a small script stays small, while a scene that builds a big
+       structure is not collected over and over as it grows (100,000 soft
+       keys: 28% fewer instructions). */
+    long pg = sysconf(_SC_PHYS_PAGES), pgsz = sysconf(_SC_PAGESIZE);
+    size_t heap = (size_t)256 << 20;
+    if (pg > 0 && pgsz > 0 && (size_t)pg * (size_t)pgsz / 8 < heap)
+      heap = (size_t)pg * (size_t)pgsz / 8;
+    GC_expand_hp(heap);
+    gc_ready = 1;
+  }
+  Interp *I = GC_MALLOC_UNCOLLECTABLE(sizeof *I);
+  char probe;
+  I->stack_base = &probe;
+  I->stack_limit = I->stack_reserved = 6u << 20;
+  /* 8 GB of values unless told otherwise, or half the machine's memory
+     when it has less than 16 GB (the limit must come before the
+     system's out-of-memory killer). */
+  I->max_memory = (size_t)8 << 30;
+  long pages = sysconf(_SC_PHYS_PAGES), pagesize = sysconf(_SC_PAGESIZE);
+  if (pages > 0 && pagesize > 0 &&
+      (unsigned long long)pages * (unsigned long long)pagesize / 2 <
+          I->max_memory)
+    I->max_memory = (size_t)((unsigned long long)pages *
+                             (unsigned long long)pagesize / 2 >> 20 << 20);
+  I->max_steps = QCS_DEFAULT_MAX_STEPS;
+  I->max_list = QCS_DEFAULT_MAX_LIST;
+  I->max_pixels = QCS_DEFAULT_MAX_PIXELS;
+  I->max_spp = QCS_DEFAULT_MAX_SPP;
+  I->v_true = GC_MALLOC(sizeof(Value));
+  I->v_true->kind = V_BOOL;
+  I->v_true->u.b = 1;
+  I->v_false = GC_MALLOC(sizeof(Value));
+  I->v_false->kind = V_BOOL;
+  I->v_nil = GC_MALLOC(sizeof(Value));
+  I->v_nil->kind = V_NIL;
+  builtins_install(I);
+  if (install) install(I);
+  I->loading_prelude = 1;
+  RunStatus st = interp_run_string(I, "<prelude>", qcs_prelude_source,
+                                   MODE_SCRIPT);
+  I->loading_prelude = 0;
+  if (st != RUN_OK) {
+    fprintf(stderr, "qcs: internal error: the prelude does not load\n");
+    exit(2);
+  }
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next) s->prelude_value = s->global;
+  return I;
+}
+
+void interp_set_stack(Interp *I, char *base, size_t limit) {
+  I->stack_base = base;
+  I->stack_limit = limit;
+  I->stack_reserved = limit;
+}
+
+void interp_set_stack_reserved(Interp *I, size_t reserved) {
+  if (reserved > I->stack_reserved) I->stack_reserved = reserved;
+}
+
+void interp_set_max_memory(Interp *I, size_t bytes) { I->max_memory = bytes; }
+
+void interp_set_max_steps(Interp *I, unsigned long long steps) {
+  I->max_steps = steps;
+  I->steps = 0;
+}
+
+/* ---- resource limits ---- */
+
+typedef enum { LIM_SIZE, LIM_COUNT, LIM_PIXELS, LIM_SPP } LimitKind;
+
+static const struct {
+  const char *name;
+  LimitKind kind;
+  int zero_ok;          /* 0 switches the limit off */
+  unsigned long long min, max;
+  const char *what;
+} limits[] = {
+  {"max-stack", LIM_SIZE, 0, 1ULL << 20, 1ULL << 40,
+   "C stack for nested calls and parsing (recursion depth)"},
+  {"max-steps", LIM_COUNT, 1, 1, ~0ULL,
+   "evaluation steps of one top-level expression"},
+  {"max-list", LIM_COUNT, 1, 1, ~0ULL,
+   "elements of one list (ranges, length, sum, printing, ...)"},
+  {"max-memory", LIM_SIZE, 1, 1ULL << 20, 1ULL << 50, "memory for values"},
+  {"max-pixels", LIM_PIXELS, 0, 1, QCS_MAX_PIXELS_CAP,
+   "pixels of one rendered image"},
+  {"max-spp", LIM_SPP, 0, 1, 256, "samples per pixel of a render"},
+};
+#define NLIMITS (sizeof limits / sizeof limits[0])
+
+const char *const interp_limit_names[] = {
+  "max-stack", "max-steps", "max-list", "max-memory", "max-pixels", "max-spp",
+  NULL};
+
+/* "256M", "8G", or bytes when not a whole number of K. */
+void interp_format_size(char *buf, size_t n, unsigned long long bytes) {
+  static const char units[] = "KMGT";
+  int u = -1;
+  while (u < 3 && bytes >= 1024 && bytes % 1024 == 0) bytes /= 1024, u++;
+  if (u < 0) snprintf(buf, n, "%llu", bytes);
+  else snprintf(buf, n, "%llu%c", bytes, units[u]);
+}
+
+static int limit_index(const char *name) {
+  for (size_t i = 0; i < NLIMITS; i++)
+    if (!strcmp(limits[i].name, name)) return (int)i;
+  return -1;
+}
+
+/* A whole number of decimal digits (no sign, no blanks); 0 on success. */
+static int parse_whole(const char **p, unsigned long long *out) {
+  const char *s = *p;
+  unsigned long long v = 0;
+  if (*s < '0' || *s > '9') return -1;
+  for (; *s >= '0' && *s <= '9'; s++) {
+    if (v > (~0ULL - 9) / 10) return -1;
+    v = v * 10 + (unsigned long long)(*s - '0');
+  }
+  *p = s;
+  *out = v;
+  return 0;
+}
+
+int interp_limit_parse(const char *name, const char *text,
+                       unsigned long long *out, char *err, size_t errlen) {
+  int i = limit_index(name);
+  if (i < 0) {
+    const char *best = NULL;
+    int bestd = 4;
+    for (size_t j = 0; j < NLIMITS; j++) {
+      int d = edit_distance(name, limits[j].name);
+      if (d < bestd) bestd = d, best = limits[j].name;
+    }
+    if (best)
+      snprintf(err, errlen, "unknown limit '%s' (did you mean %s?)", name,
+               best);
+    else
+      snprintf(err, errlen, "unknown limit '%s'; the limits are max-stack, "
+               "max-steps, max-list, max-memory, max-pixels and max-spp",
+               name);
+    return -1;
+  }
+  const char *p = text;
+  unsigned long long v = 0, h;
+  int ok = parse_whole(&p, &v) == 0;
+  const char *want = "a whole number";
+  switch (limits[i].kind) {
+  case LIM_SIZE: {
+    want = "a size such as 512M or 2G (a bare number is megabytes)";
+    unsigned shift = 20;
+    if (ok && *p) {
+      const char *u = strchr("KkMmGgTt", *p);
+      if (u && *p) {
+        shift = 10 * (unsigned)((u - "KkMmGgTt") / 2 + 1);
+        p++;
+        if (*p == 'B' || *p == 'b') p++;
+      } else {
+        ok = 0;
+      }
+    }
+    if (ok && v > (~0ULL >> shift)) ok = 0;
+    v <<= shift;
+    break;
+  }
+  case LIM_PIXELS:
+    want = "a number of pixels, or WxH such as 4096x4096";
+    if (ok && (*p == 'x' || *p == 'X')) {
+      p++;
+      if (parse_whole(&p, &h) || (h && v > ~0ULL / h)) ok = 0;
+      else v *= h;
+    }
+    break;
+  case LIM_COUNT:
+    want = "a whole number (0 for no limit)";
+    break;
+  case LIM_SPP:
+    break;
+  }
+  if (!ok || *p) {
+    snprintf(err, errlen, "%s needs %s, not '%s'", name, want, text);
+    return -1;
+  }
+  if (v == 0 && limits[i].zero_ok) {
+    *out = 0;
+    return 0;
+  }
+  if (v < limits[i].min || v > limits[i].max) {
+    char lo[32], hi[32];
+    if (limits[i].kind == LIM_SIZE) {
+      interp_format_size(lo, sizeof lo, limits[i].min);
+      interp_format_size(hi, sizeof hi, limits[i].max);
+    } else {
+      snprintf(lo, sizeof lo, "%llu", limits[i].min);
+      snprintf(hi, sizeof hi, "%llu", limits[i].max);
+    }
+    snprintf(err, errlen, "%s must be from %s to %s%s, not '%s'", name, lo, hi,
+             limits[i].zero_ok ? " (or 0 for no limit)" : "", text);
+    return -1;
+  }
+  *out = v;
+  return 0;
+}
+
+/* The most max-stack may be: the thread's stack, less a quarter kept for
+   what runs below the checks (scene compilation, the C library). */
+static size_t stack_cap(Interp *I) {
+  size_t cap = I->stack_reserved / 4 * 3;
+  return cap > I->stack_limit ? cap : I->stack_limit;
+}
+
+int interp_set_limit(Interp *I, const char *name, const char *text,
+                     char *err, size_t errlen) {
+  unsigned long long v;
+  if (interp_limit_parse(name, text, &v, err, errlen)) return -1;
+  switch (limit_index(name)) {
+  case 0:
+    if (v > stack_cap(I)) {
+      char cap[32];
+      interp_format_size(cap, sizeof cap, stack_cap(I));
+      snprintf(err, errlen, "max-stack can be at most %s here (the stack "
+               "reserved at start-up); start qcs with --max-stack SIZE for "
+               "more", cap);
+      return -1;
+    }
+    I->stack_limit = (size_t)v;
+    break;
+  case 1: I->max_steps = v; break;
+  case 2: I->max_list = v; break;
+  case 3: I->max_memory = (size_t)v; break;
+  case 4: I->max_pixels = v; break;
+  case 5: I->max_spp = (int)v; break;
+  }
+  return 0;
+}
+
+void interp_list_limits(Interp *I, FILE *out) {
+  for (size_t i = 0; i < NLIMITS; i++) {
+    unsigned long long v = 0;
+    switch (i) {
+    case 0: v = I->stack_limit; break;
+    case 1: v = I->max_steps; break;
+    case 2: v = I->max_list; break;
+    case 3: v = I->max_memory; break;
+    case 4: v = I->max_pixels; break;
+    case 5: v = (unsigned long long)I->max_spp; break;
+    }
+    char buf[40];
+    if (v == 0) snprintf(buf, sizeof buf, "none");
+    else if (limits[i].kind == LIM_SIZE) interp_format_size(buf, sizeof buf, v);
+    else snprintf(buf, sizeof buf, "%llu", v);
+    fprintf(out, "%-11s %-12s %s\n", limits[i].name, buf, limits[i].what);
+  }
+}
+
+const char *interp_version(void) { return QCS_VERSION; }

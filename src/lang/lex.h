@@ -1,0 +1,55 @@
+/* lex.h: source text to tokens.
+ *
+ * The whole text is tokenised at once into an array (the parser looks ahead
+ * freely and the layout rule needs each token's column and whether it
+ * starts a line). Token texts point into the source, which the caller keeps
+ * alive; the token array is allocated in the GC heap. Lexical errors
+ * (unterminated string or comment, stray bytes, NUL, out-of-range numbers)
+ * are raised with qcs_error at their position. */
+#ifndef QCS_LEX_H
+#define QCS_LEX_H
+
+#include "lang/error.h"
+
+#define TOKENS(X)                                                      \
+  X(EOF, "end of input") X(NUM, "number") X(STR, "string")             \
+  X(NAME, "name") X(CNAME, "capitalised name") X(WILD, "'_'")          \
+  X(LPAREN, "'('") X(RPAREN, "')'") X(LBRACK, "'['") X(RBRACK, "']'")  \
+  X(COMMA, "','") X(SEMI, "';'") X(LAMBDA, "'\\'")                     \
+  X(BACKSLASH2, "'\\\\'") X(ARROW, "'->'") X(LARROW, "'<-'")           \
+  X(EQUALS, "'='") X(BAR, "'|'") X(COLONCOLON, "'::'")                 \
+  X(DOTDOT, "'..'") X(COLON, "':'") X(BANG, "'!'")                     \
+  X(SYNONYM, "':=='")                                                  \
+  X(PLUS, "'+'") X(MINUS, "'-'") X(STAR, "'*'") X(SLASH, "'/'")        \
+  X(CARET, "'^'") X(APPEND, "'++'") X(EQ, "'=='") X(NE, "'<>'")        \
+  X(LT, "'<'") X(LE, "'<='") X(GT, "'>'") X(GE, "'>='")                \
+  X(AND, "'&&'") X(OR, "'||'") X(INDEX, "'!!'") X(COMPOSE, "'.'")      \
+  X(WHERE, "'where'") X(LET, "'let'") X(IN, "'in'") X(IF, "'if'")      \
+  X(THEN, "'then'") X(ELSE, "'else'") X(TRUE, "'True'")                \
+  X(FALSE, "'False'") X(KAND, "'and'") X(KOR, "'or'")                  \
+  X(CASE, "'case'") X(OF, "'of'")                                     \
+  X(VSEP, "end of definition") X(VEND, "end of block")
+
+typedef enum {
+#define X(name, text) T_##name,
+  TOKENS(X)
+#undef X
+  T_COUNT
+} TokKind;
+
+typedef struct Token {
+  TokKind kind;
+  Pos pos;
+  int bol;           /* first token on its line */
+  const char *start; /* into the source text */
+  int len;
+  double num;        /* T_NUM */
+  const char *str;   /* T_STR: the decoded string (NUL-terminated) */
+} Token;
+
+/* Tokenise src->text. Returns the array, ending with a T_EOF token. */
+Token *lex_all(const Src *src, int *ntokens);
+
+/* "'('", "name", ... for error messages. */
+const char *tok_kind_name(TokKind k);
+#endif

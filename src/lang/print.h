@@ -1,0 +1,23 @@
+/* print.h: values printed in the language's own syntax, so that what the
+ * REPL shows can be typed back: Reals in the shortest decimal that reads
+ * back to the same double, tuples, lists, strings with escapes, and
+ * constructor trees as applications with parentheses where needed. */
+#ifndef QCS_PRINT_H
+#define QCS_PRINT_H
+
+#include <stdio.h>
+
+#include "lang/value.h"
+
+/* Print v, forcing it completely (an infinite list prints until
+   interrupted). */
+void print_value(Interp *I, FILE *out, Value *v);
+/* The printed form as a GC string. */
+const char *show_value(Interp *I, Value *v);
+/* Print v without forcing anything: thunks show as "...", and lists and
+   trees are cut after a few elements or `depth` levels. */
+void print_brief(FILE *out, Value *v, int depth);
+/* The shortest decimal form of x that reads back as x ("0.1", "1e-12",
+   "3"); buf needs 32 bytes. */
+void format_real(char *buf, double x);
+#endif

@@ -1,0 +1,168 @@
+/* value.c: value constructors, symbols and environments. */
+#include "lang/value.h"
+
+#include <gc.h>
+#include <string.h>
+
+atomic_int qcs_interrupted;
+
+static size_t hash(const char *s, int len) {
+  size_t h = 1469598103934665603u;
+  for (int i = 0; i < len; i++) h = (h ^ (unsigned char)s[i]) * 1099511628211u;
+  return h;
+}
+
+Sym *sym_intern(Interp *I, const char *name, int len) {
+  if (I->nsyms * 2 >= I->symcap) {
+    size_t cap = I->symcap ? I->symcap * 2 : 1024;
+    Sym **tab = GC_MALLOC(sizeof(Sym *) * cap);
+    for (size_t i = 0; i < I->symcap; i++)
+      for (Sym *s = I->symtab[i], *nx; s; s = nx) {
+        nx = s->next;
+        size_t h = hash(s->name, (int)strlen(s->name)) & (cap - 1);
+        s->next = tab[h];
+        tab[h] = s;
+      }
+    I->symtab = tab;
+    I->symcap = cap;
+  }
+  size_t h = hash(name, len) & (I->symcap - 1);
+  for (Sym *s = I->symtab[h]; s; s = s->next)
+    if ((int)strlen(s->name) == len && !memcmp(s->name, name, (size_t)len))
+      return s;
+  Sym *s = GC_MALLOC(sizeof *s);
+  char *n = GC_MALLOC_ATOMIC((size_t)len + 1);
+  memcpy(n, name, (size_t)len);
+  n[len] = 0;
+  s->name = n;
+  s->con_arity = -1;
+  s->next = I->symtab[h];
+  I->symtab[h] = s;
+  I->nsyms++;
+  return s;
+}
+
+static void *cell_batch;  /* GC_malloc_many's list, linked by GC_NEXT */
+
+Value *val_cell(void) {
+  if (!cell_batch) {
+    cell_batch = GC_malloc_many(sizeof(Value));
+    if (!cell_batch) return GC_MALLOC(sizeof(Value));  /* out of memory: */
+  }                                                    /* GC's own handler */
+  Value *v = cell_batch;
+  cell_batch = GC_NEXT(cell_batch);
+  GC_NEXT(v) = NULL;
+  return v;
+}
+
+static Value *alloc(VKind k) {
+  Value *v = val_cell();
+  v->kind = (unsigned char)k;
+  return v;
+}
+
+Value *val_num(double x) {
+  Value *v = alloc(V_NUM);
+  v->u.num = x;
+  return v;
+}
+
+Value *val_bool(Interp *I, int b) { return b ? I->v_true : I->v_false; }
+
+Value *val_str(const char *s) {
+  Value *v = alloc(V_STR);
+  v->u.str = s;
+  return v;
+}
+
+Value **val_array(int n) {
+  return GC_MALLOC(sizeof(Value *) * (size_t)(n > 0 ? n : 1));
+}
+
+Value *val_tuple(int n, Value **items) {
+  Value *v = alloc(V_TUPLE);
+  v->u.tup.n = n;
+  v->u.tup.items = items;
+  return v;
+}
+
+Value *val_tuple3(double x, double y, double z) {
+  Value **it = val_array(3);
+  it[0] = val_num(x);
+  it[1] = val_num(y);
+  it[2] = val_num(z);
+  return val_tuple(3, it);
+}
+
+Value *val_cons(Value *head, Value *tail) {
+  Value *v = alloc(V_CONS);
+  v->u.cons.head = head;
+  v->u.cons.tail = tail;
+  return v;
+}
+
+Value *val_nil(Interp *I) { return I->v_nil; }
+
+Value *val_con(Sym *con, int n, Value **args) {
+  Value *v = alloc(V_CON);
+  v->u.con.con = con;
+  v->u.con.n = n;
+  v->u.con.args = args;
+  return v;
+}
+
+Value *val_builtin(const Builtin *b) {
+  Value *v = alloc(V_FUNC);
+  v->u.fn.kind = F_BUILTIN;
+  v->u.fn.arity = b->arity;
+  v->u.fn.u.bi = b;
+  return v;
+}
+
+Value *val_foreign(void *ptr, const char *tag) {
+  Value *v = alloc(V_FOREIGN);
+  v->u.foreign.ptr = ptr;
+  v->u.foreign.tag = tag;
+  return v;
+}
+
+/* The frame and its first arrays are one block (most frames never grow). */
+Env *env_new(Env *up, int cap) {
+  if (cap < 1) cap = 1;
+  Env *e = GC_MALLOC(sizeof *e + (sizeof(Sym *) + sizeof(Value *)) * (size_t)cap);
+  e->up = up;
+  e->cap = cap;
+  e->names = (Sym **)(e + 1);
+  e->vals = (Value **)(e->names + cap);
+  return e;
+}
+
+void env_bind(Env *env, Sym *name, Value *v) {
+  if (env->n == env->cap) {
+    int cap = env->cap * 2;
+    Sym **names = GC_MALLOC(sizeof(Sym *) * (size_t)cap);
+    Value **vals = GC_MALLOC(sizeof(Value *) * (size_t)cap);
+    memcpy(names, env->names, sizeof(Sym *) * (size_t)env->n);
+    memcpy(vals, env->vals, sizeof(Value *) * (size_t)env->n);
+    env->names = names;
+    env->vals = vals;
+    env->cap = cap;
+  }
+  env->names[env->n] = name;
+  env->vals[env->n] = v;
+  env->n++;
+}
+
+const char *val_describe(Value *v) {
+  switch (v->kind) {
+  case V_NUM: return "a Real";
+  case V_BOOL: return "a Bool";
+  case V_STR: return "a String";
+  case V_TUPLE: return v->u.tup.n == 3 ? "a 3-tuple" : "a tuple";
+  case V_NIL: case V_CONS: return "a list";
+  case V_CON: return "a constructor value";
+  case V_FUNC: case V_PAP: return "a function";
+  case V_FOREIGN: return v->u.foreign.tag;
+  default: return "an unevaluated value";
+  }
+}

@@ -1,0 +1,165 @@
+/* value.h: the runtime values of qcs and the interpreter's state.
+ *
+ * Values are lazy: a field of a tuple, list or constructor, an argument,
+ * a binding, may be a thunk (an expression with its environment) until
+ * something forces it. Forcing overwrites the thunk in place with its
+ * weak-head normal form, so each thunk runs at most once (call by need).
+ * All values live in the Boehm GC heap: no ownership to track, cycles
+ * (a list defined in terms of itself) are fine. */
+#ifndef QCS_VALUE_H
+#define QCS_VALUE_H
+
+#include <signal.h>
+#include <stdatomic.h>
+#include <stddef.h>
+
+#include "lang/ast.h"
+
+typedef struct Value Value;
+typedef struct Env Env;
+typedef struct Interp Interp;
+typedef struct Builtin Builtin;
+
+/* An interned name. Global bindings hang off the symbol itself. */
+struct Sym {
+  const char *name;
+  Sym *next;           /* hash chain */
+  Value *global;       /* top-level value, or NULL */
+  Value *prelude_value;/* its value as the prelude defined it: what the
+                          prelude's own code sees, whatever users define */
+  Def *def;            /* its definition (for :browse), or NULL */
+  int con_arity;       /* >= 0: a constructor of this arity; -1: not one */
+  Sym *con_type;       /* the type a constructor belongs to */
+  Value *con_value;    /* the constructor as a value */
+  int user;            /* defined outside the prelude */
+  int overridden;      /* fixed by --set: later definitions are ignored */
+  const char *sig;     /* type signature text */
+  Pos def_pos;         /* where it was defined (for "already defined") */
+  const char *def_file;/* which run defined it */
+};
+
+typedef enum {
+  V_NUM, V_BOOL, V_STR, V_TUPLE, V_NIL, V_CONS, V_CON,
+  V_FUNC, V_PAP, V_THUNK, V_APTHUNK, V_PATSEL, V_BLACKHOLE, V_FOREIGN
+} VKind;
+
+typedef enum { F_DEF, F_BUILTIN, F_CON } FnKind;
+
+typedef Value *(*BuiltinFn)(Interp *I, Value **args, Pos pos);
+
+struct Builtin {
+  const char *name;
+  int arity;
+  BuiltinFn fn;
+  const char *doc;
+};
+
+struct Value {
+  unsigned char kind;
+  union {
+    double num;
+    int b;
+    const char *str;
+    struct { int n; Value **items; } tup;
+    struct { Value *head, *tail; } cons;
+    struct { Sym *con; int n; Value **args; const Pos *pos; } con; /* pos: where it was built, or NULL */
+    struct {
+      FnKind kind;
+      int arity;
+      union { Def *def; const Builtin *bi; Sym *con; } u;
+      Env *env;
+    } fn;
+    struct { Value *fn; int n; Value **args; } pap; /* V_PAP, V_APTHUNK */
+    struct { Expr *e; Env *env; } thunk;
+    struct { Pat *pat; Sym *var; Value *whole; } patsel;
+    struct { void *ptr; const char *tag; } foreign;
+  } u;
+};
+
+/* A new, zeroed Value cell from the collected heap. Cells come in batches
+   from GC_malloc_many, which costs far less per cell than GC_MALLOC; the
+   batch waits in a static list (a root the collector scans), so Values
+   must be allocated by one thread at a time, the interpreter's. */
+Value *val_cell(void);
+
+/* A frame of local bindings; `up` is the enclosing scope. */
+struct Env {
+  Env *up;
+  int n, cap;
+  Sym **names;
+  Value **vals;
+};
+
+/* One entry of the call trace shown with runtime errors. */
+typedef struct TraceEntry {
+  const char *name;
+  Pos pos;
+} TraceEntry;
+
+/* A thunk being forced, with its contents, to restore after an error. */
+typedef struct Forcing {
+  Value *v;
+  Value saved;
+} Forcing;
+
+#define TRACE_MAX 4096
+
+struct Interp {
+  Sym **symtab;
+  size_t symcap, nsyms;
+  /* Resource limits (see interp_set_limit); 0 means no limit where a
+     limit may be switched off. */
+  char *stack_base;          /* for the recursion-depth check */
+  size_t stack_limit;        /* max-stack: bytes of C stack evaluation and
+                                parsing may use */
+  size_t stack_reserved;     /* the stack the thread has (max-stack's cap) */
+  unsigned long long steps;  /* evaluation steps of the current item */
+  unsigned long long max_steps; /* max-steps, per top-level expression */
+  size_t max_memory;         /* max-memory: bytes of values allowed */
+  unsigned memcheck;         /* steps since the memory was last checked */
+  unsigned long long max_list; /* max-list: elements of one list */
+  unsigned long long max_pixels; /* max-pixels: of one rendered image */
+  int max_spp;               /* max-spp: samples per pixel of a render */
+  Pos item_pos;              /* the top-level item being run, for errors
+                                found where no position is at hand */
+  TraceEntry trace[TRACE_MAX];
+  int ntrace;                /* entries in use (may exceed TRACE_MAX) */
+  Forcing *forcing;
+  int nforcing, capforcing;
+  void *host;                /* state of the layer that installed its
+                                built-ins (bind/): opaque here */
+  Pos warned[64];            /* warnings already given (said once each) */
+  int nwarned;
+  const char *run_name;      /* the file currently being run */
+  const Src *prelude_src;    /* the prelude's source, for its own scope */
+  int loading_prelude;
+  Value *v_true, *v_false, *v_nil;
+  /* Shared symbols the evaluator looks for. */
+  Sym *s_otherwise;
+};
+
+/* Set by SIGINT (or another thread) to stop the running evaluation and
+   any render it started: lock-free, so a signal handler may store to it,
+   and read by render workers without a race. */
+extern atomic_int qcs_interrupted;
+
+Sym *sym_intern(Interp *I, const char *name, int len);
+
+Value *val_num(double x);
+Value *val_bool(Interp *I, int b);
+Value *val_str(const char *s);
+Value *val_tuple(int n, Value **items);
+Value *val_tuple3(double x, double y, double z);
+Value *val_cons(Value *head, Value *tail);
+Value *val_nil(Interp *I);
+Value *val_con(Sym *con, int n, Value **args);
+Value *val_builtin(const Builtin *b);
+Value *val_foreign(void *ptr, const char *tag);
+Value **val_array(int n);
+
+Env *env_new(Env *up, int cap);
+void env_bind(Env *env, Sym *name, Value *v);
+
+/* "a number", "a list", "constructor Sum", ... for error messages. */
+const char *val_describe(Value *v);
+#endif

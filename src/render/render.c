@@ -1,0 +1,907 @@
+/* render.c: the ray tracer. See render.h. */
+#include "render/render.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "core/bounds.h"
+#include "scene/ray.h"
+
+#define TILE 16
+
+/* ---- boxes ---- */
+
+typedef struct Box {
+  double lo[3], hi[3];
+} Box;
+
+static Box box_empty(void) {
+  return (Box){{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+}
+static Box box_all(void) {
+  return (Box){{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
+}
+static int box_is_empty(const Box *b) {
+  return b->lo[0] > b->hi[0] || b->lo[1] > b->hi[1] || b->lo[2] > b->hi[2];
+}
+static int box_bounded(const Box *b) {
+  for (int i = 0; i < 3; i++)
+    if (!isfinite(b->lo[i]) || !isfinite(b->hi[i])) return box_is_empty(b);
+  return 1;
+}
+static Box box_union(Box a, Box b) {
+  for (int i = 0; i < 3; i++) {
+    a.lo[i] = fmin(a.lo[i], b.lo[i]);
+    a.hi[i] = fmax(a.hi[i], b.hi[i]);
+  }
+  return a;
+}
+static Box box_inter(Box a, Box b) {
+  for (int i = 0; i < 3; i++) {
+    a.lo[i] = fmax(a.lo[i], b.lo[i]);
+    a.hi[i] = fmin(a.hi[i], b.hi[i]);
+  }
+  return a;
+}
+
+/* A convex set n.x <= d over a list of planes, or a box. */
+typedef struct Shape {
+  int convex;
+  int n, cap;
+  double (*pl)[4];
+  Box box;
+} Shape;
+
+static void shape_free(Shape *s) { free(s->pl); }
+
+static int shape_add(Shape *s, const double n[3], double d) {
+  if (s->n == s->cap) {
+    int cap = s->cap ? 2 * s->cap : 8;
+    double(*pl)[4] = realloc(s->pl, sizeof *pl * (size_t)cap);
+    if (!pl) return -1;
+    s->pl = pl;
+    s->cap = cap;
+  }
+  s->pl[s->n][0] = n[0];
+  s->pl[s->n][1] = n[1];
+  s->pl[s->n][2] = n[2];
+  s->pl[s->n][3] = d;
+  s->n++;
+  return 0;
+}
+
+static void cross3(const double a[3], const double b[3], double c[3]) {
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+static double dot3(const double a[3], const double b[3]) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The box of the convex set {x : n_j . x <= d_j} (unit normals). It is
+   bounded iff its recession cone {u : n_j . u <= 0} is {0}; the cone's
+   extreme rays lie along cross products of pairs of normals, and a set
+   whose normals span less than 3 dimensions is unbounded. If bounded, the
+   box is that of the vertices (triples of planes), widened a little. */
+static Box convex_box(const Shape *s) {
+  int n = s->n;
+  if (n < 4) return box_all(); /* fewer than 4 halfspaces never enclose */
+  int rank3 = 0;
+  for (int j = 0; j < n; j++)
+    for (int k = j + 1; k < n; k++) {
+      double u[3];
+      cross3(s->pl[j], s->pl[k], u);
+      double len = sqrt(dot3(u, u));
+      if (len < 1e-12) continue;
+      for (int sgn = -1; sgn <= 1; sgn += 2) {
+        int ray = 1;
+        for (int i = 0; i < n && ray; i++)
+          if (sgn * dot3(s->pl[i], u) / len > 1e-12) ray = 0;
+        if (ray) return box_all();
+      }
+      for (int i = 0; i < n && !rank3; i++)
+        if (fabs(dot3(s->pl[i], u)) / len > 1e-9) rank3 = 1;
+    }
+  if (!rank3) return box_all();
+  Box b = box_empty();
+  double scale = 1;
+  for (int i = 0; i < n; i++) scale = fmax(scale, fabs(s->pl[i][3]));
+  for (int a = 0; a < n; a++)
+    for (int c = a + 1; c < n; c++)
+      for (int e = c + 1; e < n; e++) {
+        const double *p = s->pl[a], *q = s->pl[c], *r = s->pl[e];
+        double qr[3], rp[3], pq[3];
+        cross3(q, r, qr);
+        cross3(r, p, rp);
+        cross3(p, q, pq);
+        double det = dot3(p, qr);
+        if (fabs(det) < 1e-12) continue;
+        double v[3];
+        for (int i = 0; i < 3; i++)
+          v[i] = (p[3] * qr[i] + q[3] * rp[i] + r[3] * pq[i]) / det;
+        int inside = 1;
+        for (int i = 0; i < n && inside; i++)
+          if (dot3(s->pl[i], v) > s->pl[i][3] + 1e-9 * scale) inside = 0;
+        if (!inside) continue;
+        for (int i = 0; i < 3; i++) {
+          b.lo[i] = fmin(b.lo[i], v[i]);
+          b.hi[i] = fmax(b.hi[i], v[i]);
+        }
+      }
+  if (box_is_empty(&b)) return b;
+  for (int i = 0; i < 3; i++) {
+    double pad = 1e-9 * (scale + fabs(b.lo[i]) + fabs(b.hi[i]));
+    b.lo[i] -= pad;
+    b.hi[i] += pad;
+  }
+  return b;
+}
+
+static Box shape_box(Shape *s) { return s->convex ? convex_box(s) : s->box; }
+
+/* Combine two shapes by a set operation ('u', 'i', 'd' for a - b). */
+static void shape_combine(Shape *a, Shape *b, int op) {
+  if (op == 'i' && a->convex && b->convex) {
+    for (int i = 0; i < b->n; i++) shape_add(a, b->pl[i], b->pl[i][3]);
+    shape_free(b);
+    return;
+  }
+  Box ba = shape_box(a), bb = shape_box(b);
+  shape_free(a);
+  shape_free(b);
+  memset(a, 0, sizeof *a);
+  a->box = op == 'u' ? box_union(ba, bb) : op == 'i' ? box_inter(ba, bb) : ba;
+}
+
+static void shape_plane(Shape *s, const double n[3], double d) {
+  memset(s, 0, sizeof *s);
+  s->convex = 1;
+  shape_add(s, n, d);
+}
+
+static void shape_box_only(Shape *s, Box b) {
+  memset(s, 0, sizeof *s);
+  s->box = b;
+}
+
+/* The box of a sharp CSG tape (an outer bound). */
+static Box csg_box(const csg_tape *t) {
+  Shape stack[CSG_STACK_MAX + 2];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const csg_instr *in = &t->code[i];
+    switch (in->op) {
+    case CSG_PLANE:
+      shape_plane(&stack[sp++], t->planes[in->arg].n, t->planes[in->arg].d);
+      break;
+    case CSG_EMPTY: shape_box_only(&stack[sp++], box_empty()); break;
+    case CSG_ALL: shape_box_only(&stack[sp++], box_all()); break;
+    default: {
+      Shape y = stack[--sp];
+      Shape *x = &stack[sp - 1];
+      if (in->op == CSG_RDIFF) { /* y - x */
+        Shape tmp = *x;
+        *x = y;
+        shape_combine(x, &tmp, 'd');
+      } else {
+        shape_combine(x, &y, in->op == CSG_UNION ? 'u' : in->op == CSG_INTER ? 'i' : 'd');
+      }
+    }
+    }
+  }
+  if (sp != 1) return box_all();
+  Box b = shape_box(&stack[0]);
+  shape_free(&stack[0]);
+  return b;
+}
+
+static void node_shape(const Scene *s, int node, Shape *out) {
+  const ScNode *n = &s->nodes[node];
+  switch (n->kind) {
+  case SC_HALFSPACE:
+    shape_plane(out, n->n, n->d);
+    return;
+  case SC_ROUNDED:
+    shape_box_only(out, csg_box(n->outer));
+    return;
+  case SC_SOFT: {
+    Box b;
+    if (!soft_bounds(n->soft, b.lo, b.hi)) b = box_empty();
+    shape_box_only(out, b);
+    return;
+  }
+  case SC_EMPTY: shape_box_only(out, box_empty()); return;
+  case SC_ALL: shape_box_only(out, box_all()); return;
+  default: {
+    Shape b;
+    node_shape(s, n->a, out);
+    node_shape(s, n->b, &b);
+    shape_combine(out, &b, n->kind == SC_UNION ? 'u' : n->kind == SC_INTER ? 'i' : 'd');
+  }
+  }
+}
+
+int render_node_box(const Scene *s, int node, double lo[3], double hi[3]) {
+  Shape sh;
+  node_shape(s, node, &sh);
+  Box b = shape_box(&sh);
+  shape_free(&sh);
+  memcpy(lo, b.lo, sizeof b.lo);
+  memcpy(hi, b.hi, sizeof b.hi);
+  return box_bounded(&b);
+}
+
+/* ---- primitives and the BVH ---- */
+
+typedef struct Prim {
+  int node;
+  Box box;
+  int bounded;
+  double colour[3];
+} Prim;
+
+typedef struct BvhNode {
+  Box box;
+  int left, right;   /* children, or -1 */
+  int first, count;  /* prims of a leaf */
+} BvhNode;
+
+typedef struct Tracer {
+  const Scene *s;
+  const RenderSettings *rs;
+  Prim *prims;
+  int nprims, capprims;
+  int *bounded, nbounded;     /* prim indices in BVH order */
+  int *unbounded, nunbounded;
+  BvhNode *bvh;
+  int nbvh;
+  double eye[3], fwd[3], right[3], upv[3];
+  double coord_scale;       /* the largest |coordinate| of the eye and bounds */
+  double lights[RENDER_MAX_LIGHTS][3];
+  double intensity[RENDER_MAX_LIGHTS];
+  int nlights;
+  double eps;                 /* shadow-ray offset */
+  Image *im;
+  int tiles_x, tiles_y, ntiles;
+  atomic_int next_tile;
+  atomic_int done_tiles;
+  atomic_int *cancel;
+  pthread_mutex_t lock;
+  double start, last_progress;
+  int progressed;             /* the progress callback was called */
+  RenderReport *rep;
+  int grid;                   /* n of the n x n samples */
+  int failed;
+} Tracer;
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int add_prim(Tracer *T, int node, const double *colour) {
+  if (T->nprims == T->capprims) {
+    int cap = T->capprims ? 2 * T->capprims : 16;
+    Prim *p = realloc(T->prims, sizeof *p * (size_t)cap);
+    if (!p) return -1;
+    T->prims = p;
+    T->capprims = cap;
+  }
+  Prim *p = &T->prims[T->nprims++];
+  memset(p, 0, sizeof *p);
+  p->node = node;
+  const ScNode *n = &T->s->nodes[node];
+  if (n->has_colour) colour = n->colour;
+  if (colour) {
+    memcpy(p->colour, colour, sizeof p->colour);
+  } else {
+    /* An unbounded halfspace is the floor of the conventions. */
+    const double *c = n->kind == SC_HALFSPACE ? T->rs->floor_colour
+                                              : T->rs->object_colour;
+    memcpy(p->colour, c, sizeof p->colour);
+  }
+  Shape sh;
+  node_shape(T->s, node, &sh);
+  p->box = shape_box(&sh);
+  shape_free(&sh);
+  p->bounded = box_bounded(&p->box);
+  return 0;
+}
+
+/* The top-level union, flattened into primitives; colours are inherited. */
+static int collect_prims(Tracer *T, int node, const double *colour) {
+  const ScNode *n = &T->s->nodes[node];
+  if (n->has_colour) colour = n->colour;
+  if (n->kind == SC_UNION)
+    return collect_prims(T, n->a, colour) || collect_prims(T, n->b, colour);
+  if (n->kind == SC_EMPTY) return 0;
+  return add_prim(T, node, colour);
+}
+
+static int build_bvh(Tracer *T, int first, int count) {
+  int idx = T->nbvh++;
+  BvhNode *b = &T->bvh[idx];
+  b->left = b->right = -1;
+  b->box = box_empty();
+  for (int i = first; i < first + count; i++)
+    b->box = box_union(b->box, T->prims[T->bounded[i]].box);
+  if (count <= 2) {
+    b->first = first;
+    b->count = count;
+    return idx;
+  }
+  /* Median split along the widest spread of centres. */
+  double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int i = first; i < first + count; i++)
+    for (int k = 0; k < 3; k++) {
+      const Box *pb = &T->prims[T->bounded[i]].box;
+      double c = 0.5 * (pb->lo[k] + pb->hi[k]);
+      clo[k] = fmin(clo[k], c);
+      chi[k] = fmax(chi[k], c);
+    }
+  int axis = 0;
+  for (int k = 1; k < 3; k++)
+    if (chi[k] - clo[k] > chi[axis] - clo[axis]) axis = k;
+  /* Insertion-free selection: sort this range by centre on the axis. */
+  for (int i = first + 1; i < first + count; i++) {
+    int v = T->bounded[i], j = i - 1;
+    const Box *vb = &T->prims[v].box;
+    double cv = vb->lo[axis] + vb->hi[axis];
+    while (j >= first) {
+      const Box *jb = &T->prims[T->bounded[j]].box;
+      if (jb->lo[axis] + jb->hi[axis] <= cv) break;
+      T->bounded[j + 1] = T->bounded[j];
+      j--;
+    }
+    T->bounded[j + 1] = v;
+  }
+  int half = count / 2;
+  int l = build_bvh(T, first, half);
+  int r = build_bvh(T, first + half, count - half);
+  T->bvh[idx].left = l;
+  T->bvh[idx].right = r;
+  T->bvh[idx].count = 0;
+  return idx;
+}
+
+/* Slab test: the part of [t0, t1] inside the box. */
+static int box_hit(const Box *b, const double o[3], const double inv[3],
+                   double t0, double t1, double *enter) {
+  for (int k = 0; k < 3; k++) {
+    double a = (b->lo[k] - o[k]) * inv[k];
+    double c = (b->hi[k] - o[k]) * inv[k];
+    if (isnan(a) || isnan(c)) { /* parallel and on a slab plane */
+      if (o[k] < b->lo[k] || o[k] > b->hi[k]) return 0;
+      continue;
+    }
+    if (a > c) {
+      double tmp = a;
+      a = c;
+      c = tmp;
+    }
+    if (a > t0) t0 = a;
+    if (c < t1) t1 = c;
+    if (t0 > t1) return 0;
+  }
+  *enter = t0;
+  return 1;
+}
+
+/* ---- hits ---- */
+
+typedef struct Hit {
+  double t;
+  int prim;
+  int id, flip;   /* the surface: scene node and orientation */
+  int has_grad;   /* a rounded primitive's hit: grad is its density */
+  double grad[3]; /* gradient there, from the root search */
+} Hit;
+
+/* The first surface crossing of one primitive in (t0, t1); with any != 0
+   (a shadow ray) a rounded primitive may report any t in (t0, t1] when
+   there is a crossing, and none when there is none. */
+static int prim_hit(const Tracer *T, int pi, const double o[3],
+                    const double d[3], double t0, double t1, RayCtx *c,
+                    Hit *h, int any) {
+  const Scene *s = T->s;
+  int node = T->prims[pi].node;
+  const ScNode *n = &s->nodes[node];
+  switch (n->kind) {
+  case SC_HALFSPACE: {
+    double nd = dot3(n->n, d);
+    if (nd == 0) return 0;
+    double t = (n->d - dot3(n->n, o)) / nd;
+    if (!(t > t0 && t < t1)) return 0;
+    h->t = t;
+    h->id = node;
+    h->flip = 0;
+    h->has_grad = 0;
+    break;
+  }
+  case SC_ROUNDED: {
+    lg_root roots[8];
+    double tol = ray_dist_tol(c, o, d);
+    long unsplit = c->stats.lg.overflows;
+    int nr = lg_first_bounded(n->tape, n->outer, n->inner, o, d, t0, t1, tol,
+                              roots, 8, &c->stats.lg, any,
+                              any ? NULL : h->grad);
+    if (c->stats.lg.overflows != unsplit && c->unresolved_node < 0)
+      c->unresolved_node = node;
+    int k = 0;
+    while (k < nr && (roots[k].kind == LG_TOUCH || !(roots[k].t > t0))) k++;
+    if (k >= nr) return 0;
+    h->t = roots[k].t;
+    h->id = node;
+    h->flip = 0;
+    h->has_grad = !any;   /* the search stopped at roots[k] */
+    h->prim = pi;
+    return 1;
+  }
+  case SC_SOFT: {
+    double t;
+    int nr = soft_roots(n->soft, o, d, t0, t1, &t, 1, c->soft, &c->stats.soft);
+    if (nr < 1) return 0;
+    h->t = t;
+    h->id = node;
+    h->flip = 0;
+    h->has_grad = 0;
+    break;
+  }
+  default: {
+    csg_span *sp;
+    h->has_grad = 0;
+    ray_reset(c);
+    int ns = ray_spans(s, node, o, d, t0, t1, c, &sp);
+    int found = 0;
+    for (int i = 0; i < ns && !found; i++) {
+      if (sp[i].id0 >= 0 && sp[i].t0 > t0 && sp[i].t0 < t1) {
+        h->t = sp[i].t0;
+        h->id = sp[i].id0;
+        h->flip = sp[i].flip0;
+        found = 1;
+      } else if (sp[i].id1 >= 0 && sp[i].t1 > t0 && sp[i].t1 < t1) {
+        h->t = sp[i].t1;
+        h->id = sp[i].id1;
+        h->flip = sp[i].flip1;
+        found = 1;
+      }
+    }
+    if (!found) return 0;
+  }
+  }
+  h->prim = pi;
+  return 1;
+}
+
+/* The nearest hit in (t0, t1); with any != 0, the first one found. */
+static int trace(const Tracer *T, const double o[3], const double d[3],
+                 double t0, double t1, RayCtx *c, Hit *best, int any) {
+  int found = 0;
+  for (int i = 0; i < T->nunbounded; i++) {
+    Hit h;
+    if (prim_hit(T, T->unbounded[i], o, d, t0, t1, c, &h, any)) {
+      *best = h;
+      t1 = h.t;
+      found = 1;
+      if (any) return 1;
+    }
+  }
+  if (!T->nbvh) return found;
+  double inv[3] = {1 / d[0], 1 / d[1], 1 / d[2]};
+  int stack[128], sp = 0;
+  stack[sp++] = 0;
+  while (sp) {
+    const BvhNode *b = &T->bvh[stack[--sp]];
+    double enter;
+    if (!box_hit(&b->box, o, inv, t0, t1, &enter)) continue;
+    if (b->count || b->left < 0) {
+      for (int i = b->first; i < b->first + b->count; i++) {
+        int pi = T->bounded[i];
+        double e2;
+        if (!box_hit(&T->prims[pi].box, o, inv, t0, t1, &e2)) continue;
+        Hit h;
+        if (prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
+          *best = h;
+          t1 = h.t;
+          found = 1;
+          if (any) return 1;
+        }
+      }
+      continue;
+    }
+    /* Visit the nearer child first. */
+    double el = INFINITY, er = INFINITY;
+    int hl = box_hit(&T->bvh[b->left].box, o, inv, t0, t1, &el);
+    int hr = box_hit(&T->bvh[b->right].box, o, inv, t0, t1, &er);
+    if (sp + 2 > 128) continue;
+    if (hl && hr) {
+      if (el < er) {
+        stack[sp++] = b->right;
+        stack[sp++] = b->left;
+      } else {
+        stack[sp++] = b->left;
+        stack[sp++] = b->right;
+      }
+    } else if (hl) {
+      stack[sp++] = b->left;
+    } else if (hr) {
+      stack[sp++] = b->right;
+    }
+  }
+  return found;
+}
+
+static long ray_work(const RayCtx *c) {
+  return c->stats.lg.segments + c->stats.lg.rf_steps + c->stats.soft.intervals;
+}
+
+typedef struct Worker {
+  Tracer *T;
+  RayCtx *c;
+  long primary, shadow, max_work;
+  long rounded_hits, rounded_hit_evals;
+} Worker;
+
+/* One camera sample: radiance, and for the AOVs the hit's distance and
+   normal. */
+static void shade_sample(Worker *W, const double o[3], const double d[3],
+                         double rgb[3], double *z, double nrm[3]) {
+  const Tracer *T = W->T;
+  RayCtx *c = W->c;
+  const RenderSettings *rs = T->rs;
+  Hit h;
+  long evals0 = c->stats.lg.evals;
+  W->primary++;
+  if (!trace(T, o, d, 0, INFINITY, c, &h, 0)) {
+    memcpy(rgb, rs->background, 3 * sizeof(double));
+    *z = INFINITY;
+    nrm[0] = nrm[1] = nrm[2] = 0;
+    return;
+  }
+  if (T->s->nodes[h.id].kind == SC_ROUNDED) {
+    W->rounded_hits++;
+    W->rounded_hit_evals += c->stats.lg.evals - evals0;
+  }
+  double p[3], n[3];
+  for (int i = 0; i < 3; i++) p[i] = o[i] + h.t * d[i];
+  if (h.has_grad) { /* outward is down the density gradient */
+    double g[3] = {-h.grad[0], -h.grad[1], -h.grad[2]};
+    ray_normal_grad(g, h.flip, n);
+  } else {
+    ray_normal(T->s, h.id, h.flip, p, n);
+  }
+  if (dot3(n, d) > 0)
+    for (int i = 0; i < 3; i++) n[i] = -n[i];
+  *z = h.t; /* d is unit length: t is the distance */
+  memcpy(nrm, n, sizeof n);
+  const double *col = T->prims[h.prim].colour;
+  for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
+  double scale = fmax(1.0, sqrt(dot3(p, p)));
+  double eps = T->eps * scale;
+  for (int l = 0; l < T->nlights; l++) {
+    double L[3];
+    for (int i = 0; i < 3; i++) L[i] = T->lights[l][i] - p[i];
+    double dist = sqrt(dot3(L, L));
+    if (!(dist > 0)) continue;
+    for (int i = 0; i < 3; i++) L[i] /= dist;
+    double ndl = dot3(n, L);
+    if (ndl <= 0) continue;
+    if (rs->shadows) {
+      double so[3];
+      for (int i = 0; i < 3; i++) so[i] = p[i] + eps * n[i];
+      Hit sh;
+      W->shadow++;
+      if (trace(T, so, L, 0, dist, c, &sh, 1)) continue;
+    }
+    double H[3] = {L[0] - d[0], L[1] - d[1], L[2] - d[2]};
+    double hl = sqrt(dot3(H, H));
+    double spec = 0;
+    if (hl > 0) {
+      double ndh = dot3(n, H) / hl;
+      if (ndh > 0) { /* 0.3 ndh^32 by five squarings */
+        double p2 = ndh * ndh, p4 = p2 * p2, p8 = p4 * p4, p16 = p8 * p8;
+        spec = 0.3 * p16 * p16;
+      }
+    }
+    double I = T->intensity[l];
+    for (int i = 0; i < 3; i++) rgb[i] += I * (col[i] * ndl + spec);
+  }
+}
+
+/* The camera ray through image position (px, py) (pixels, top left 0). */
+static void camera_ray(const Tracer *T, double px, double py, double d[3]) {
+  const RenderSettings *rs = T->rs;
+  double h = tan(rs->fov * M_PI / 360);
+  double aspect = (double)rs->width / rs->height;
+  double u = (2 * px / rs->width - 1) * h * aspect;
+  double v = (1 - 2 * py / rs->height) * h;
+  for (int i = 0; i < 3; i++) d[i] = T->fwd[i] + u * T->right[i] + v * T->upv[i];
+  double len = sqrt(dot3(d, d));
+  for (int i = 0; i < 3; i++) d[i] /= len;
+}
+
+static void progress(Tracer *T) {
+  if (!T->rs->progress) return;
+  double t = now();
+  int done = atomic_load(&T->done_tiles);
+  if (t - T->start < 0.5) return; /* start is set before the threads */
+  pthread_mutex_lock(&T->lock);   /* last_progress is shared */
+  if (t - T->last_progress >= 0.1) {
+    T->last_progress = t;
+    double frac = (double)done / T->ntiles;
+    double left = frac > 0 ? (t - T->start) * (1 - frac) / frac : 0;
+    T->rs->progress(T->rs->progress_ud, frac, left);
+    T->progressed = 1;
+  }
+  pthread_mutex_unlock(&T->lock);
+}
+
+static void render_tile(Worker *W, int tile) {
+  Tracer *T = W->T;
+  const RenderSettings *rs = T->rs;
+  Image *im = T->im;
+  int tx = tile % T->tiles_x, ty = tile / T->tiles_x;
+  int x0 = tx * TILE, y0 = ty * TILE;
+  int x1 = x0 + TILE < rs->width ? x0 + TILE : rs->width;
+  int y1 = y0 + TILE < rs->height ? y0 + TILE : rs->height;
+  int g = T->grid;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++) {
+      double sum[3] = {0, 0, 0}, zmin = INFINITY, nrm0[3] = {0, 0, 0};
+      long work0 = ray_work(W->c);
+      for (int sy = 0; sy < g; sy++)
+        for (int sx = 0; sx < g; sx++) {
+          double d[3], rgb[3], z, nrm[3];
+          camera_ray(T, x + (sx + 0.5) / g, y + (sy + 0.5) / g, d);
+          long w0 = ray_work(W->c);
+          shade_sample(W, T->eye, d, rgb, &z, nrm);
+          long w = ray_work(W->c) - w0;
+          if (w > W->max_work) W->max_work = w;
+          for (int i = 0; i < 3; i++) sum[i] += rgb[i];
+          if (sx == g / 2 && sy == g / 2) { /* AOVs from the central sample */
+            zmin = z;
+            memcpy(nrm0, nrm, sizeof nrm0);
+          }
+        }
+      size_t k = img_index(im, x, y);
+      for (int i = 0; i < 3; i++) im->rgba[4 * k + i] = (float)(sum[i] / (g * g));
+      im->rgba[4 * k + 3] = 1;
+      if (im->z) im->z[k] = (float)zmin;
+      if (im->n)
+        for (int i = 0; i < 3; i++) im->n[3 * k + i] = (float)nrm0[i];
+      if (im->cost) im->cost[k] = (float)(ray_work(W->c) - work0);
+    }
+}
+
+static void *worker_main(void *arg) {
+  Worker *W = arg;
+  Tracer *T = W->T;
+  for (;;) {
+    if (T->cancel && atomic_load_explicit(T->cancel, memory_order_relaxed)) break;
+    int tile = atomic_fetch_add(&T->next_tile, 1);
+    if (tile >= T->ntiles) break;
+    render_tile(W, tile);
+    atomic_fetch_add(&T->done_tiles, 1);
+    progress(T);
+  }
+  return NULL;
+}
+
+void render_defaults(RenderSettings *rs) {
+  memset(rs, 0, sizeof *rs);
+  rs->width = 600;
+  rs->height = 380;
+  rs->spp = 1;
+  rs->fov = 35;
+  rs->up[1] = 1;
+  rs->ambient = 0.15;
+  rs->background[0] = 0.55;
+  rs->background[1] = 0.65;
+  rs->background[2] = 0.85;
+  rs->object_colour[0] = 0.80;
+  rs->object_colour[1] = 0.78;
+  rs->object_colour[2] = 0.72;
+  rs->floor_colour[0] = rs->floor_colour[1] = rs->floor_colour[2] = 0.5;
+  rs->tol = 1e-9;
+  rs->shadows = 1;
+  rs->aovs = IMG_Z | IMG_N;
+  rs->progress = NULL;
+}
+
+static int setup_camera(Tracer *T, char *err, size_t errlen) {
+  const RenderSettings *rs = T->rs;
+  double eye[3], at[3];
+  Box all = box_empty();
+  for (int i = 0; i < T->nprims; i++)
+    if (T->prims[i].bounded) all = box_union(all, T->prims[i].box);
+  if (box_is_empty(&all)) all = (Box){{0, 0, 0}, {1, 1, 1}};
+  double c[3], R = 0;
+  for (int i = 0; i < 3; i++) {
+    c[i] = 0.5 * (all.lo[i] + all.hi[i]);
+    R += 0.25 * (all.hi[i] - all.lo[i]) * (all.hi[i] - all.lo[i]);
+  }
+  R = fmax(sqrt(R), 1e-9);
+  if (rs->camera_set) {
+    memcpy(eye, rs->eye, sizeof eye);
+    memcpy(at, rs->at, sizeof at);
+  } else {
+    /* Frame the bounds: look at their centre from the front, above and to
+       the right, far enough that the bounding sphere fits the view. */
+    double dir[3] = {0.45, 0.6, 1};
+    double len = sqrt(dot3(dir, dir));
+    double dist = R / sin(fmin(rs->fov, 120) * M_PI / 360) * 1.05;
+    for (int i = 0; i < 3; i++) {
+      at[i] = c[i];
+      eye[i] = c[i] + dir[i] / len * dist;
+    }
+  }
+  memcpy(T->eye, eye, sizeof eye);
+  /* Rounded roots are placed to ray_dist_tol: max(tol, RAY_TOL_FLOOR |o|)
+     along a ray from o: rays start at the eye or at a hit inside the bounds. */
+  T->coord_scale = 1;
+  for (int i = 0; i < 3; i++) {
+    T->coord_scale = fmax(T->coord_scale, fabs(eye[i]));
+    if (!box_is_empty(&all) && isfinite(all.lo[i]) && isfinite(all.hi[i]))
+      T->coord_scale = fmax(T->coord_scale, fmax(fabs(all.lo[i]), fabs(all.hi[i])));
+  }
+  for (int i = 0; i < 3; i++) T->fwd[i] = at[i] - eye[i];
+  double fl = sqrt(dot3(T->fwd, T->fwd));
+  if (!(fl > 0) || !isfinite(fl)) {
+    snprintf(err, errlen, "the camera's eye and at must differ");
+    return -1;
+  }
+  for (int i = 0; i < 3; i++) T->fwd[i] /= fl;
+  cross3(T->fwd, rs->up, T->right);
+  double rl = sqrt(dot3(T->right, T->right));
+  if (!(rl > 1e-12)) {
+    snprintf(err, errlen, "the camera's up direction is zero or parallel to its view");
+    return -1;
+  }
+  for (int i = 0; i < 3; i++) T->right[i] /= rl;
+  cross3(T->right, T->fwd, T->upv);
+  if (rs->nlights) {
+    T->nlights = rs->nlights;
+    memcpy(T->lights, rs->lights, sizeof T->lights);
+    memcpy(T->intensity, rs->light_intensity, sizeof T->intensity);
+  } else {
+    T->nlights = 1;
+    T->intensity[0] = 1;
+    if (rs->camera_set) { /* the conventional light */
+      T->lights[0][0] = -3;
+      T->lights[0][1] = 8;
+      T->lights[0][2] = 6;
+    } else { /* the same direction, scaled to the scene */
+      double l[3] = {-3, 8, 6};
+      for (int i = 0; i < 3; i++) T->lights[0][i] = c[i] + l[i] * R;
+    }
+  }
+  T->eps = 1e-7 * fmax(R, 1e-3);
+  return 0;
+}
+
+Image *render_scene(const Scene *s, const RenderSettings *rs,
+                    RenderReport *rep, atomic_int *cancel,
+                    char *err, size_t errlen) {
+  memset(rep, 0, sizeof *rep);
+  if (img_check_size(rs->width, rs->height, err, errlen)) return NULL;
+  int grid = (int)lround(sqrt((double)rs->spp));
+  if (rs->spp < 1 || grid * grid != rs->spp || grid > 16) {
+    snprintf(err, errlen, "samples per pixel must be a square number from 1 "
+             "to 256 (1, 4, 9, ...: an n x n stratified grid), not %d",
+             rs->spp);
+    return NULL;
+  }
+  if (!(rs->fov > 0 && rs->fov < 180)) {
+    snprintf(err, errlen, "the field of view must be between 0 and 180 "
+             "degrees, not %g", rs->fov);
+    return NULL;
+  }
+  Tracer T;
+  memset(&T, 0, sizeof T);
+  T.s = s;
+  T.rs = rs;
+  T.rep = rep;
+  T.grid = grid;
+  T.cancel = cancel;
+  pthread_mutex_init(&T.lock, NULL);
+  Image *im = NULL;
+  Worker *workers = NULL;
+  pthread_t *threads = NULL;
+  int nthreads = rs->threads > 0 ? rs->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+  if (nthreads < 1) nthreads = 1;
+  if (nthreads > 256) nthreads = 256;
+  if (collect_prims(&T, s->root, NULL)) goto oom;
+  T.bounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
+  T.unbounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
+  T.bvh = malloc(sizeof(BvhNode) * (size_t)(2 * T.nprims + 1));
+  if (!T.bounded || !T.unbounded || !T.bvh) goto oom;
+  for (int i = 0; i < T.nprims; i++) {
+    if (box_is_empty(&T.prims[i].box)) continue; /* nothing to see */
+    if (T.prims[i].bounded) T.bounded[T.nbounded++] = i;
+    else T.unbounded[T.nunbounded++] = i;
+  }
+  if (T.nbounded) build_bvh(&T, 0, T.nbounded);
+  if (setup_camera(&T, err, errlen)) goto fail;
+  im = img_new(rs->width, rs->height, rs->aovs);
+  if (!im) goto oom;
+  T.im = im;
+  T.tiles_x = (rs->width + TILE - 1) / TILE;
+  T.tiles_y = (rs->height + TILE - 1) / TILE;
+  T.ntiles = T.tiles_x * T.tiles_y;
+  atomic_init(&T.next_tile, 0);
+  atomic_init(&T.done_tiles, 0);
+  T.start = now();
+  workers = calloc((size_t)nthreads, sizeof *workers);
+  threads = calloc((size_t)nthreads, sizeof *threads);
+  if (!workers || !threads) goto oom;
+  for (int i = 0; i < nthreads; i++) {
+    workers[i].T = &T;
+    workers[i].c = ray_ctx_new(s, rs->tol);
+    if (!workers[i].c) goto oom;
+  }
+  int started = 0;
+  for (int i = 1; i < nthreads; i++)
+    if (pthread_create(&threads[i], NULL, worker_main, &workers[i]) == 0)
+      started = i;
+    else
+      break;
+  worker_main(&workers[0]);
+  for (int i = 1; i <= started; i++) pthread_join(threads[i], NULL);
+  if (rs->progress && T.progressed) rs->progress(rs->progress_ud, 1, 0);
+  rep->seconds = now() - T.start;
+  rep->width = rs->width;
+  rep->height = rs->height;
+  rep->spp = rs->spp;
+  rep->threads = started + 1;
+  rep->tol = rs->tol;
+  rep->unresolved = 0;
+  rep->unresolved_node = -1;
+  rep->coord_scale = T.coord_scale;
+  rep->tol_in_force = fmax(rs->tol, RAY_TOL_FLOOR * T.coord_scale);
+  rep->prims = T.nprims;
+  rep->bounded_prims = T.nbounded;
+  for (int i = 0; i < nthreads; i++) {
+    Worker *W = &workers[i];
+    rep->primary += W->primary;
+    rep->shadow += W->shadow;
+    rep->evals += W->c->stats.lg.evals;
+    rep->segments += W->c->stats.lg.segments;
+    rep->steps += W->c->stats.lg.rf_steps;
+    rep->soft_solves += W->c->stats.soft.poly.solves;
+    if (W->max_work > rep->max_ray_work) rep->max_ray_work = W->max_work;
+    rep->rounded_hits += W->rounded_hits;
+    rep->rounded_hit_evals += W->rounded_hit_evals;
+    rep->unresolved += W->c->stats.lg.overflows;
+    if (rep->unresolved_node < 0) rep->unresolved_node = W->c->unresolved_node;
+  }
+  if (cancel && atomic_load(cancel) && atomic_load(&T.done_tiles) < T.ntiles) {
+    rep->interrupted = 1;
+    snprintf(err, errlen, "render interrupted");
+    img_free(im);
+    im = NULL;
+  }
+  goto done;
+oom:
+  snprintf(err, errlen, "out of memory for the render");
+fail:
+  img_free(im);
+  im = NULL;
+done:
+  if (workers)
+    for (int i = 0; i < nthreads; i++) ray_ctx_free(workers[i].c);
+  free(workers);
+  free(threads);
+  free(T.prims);
+  free(T.bounded);
+  free(T.unbounded);
+  free(T.bvh);
+  pthread_mutex_destroy(&T.lock);
+  return im;
+}

@@ -1,0 +1,265 @@
+/* ray.c: span lists of a ray through a compiled scene. See ray.h. */
+#include "scene/ray.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CHUNK_SPANS 4096
+#define MAX_LEAF_ROOTS 256
+
+struct SpanChunk {
+  SpanChunk *next;
+  csg_span spans[CHUNK_SPANS];
+};
+
+RayCtx *ray_ctx_new(const Scene *s, double tol) {
+  RayCtx *c = calloc(1, sizeof *c);
+  if (!c) return NULL;
+  c->tol = tol;
+  c->unresolved_node = -1;
+  if (s->max_keys) {
+    c->soft = soft_scratch_new(s->max_keys);
+    if (!c->soft) {
+      free(c);
+      return NULL;
+    }
+  }
+  return c;
+}
+
+void ray_ctx_free(RayCtx *c) {
+  if (!c) return;
+  for (SpanChunk *k = c->chunks, *nx; k; k = nx) {
+    nx = k->next;
+    free(k);
+  }
+  if (c->soft) soft_scratch_free(c->soft);
+  free(c);
+}
+
+void ray_reset(RayCtx *c) {
+  c->cur = c->chunks;
+  c->used = 0;
+}
+
+/* n contiguous spans from the arena (n <= CHUNK_SPANS), or NULL. */
+static csg_span *alloc_spans(RayCtx *c, int n) {
+  if (n > CHUNK_SPANS) return NULL;
+  if (!c->cur || c->used + (size_t)n > CHUNK_SPANS) {
+    SpanChunk *next = c->cur ? c->cur->next : c->chunks;
+    if (!next) {
+      next = malloc(sizeof *next);
+      if (!next) return NULL;
+      next->next = NULL;
+      if (c->cur) c->cur->next = next;
+      else c->chunks = next;
+    }
+    c->cur = next;
+    c->used = 0;
+  }
+  csg_span *s = c->cur->spans + c->used;
+  c->used += (size_t)n;
+  return s;
+}
+
+static void set_span(csg_span *s, double t0, double t1, int id0, int id1,
+                     int flip0, int flip1) {
+  s->t0 = t0;
+  s->t1 = t1;
+  s->id0 = id0;
+  s->id1 = id1;
+  s->flip0 = (unsigned char)flip0;
+  s->flip1 = (unsigned char)flip1;
+}
+
+static int halfspace_spans(const ScNode *n, int id, const double o[3],
+                           const double d[3], double t0, double t1,
+                           csg_span *out) {
+  double no = n->n[0] * o[0] + n->n[1] * o[1] + n->n[2] * o[2];
+  double nd = n->n[0] * d[0] + n->n[1] * d[1] + n->n[2] * d[2];
+  if (nd == 0) { /* parallel: inside everywhere or nowhere */
+    if (no < n->d) {
+      set_span(out, t0, t1, -1, -1, 0, 0);
+      return 1;
+    }
+    return 0;
+  }
+  double t = (n->d - no) / nd;
+  if (nd > 0) { /* inside before t */
+    if (t <= t0) return 0;
+    if (t < t1) set_span(out, t0, t, -1, id, 0, 0);
+    else set_span(out, t0, t1, -1, -1, 0, 0);
+  } else { /* inside after t */
+    if (t >= t1) return 0;
+    if (t > t0) set_span(out, t, t1, id, -1, 0, 0);
+    else set_span(out, t0, t1, -1, -1, 0, 0);
+  }
+  return 1;
+}
+
+/* Spans from ascending crossings that alternate in and out, starting
+   inside or not. Touches are skipped. */
+static int crossings_to_spans(const double *t, const int *kind, int nroots,
+                              int inside, int id, double t0, double t1,
+                              csg_span *out) {
+  int n = 0;
+  double start = t0;
+  int sid = -1;
+  for (int i = 0; i < nroots; i++) {
+    int enter = kind ? kind[i] == LG_ENTER : !inside;
+    if (kind && kind[i] == LG_TOUCH) continue;
+    if (enter && !inside) {
+      start = t[i];
+      sid = id;
+      inside = 1;
+    } else if (!enter && inside) {
+      if (t[i] > start) set_span(&out[n++], start, t[i], sid, id, 0, 0);
+      inside = 0;
+    }
+  }
+  if (inside && t1 > start) set_span(&out[n++], start, t1, sid, -1, 0, 0);
+  return n;
+}
+
+double ray_dist_tol(const RayCtx *c, const double o[3], const double d[3]) {
+  double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
+  return fmax(c->tol, RAY_TOL_FLOOR * scale) / len;
+}
+
+static int rounded_spans(const ScNode *n, int id, const double o[3],
+                         const double d[3], double t0, double t1, RayCtx *c,
+                         csg_span *out) {
+  lg_root roots[MAX_LEAF_ROOTS];
+  long unsplit = c->stats.lg.overflows;
+  int nr = lg_roots_bounded(n->tape, n->outer, n->inner, o, d, t0, t1,
+                            ray_dist_tol(c, o, d), roots, MAX_LEAF_ROOTS,
+                            &c->stats.lg, c->hook);
+  if (c->stats.lg.overflows != unsplit) c->unresolved_node = id;
+  if (nr < 0) return -1;
+  double p[3] = {o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2]};
+  int inside = isfinite(t0) ? dt_density(n->tape, p) > 0.5 : 0;
+  double t[MAX_LEAF_ROOTS];
+  int kind[MAX_LEAF_ROOTS];
+  for (int i = 0; i < nr; i++) {
+    t[i] = roots[i].t;
+    kind[i] = roots[i].kind;
+  }
+  /* The state at t0 follows from the first real crossing when there is
+     one (robust at a surface exactly at t0). */
+  for (int i = 0; i < nr; i++)
+    if (kind[i] != LG_TOUCH) {
+      inside = kind[i] == LG_EXIT;
+      break;
+    }
+  return crossings_to_spans(t, kind, nr, inside, id, t0, t1, out);
+}
+
+static int soft_spans(const ScNode *n, int id, const double o[3],
+                      const double d[3], double t0, double t1, RayCtx *c,
+                      csg_span *out) {
+  double t[MAX_LEAF_ROOTS];
+  int nr = soft_roots(n->soft, o, d, t0, t1, t, MAX_LEAF_ROOTS, c->soft,
+                      &c->stats.soft);
+  if (nr < 0) return -1;
+  /* The state before the first crossing, sampled halfway to it; a
+     crossing reported at t0 itself (the origin on the surface, or within
+     rounding of it) is dropped and the state after it sampled instead. */
+  double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  double near = 1e-12 * (1 + fabs(t0) * len) / len;
+  int skip = 0;
+  while (skip < nr && isfinite(t0) && t[skip] - t0 <= near) skip++;
+  double end = skip < nr ? t[skip] : (isfinite(t1) ? t1 : t0 + 1 / len);
+  double tm = isfinite(t0) ? 0.5 * (t0 + end) : end - 1 / len;
+  double p[3] = {o[0] + tm * d[0], o[1] + tm * d[1], o[2] + tm * d[2]};
+  int inside = soft_field(n->soft, p) > soft_magic(n->soft);
+  return crossings_to_spans(t + skip, NULL, nr - skip, inside, id, t0, t1,
+                            out);
+}
+
+int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
+              double t0, double t1, RayCtx *c, csg_span **spans) {
+  const ScNode *n = &s->nodes[node];
+  csg_span *out;
+  int cnt;
+  switch (n->kind) {
+  case SC_HALFSPACE:
+    out = alloc_spans(c, 1);
+    if (!out) return -1;
+    cnt = halfspace_spans(n, node, o, d, t0, t1, out);
+    break;
+  case SC_ROUNDED:
+    out = alloc_spans(c, MAX_LEAF_ROOTS / 2 + 1);
+    if (!out) return -1;
+    cnt = rounded_spans(n, node, o, d, t0, t1, c, out);
+    break;
+  case SC_SOFT:
+    out = alloc_spans(c, MAX_LEAF_ROOTS / 2 + 1);
+    if (!out) return -1;
+    cnt = soft_spans(n, node, o, d, t0, t1, c, out);
+    break;
+  case SC_EMPTY:
+    out = NULL;
+    cnt = 0;
+    break;
+  case SC_ALL:
+    out = alloc_spans(c, 1);
+    if (!out) return -1;
+    set_span(out, t0, t1, -1, -1, 0, 0);
+    cnt = 1;
+    break;
+  default: {
+    csg_span *a, *b;
+    int na = ray_spans(s, n->a, o, d, t0, t1, c, &a);
+    if (na < 0) return -1;
+    /* An empty left side of an intersection or difference decides. */
+    if (na == 0 && n->kind != SC_UNION) {
+      *spans = NULL;
+      return 0;
+    }
+    int nb = ray_spans(s, n->b, o, d, t0, t1, c, &b);
+    if (nb < 0) return -1;
+    out = alloc_spans(c, na + nb + 1);
+    if (!out) return -1;
+    if (n->kind == SC_UNION) cnt = csg_spans_union(a, na, b, nb, out);
+    else if (n->kind == SC_INTER) cnt = csg_spans_inter(a, na, b, nb, out);
+    else cnt = csg_spans_diff(a, na, b, nb, out);
+  }
+  }
+  *spans = out;
+  return cnt;
+}
+
+void ray_normal_grad(const double g[3], int flip, double n[3]) {
+  double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+  if (!(len > 0) || !isfinite(len)) {
+    n[0] = n[1] = 0;
+    n[2] = 1;
+    return;
+  }
+  double sgn = flip ? -1 : 1;
+  for (int i = 0; i < 3; i++) n[i] = sgn * g[i] / len;
+}
+
+void ray_normal(const Scene *s, int id, int flip, const double p[3],
+                double n[3]) {
+  const ScNode *nd = &s->nodes[id];
+  double g[3] = {0, 0, 0};
+  switch (nd->kind) {
+  case SC_HALFSPACE:
+    memcpy(g, nd->n, sizeof g);
+    break;
+  case SC_ROUNDED: /* outward is down the density gradient */
+    dt_density_grad(nd->tape, p, g);
+    for (int i = 0; i < 3; i++) g[i] = -g[i];
+    break;
+  case SC_SOFT:
+    soft_field_grad(nd->soft, p, g);
+    for (int i = 0; i < 3; i++) g[i] = -g[i];
+    break;
+  default:
+    break;
+  }
+  ray_normal_grad(g, flip, n);
+}

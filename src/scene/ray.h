@@ -1,0 +1,71 @@
+/* ray.h: a ray against a compiled scene: the inside spans of every node,
+ * combined by Roth's span lists so that CSG finds the right crossing even
+ * when it is not the nearest (Wyvill and Trotman's "all intersections").
+ *
+ * Leaves: a halfspace gives one span; a rounded density tree gives the
+ * crossings of the guaranteed root search (lg.h) restricted to its outer
+ * minus inner bound; a soft object gives its polynomial crossings
+ * (soft.h). Each span end names the node whose surface it is (id) and
+ * whether the solid lies on the far side (flip, for subtracted objects),
+ * so the caller can compute the normal there.
+ *
+ * Memory: a RayCtx is per thread (ray_ctx_new / ray_ctx_free); it owns
+ * the span arena and the soft-object scratch and holds the counters. A
+ * query allocates nothing once the arena has grown to the scene's needs. */
+#ifndef QCS_RAY_H
+#define QCS_RAY_H
+
+#include "core/csg.h"
+#include "core/lg.h"
+#include "scene/scene.h"
+#include "core/soft.h"
+
+typedef struct RayStats {
+  long rays;
+  lg_stats lg;         /* density evaluations, segments, regula falsi */
+  soft_stats soft;     /* keys, intervals, polynomial solves */
+  long max_steps;      /* the most root-finder steps one ray took */
+} RayStats;
+
+typedef struct SpanChunk SpanChunk;
+
+typedef struct RayCtx {
+  soft_scratch *soft;
+  SpanChunk *chunks;   /* the span arena */
+  SpanChunk *cur;
+  size_t used;
+  double tol;          /* root tolerance as a distance (scene units) */
+  RayStats stats;
+  const lg_hook *hook; /* optional trace of every root search segment */
+  int unresolved_node; /* a rounded node whose search left segments unsplit
+                          (lg_stats.overflows grew), or -1 */
+} RayCtx;
+
+/* The finest root tolerance doubles allow at coordinates of size scale
+   (>= 1): RAY_TOL_FLOOR * scale. */
+#define RAY_TOL_FLOOR 4e-16
+
+/* The root tolerance in units of t along o + t d: c->tol as a distance,
+   never below what doubles resolve at the ray's origin. */
+double ray_dist_tol(const RayCtx *c, const double o[3], const double d[3]);
+
+RayCtx *ray_ctx_new(const Scene *s, double tol);
+void ray_ctx_free(RayCtx *c);
+
+/* The inside spans of node along o + t d, t in [t0, t1] (t1 may be
+   infinite), sorted and disjoint, in an array owned by the ctx and valid
+   until ray_reset. Returns the count; *spans points at them. */
+int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
+              double t0, double t1, RayCtx *c, csg_span **spans);
+
+/* Forget the spans of earlier queries (call once per ray). */
+void ray_reset(RayCtx *c);
+
+/* The outward unit normal of node's surface at p (the span end's id). */
+void ray_normal(const Scene *s, int id, int flip, const double p[3],
+                double n[3]);
+
+/* The unit normal along g, an outward (unnormalised) normal, as
+   ray_normal makes it; negated with flip; (0, 0, 1) if g is 0. */
+void ray_normal_grad(const double g[3], int flip, double n[3]);
+#endif

@@ -1,0 +1,94 @@
+/* tradeoff.h: what accuracy costs (issue 6, "Error against run time").
+ *
+ * 1. The root tolerance ladder (qcs tradeoff FILE, :tradeoff FILE): the
+ *    scene a script renders (or its `scene`) is captured through the
+ *    render hook of render_lang.h instead of being written, rendered at
+ *    tolerances 1e-2, 1e-3, ..., 1e-12 (best wall time of a few runs each)
+ *    and every rung is compared with the tightest: hit-distance error from
+ *    the Z plane, RMS RGB error, pixels whose hit changed. A table goes to
+ *    a stream and a log-log SVG plot of error against time to a file.
+ *
+ * 2. The approximation itself (qcs convolution): the quasi-convolutional
+ *    density (Lobb, eq. 1 approximated by products and sums of smoothed
+ *    halfspaces) against the true convolution of the sharp polyhedron with
+ *    the spherical filter: the fraction of the ball of radius r about p
+ *    that lies inside. The true value is computed by integrating exact
+ *    chord lengths (sharp CSG span lists, csg.h) over the disc of parallel
+ *    chords through the ball with nested adaptive Gauss-Kronrod (7-15)
+ *    quadrature; see conv_fraction for its accuracy.
+ *
+ * Memory: nothing here keeps a caller's pointer after returning. The
+ * scene and settings handed to the capture hook are borrowed for the
+ * call; images made for the ladder are freed before returning; rows are
+ * written to caller-provided arrays. */
+#ifndef QCS_TRADEOFF_H
+#define QCS_TRADEOFF_H
+
+#include <stdio.h>
+
+#include "core/csg.h"
+#include "core/density.h"
+
+/* Kept light (no value.h) so that repl.c can include it. */
+struct Scene;
+struct RenderSettings;
+struct Interp;
+
+#define TRADEOFF_RUNGS 11 /* 1e-2 ... 1e-12 */
+
+typedef struct TradeoffOptions {
+  int width, height;    /* 0: the script's size */
+  int threads;          /* 0: the script's (all cores) */
+  int repeats;          /* timing runs per rung, best kept (0: 3) */
+  const char *svg;      /* plot file (NULL: tradeoff.svg; "" for none) */
+  FILE *out;            /* the table (NULL: stdout) */
+} TradeoffOptions;
+
+typedef struct TradeoffRow {
+  double tol;
+  double seconds;       /* best wall time of the repeats */
+  long evals, steps;    /* density evaluations, root-search steps */
+  double max_dz, rms_dz;/* hit-distance error against the reference, over
+                           pixels hit on the same surface in both */
+  double rms_rgb;       /* RMS RGB difference, all pixels */
+  long changed;         /* hit vs miss, or a different surface */
+  long both;            /* pixels hit on the same surface in both */
+} TradeoffRow;
+
+/* Render s at every rung and fill rows[TRADEOFF_RUNGS] (the last row, the
+   reference, has zero errors). Prints the table to o->out and writes the
+   plot. 0, or -1 with a message in err. */
+int tradeoff_scene(const struct Scene *s, const struct RenderSettings *base,
+                   const TradeoffOptions *o, const char *name,
+                   TradeoffRow *rows, char *err, size_t errlen);
+
+/* Run the script path in I with its first render captured (or, if it
+   renders nothing, its `scene`) and report its tradeoff. The other
+   renders of the script are skipped. 0 on success, 1 on an error (already
+   reported on stderr). */
+int tradeoff_file(struct Interp *I, const char *path, const TradeoffOptions *o);
+
+/* Write the plot of rows to path (log-log: error against time). */
+int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
+                 const char *path, char *err, size_t errlen);
+
+/* ---- the true convolution ---- */
+
+/* The sharp polyhedron a density tape describes (Product = Intersection,
+   Sum and Union = Union, Difference = set difference). Caller frees with
+   csg_tape_free. NULL on failure. */
+csg_tape *conv_sharp_of(const dt_tape *t);
+
+/* The fraction of the ball of radius r about p inside the sharp object t,
+   to an absolute accuracy of about tol (the quadrature's error estimate;
+   verified against exact values by the tests). *evals, if not NULL, is
+   increased by the number of chords cast. */
+double conv_fraction(const csg_tape *t, const double p[3], double r,
+                     double tol, long *evals);
+
+/* The convolution report: canonical objects and radii, the distance
+   between the 0.5-isosurfaces of both fields along sample rays, and the
+   time per evaluation of each, as a Markdown table on out. 0 on success. */
+int conv_report(FILE *out);
+
+#endif
