@@ -1,6 +1,6 @@
 #!/bin/bash
 # bench/run.sh -- `make bench`: time qcs on the canonical scenes, side by side
-# with POV-Ray 3.7 (../shared/peers/povray/), and check issue 7's targets.
+# with POV-Ray 3.7 (bench/povray/), and check issue 7's targets.
 #
 # Usage: bench/run.sh [-n REPS] [-p POV_REPS] [-c] [SCENE ...]
 #   SCENE     figure12 figure12-sharp figure13 figure15a figure15a-sharp
@@ -10,7 +10,7 @@
 #   -p REPS   POV-Ray renders per scene (default 3; 0 = skip POV-Ray)
 #   -c        also run the callgrind counts (bench/callgrind.sh)
 # Environment: QCS (default ./qcs), THREADS (2), SIZE (600x380),
-#   OUT (/tmp/qcs-bench), POVDIR (../shared/peers/povray from the repo),
+#   OUT (/tmp/qcs-bench), POVDIR (bench/povray),
 #   POV_ISO (1: render POV-Ray's exact Wyvill isosurface soft-cloud-iso-100
 #   once, for the "exact field at N = 100" target; 0 to skip).
 # Writes bench/results.csv and bench/README.md (the summary of this run).
@@ -36,7 +36,7 @@ QCS=${QCS:-./qcs}
 THREADS=${THREADS:-2}
 SIZE=${SIZE:-600x380}
 OUT=${OUT:-/tmp/qcs-bench}
-POVDIR=${POVDIR:-$ROOT/../shared/peers/povray}
+POVDIR=${POVDIR:-$ROOT/bench/povray}
 POV_ISO=${POV_ISO:-1}
 W=${SIZE%x*}; H=${SIZE#*x}
 CLOUD_NS="10 100 1000 10000 100000"
@@ -299,10 +299,10 @@ fi
 
 \`make bench\` builds qcs, installs what is missing (the build's packages and
 the Debian package \`povray\`, as root), then runs \`bench/run.sh\`: every
-canonical scene of \`../shared/scenes/README.md\` at $SIZE, rendered
+canonical scene (\`examples/\`) at $SIZE, rendered
 $REPS times by qcs (\`--threads $THREADS\`) and, interleaved with those runs so that both
-see the same load, $POV_REPS times by POV-Ray from \`../shared/peers/povray/\`
-(\`+W$W +H$H -A -D +WT2 File_Gamma=sRGB\`, as its \`run.sh\`). Times are medians
+see the same load, $POV_REPS times by POV-Ray from \`bench/povray/\`
+(\`+W$W +H$H -A -D +WT2 File_Gamma=sRGB\`, as the POV-Ray project peers time them). Times are medians
 of whole-process wall time. The machines are shared and noisy: the
 **ratios** measured side by side are the figures to report.
 

@@ -4,7 +4,7 @@
  *   renderWith [Size 600 380, Camera eye at fov, Light pos, ...] "out.exr" scene
  *
  * The settings are constructors declared in the prelude (:: Setting);
- * anything not given takes the conventions of shared/scenes/README.md,
+ * anything not given takes the conventions of the canonical scenes,
  * and with no Camera the scene's bounds are framed automatically. Options
  * of the command line (-o, --size, --spp, --threads) override a script's
  * own settings. The render's report goes to stderr; the value of a render

@@ -59,7 +59,7 @@ typedef struct RenderSettings {
   void *progress_ud;
 } RenderSettings;
 
-/* The conventions of shared/scenes/README.md: 600 x 380, 1 sample, one
+/* The conventions of the canonical scenes: 600 x 380, 1 sample, one
    white light, ambient 0.15, sky (0.55, 0.65, 0.85), object colour
    (0.80, 0.78, 0.72), floor (0.5, 0.5, 0.5), shadows, Z and N planes. */
 void render_defaults(RenderSettings *rs);

@@ -1,5 +1,5 @@
 /* bench_soft.c: rays per second of soft_roots on the soft-cloud N scene
- * (shared/scenes/README.md): N keys, R = 0.6, w = 1, magic 0.5, on the R2
+ * (examples/soft-cloud.qcs): N keys, R = 0.6, w = 1, magic 0.5, on the R2
  * sequence; 600 x 380 primary rays from the scene's camera, plus one shadow
  * ray towards the light from every hit. Not part of the test suite (it is
  * not named test_*). Build and run:
