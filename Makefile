@@ -5,6 +5,7 @@
 #   make test       install what is missing, build, run every test suite
 #   make sanitize   the test suite under ASan + UBSan (clang)
 #   make fuzz       the libFuzzer targets, FUZZ_TIME seconds each
+#   make difftest   N random programs (default 5000) through qcs and Hugs 98, SEED=
 #   make install    PREFIX=/usr/local DESTDIR=
 #
 # System packages are installed through apt-get when make runs as root and
@@ -18,7 +19,7 @@ OPT     ?= -O2
 
 # Debian packages the build and the tests need.
 DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
-            libmpfr-dev libgmp-dev tmux clang
+            libmpfr-dev libgmp-dev tmux clang hugs
 PC_PKGS  := readline bdw-gc libpng OpenEXR
 
 WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
@@ -55,7 +56,7 @@ UNIT_BINS += $(STAB_SRCS:tests/stability/%.c=$(BUILD)/tests/%)
 # The fuzz targets of fuzz/ as plain programs that replay fuzz/corpus/.
 REPLAY_BINS := $(patsubst %,$(BUILD)/fuzz/replay_%,parse eval probes image)
 
-.PHONY: all units deps demo test check sanitize install uninstall clean bench update-references gallery layers
+.PHONY: all units deps demo test check sanitize install uninstall clean bench update-references gallery layers difftest
 
 BIN ?= qcs
 
@@ -130,6 +131,15 @@ test: deps
 	@sh tests/run-all.sh
 
 check: test
+
+# difftest: N random programs of the subset qcs shares with Haskell 98,
+# run through qcs and Hugs (runhugs) and compared value by value (issue
+# 20); every disagreement prints both programs. make test runs 300.
+N    ?= 5000
+SEED ?= 1
+difftest: deps
+	@$(MAKE) -s $(BIN)
+	@python3 tests/difftest/difftest.py -n $(N) --seed $(SEED) --qcs ./$(BIN)
 
 # Every rendering example to gallery/NAME.png and gallery/NAME.exr.
 gallery: deps

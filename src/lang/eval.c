@@ -844,8 +844,14 @@ static Value *binop(Interp *I, Expr *e, Env *env) {
     return val_bool(I, !values_equal(I, eval(I, e->u.bin.a, env),
                                      eval(I, e->u.bin.b, env), pos));
   case T_LT: case T_LE: case T_GT: case T_GE: {
-    int c = compare(I, eval(I, e->u.bin.a, env), eval(I, e->u.bin.b, env), pos,
-                    op);
+    Value *a = force(I, eval(I, e->u.bin.a, env));
+    Value *b = force(I, eval(I, e->u.bin.b, env));
+    if (a->kind == V_NUM && b->kind == V_NUM) { /* IEEE: NaN is unordered */
+      double x = a->u.num, y = b->u.num;
+      return val_bool(I, op == T_LT ? x < y : op == T_LE ? x <= y
+                         : op == T_GT ? x > y : x >= y);
+    }
+    int c = compare(I, a, b, pos, op);
     int r = op == T_LT ? c < 0 : op == T_LE ? c <= 0 : op == T_GT ? c > 0 : c >= 0;
     return val_bool(I, r);
   }
@@ -870,10 +876,9 @@ static Value *bi_range_k(Interp *I, Value **args, Pos pos) {
   double x = from + k * step;
   if (args[2]) {
     double to = args[2]->u.num;
-    /* Whole-number ranges stop at `to` exactly ([10, 8 .. 1] ends at 2);
-       others allow half a step of rounding, as Haskell's Double ranges. */
-    int whole = from == floor(from) && step == floor(step) && to == floor(to);
-    double limit = whole ? to : to + step / 2;
+    /* Every range, whole numbers too, runs while not past to + step/2, as
+       Haskell's ranges of Doubles do ([1, 3 .. 8] ends at 9). */
+    double limit = to + step / 2;
     if (step > 0 ? x > limit : x < limit) return I->v_nil;
   }
   const Pos *rpos = args[4]->u.foreign.ptr;

@@ -23,6 +23,7 @@ typedef struct Parser {
 
 static Expr *expr(Parser *P);
 static Expr *app(Parser *P);
+static Expr *binary(Parser *P, int minprec);
 
 /* Deep nesting ((((... a million brackets, - - - ... 1, a : b : ...) is
    stopped under the max-stack limit, as deep recursion in evaluation is:
@@ -486,9 +487,27 @@ static Expr *finish_range(Parser *P, Expr *from, Expr *then, Pos pos,
   return e;
 }
 
+/* Whether the tokens [from, to) are one bracketed group, ( ... ) or
+   [ ... ] (a list in tail form is a cons node too). */
+static int bracketed(Parser *P, int from, int to) {
+  if (to - from < 2 ||
+      (P->toks[from].kind != T_LPAREN && P->toks[from].kind != T_LBRACK))
+    return 0;
+  int depth = 0;
+  for (int j = from; j < to; j++) {
+    TokKind k = P->toks[j].kind;
+    if (k == T_LPAREN || k == T_LBRACK) depth++;
+    else if (k == T_RPAREN || k == T_RBRACK) depth--;
+    if (depth == 0 && j < to - 1) return 0;
+  }
+  return 1;
+}
+
 /* list -> '[' ']' | '[' expr '..' [expr] ']' | '[' expr ',' expr '..' ...
          | '[' expr ('\\' | '|') quals ']' | '[' expr {',' expr} ']'
-   Inside brackets a final `a : rest` is Clean's tail syntax [x, y : rest]. */
+   Inside brackets a final unbracketed `a : rest` is Clean's tail syntax
+   [x, y : rest]; a bracketed one, [(a : rest)] or [[a : rest]], is an
+   element. */
 static Expr *list_expr(Parser *P) {
   Pos open = pos_here(P);
   next(P);
@@ -497,6 +516,7 @@ static Expr *list_expr(Parser *P) {
     Expr *e = mk(E_LIST, open);
     return e;
   }
+  int first_tok = P->i;
   Expr *first = expr(P);
   if (peek(P) == T_DOTDOT) return finish_range(P, first, NULL, open, open);
   if (peek(P) == T_BACKSLASH2 || peek(P) == T_BAR) {
@@ -505,9 +525,12 @@ static Expr *list_expr(Parser *P) {
   }
   Vec items = {0};
   vec_push(&items, first);
+  int last_start = first_tok, last_end = P->i;
   while (peek(P) == T_COMMA) {
     next(P);
+    last_start = P->i;
     Expr *x = expr(P);
+    last_end = P->i;
     if (items.n == 1 && peek(P) == T_DOTDOT)
       return finish_range(P, first, x, open, open);
     vec_push(&items, x);
@@ -515,7 +538,8 @@ static Expr *list_expr(Parser *P) {
   expect_close(P, T_RBRACK, open);
   Expr *tail = NULL;
   Expr *last = items.items[items.n - 1];
-  if (last->kind == E_BINOP && last->u.bin.op == T_COLON) {
+  if (last->kind == E_BINOP && last->u.bin.op == T_COLON &&
+      !bracketed(P, last_start, last_end)) {
     /* [a, b : rest] */
     items.items[items.n - 1] = last->u.bin.a;
     tail = last->u.bin.b;
@@ -828,21 +852,10 @@ static Expr *operand_body(Parser *P, int minprec) {
   }
   case T_MINUS: {
     next(P);
-    /* Unary minus binds like binary minus: -a*b is -(a*b), -a^2 is -(a^2). */
-    Expr *x = operand(P, 7);
-    int assoc;
-    while (is_binop(peek(P)) && prec(peek(P), &assoc) >= 7) {
-      TokKind op = peek(P);
-      int p = prec(op, &assoc);
-      Pos opos = pos_here(P);
-      next(P);
-      Expr *rhs = operand(P, assoc == 1 ? p : p + 1);
-      Expr *b = mk(E_BINOP, opos);
-      b->u.bin.op = op;
-      b->u.bin.a = x;
-      b->u.bin.b = rhs;
-      x = b;
-    }
+    /* Unary minus binds like binary minus (level 6): it takes the operators
+       of level 7 and above with it, parsed by their own precedence, so
+       -a*b is -(a*b), -a^2 is -(a^2) and -2*3^2 is -(2*(3^2)). */
+    Expr *x = binary(P, 7);
     if (x->kind == E_NUM && x->pos.line == pos.line) {
       x->u.num = -x->u.num;
       x->pos = pos;
