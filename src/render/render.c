@@ -49,7 +49,12 @@ static Box box_inter(Box a, Box b) {
   return a;
 }
 
-/* A convex set n.x <= d over a list of planes, or a box. */
+/* A convex set n.x <= d over a list of planes, or a box. An intersection
+   that would hold more than CONVEX_MAX_PLANES planes becomes the
+   intersection of the two boxes instead (still conservative): convex_box
+   costs the fourth power of the plane count, and a scene can intersect a
+   million halfspaces. */
+#define CONVEX_MAX_PLANES 64
 typedef struct Shape {
   int convex;
   int n, cap;
@@ -147,7 +152,8 @@ static Box shape_box(Shape *s) { return s->convex ? convex_box(s) : s->box; }
 
 /* Combine two shapes by a set operation ('u', 'i', 'd' for a - b). */
 static void shape_combine(Shape *a, Shape *b, int op) {
-  if (op == 'i' && a->convex && b->convex) {
+  if (op == 'i' && a->convex && b->convex &&
+      a->n + b->n <= CONVEX_MAX_PLANES) {
     for (int i = 0; i < b->n; i++) shape_add(a, b->pl[i], b->pl[i][3]);
     shape_free(b);
     return;
@@ -201,8 +207,8 @@ static Box csg_box(const csg_tape *t) {
   return b;
 }
 
-static void node_shape(const Scene *s, int node, Shape *out) {
-  const ScNode *n = &s->nodes[node];
+/* The shape of a leaf node (not a set operation). */
+static void leaf_shape(const ScNode *n, Shape *out) {
   switch (n->kind) {
   case SC_HALFSPACE:
     shape_plane(out, n->n, n->d);
@@ -216,20 +222,71 @@ static void node_shape(const Scene *s, int node, Shape *out) {
     shape_box_only(out, b);
     return;
   }
-  case SC_EMPTY: shape_box_only(out, box_empty()); return;
   case SC_ALL: shape_box_only(out, box_all()); return;
-  default: {
-    Shape b;
-    node_shape(s, n->a, out);
-    node_shape(s, n->b, &b);
-    shape_combine(out, &b, n->kind == SC_UNION ? 'u' : n->kind == SC_INTER ? 'i' : 'd');
+  default: shape_box_only(out, box_empty()); return; /* SC_EMPTY */
   }
+}
+
+static int is_op(ScKind k) { return k == SC_UNION || k == SC_INTER || k == SC_DIFF; }
+
+/* Grow a stack *p of *cap elements of size sz (a local array at first:
+   local) so that it holds at least need; 0, or -1 without memory. */
+static int grow_stack(void **p, int *cap, int need, size_t sz, void *local) {
+  if (need <= *cap) return 0;
+  int cap2 = *cap * 2 > need ? *cap * 2 : need;
+  void *q = *p == local ? malloc(sz * (size_t)cap2) : realloc(*p, sz * (size_t)cap2);
+  if (!q) return -1;
+  if (*p == local) memcpy(q, local, sz * (size_t)*cap);
+  *p = q;
+  *cap = cap2;
+  return 0;
+}
+
+/* The shape of node: its subtree's leaves combined children first, a then
+   b, on explicit stacks (the C stack stays flat however deep the tree).
+   0, or -1 when memory runs out (*out is then unbounded). */
+static int node_shape(const Scene *s, int node, Shape *out) {
+  if (!is_op(s->nodes[node].kind)) {
+    leaf_shape(&s->nodes[node], out);
+    return 0;
   }
+  enum { LOCAL = 32 };
+  struct Frame { int node, stage; } lf[LOCAL], *fr = lf;
+  Shape ls[LOCAL], *sh = ls;
+  int capf = LOCAL, caps = LOCAL, nf = 0, ns = 0, r = 0;
+  fr[nf++] = (struct Frame){node, 0};
+  while (nf) {
+    struct Frame *f = &fr[nf - 1];
+    const ScNode *n = &s->nodes[f->node];
+    if (!is_op(n->kind)) {
+      if (grow_stack((void **)&sh, &caps, ns + 1, sizeof *sh, ls)) goto oom;
+      leaf_shape(n, &sh[ns++]);
+      nf--;
+    } else if (f->stage < 2) {
+      int child = f->stage++ ? n->b : n->a;
+      if (grow_stack((void **)&fr, &capf, nf + 1, sizeof *fr, lf)) goto oom;
+      fr[nf++] = (struct Frame){child, 0};
+    } else {
+      Shape b = sh[--ns];
+      shape_combine(&sh[ns - 1], &b, n->kind == SC_UNION ? 'u' : n->kind == SC_INTER ? 'i' : 'd');
+      nf--;
+    }
+  }
+  *out = sh[0];
+  goto done;
+oom:
+  for (int i = 0; i < ns; i++) shape_free(&sh[i]);
+  shape_box_only(out, box_all());
+  r = -1;
+done:
+  if (fr != lf) free(fr);
+  if (sh != ls) free(sh);
+  return r;
 }
 
 int render_node_box(const Scene *s, int node, double lo[3], double hi[3]) {
   Shape sh;
-  node_shape(s, node, &sh);
+  node_shape(s, node, &sh); /* without memory: unbounded, still true */
   Box b = shape_box(&sh);
   shape_free(&sh);
   memcpy(lo, b.lo, sizeof b.lo);
@@ -275,9 +332,8 @@ typedef struct Tracer {
   pthread_mutex_t lock;
   double start, last_progress;
   int progressed;             /* the progress callback was called */
-  RenderReport *rep;
   int grid;                   /* n of the n x n samples */
-  int failed;
+  atomic_int oom;             /* a worker ran out of memory: all stop */
 } Tracer;
 
 static double now(void) {
@@ -308,21 +364,39 @@ static int add_prim(Tracer *T, int node, const double *colour) {
     memcpy(p->colour, c, sizeof p->colour);
   }
   Shape sh;
-  node_shape(T->s, node, &sh);
+  if (node_shape(T->s, node, &sh)) return -1;
   p->box = shape_box(&sh);
   shape_free(&sh);
   p->bounded = box_bounded(&p->box);
   return 0;
 }
 
-/* The top-level union, flattened into primitives; colours are inherited. */
-static int collect_prims(Tracer *T, int node, const double *colour) {
-  const ScNode *n = &T->s->nodes[node];
-  if (n->has_colour) colour = n->colour;
-  if (n->kind == SC_UNION)
-    return collect_prims(T, n->a, colour) || collect_prims(T, n->b, colour);
-  if (n->kind == SC_EMPTY) return 0;
-  return add_prim(T, node, colour);
+/* The top-level union, flattened into primitives, a before b; colours
+   are inherited. An explicit stack: a scene may be a union a million deep.
+   0, or -1 when memory runs out. */
+static int collect_prims(Tracer *T, int root) {
+  typedef struct { int node; const double *colour; } Item;
+  Item local[32], *st = local;
+  int cap = 32, n = 0, r = 0;
+  st[n++] = (Item){root, NULL};
+  while (n) {
+    Item it = st[--n];
+    const ScNode *nd = &T->s->nodes[it.node];
+    const double *colour = nd->has_colour ? nd->colour : it.colour;
+    if (nd->kind == SC_UNION) {
+      if (grow_stack((void **)&st, &cap, n + 2, sizeof *st, local)) {
+        r = -1;
+        break;
+      }
+      st[n++] = (Item){nd->b, colour};
+      st[n++] = (Item){nd->a, colour};
+    } else if (nd->kind != SC_EMPTY && add_prim(T, it.node, colour)) {
+      r = -1;
+      break;
+    }
+  }
+  if (st != local) free(st);
+  return r;
 }
 
 static int build_bvh(Tracer *T, int first, int count) {
@@ -434,6 +508,7 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
                               any ? NULL : h->grad);
     if (c->stats.lg.overflows != unsplit && c->unresolved_node < 0)
       c->unresolved_node = node;
+    if (nr < 0) c->failed = 1;
     int k = 0;
     while (k < nr && (roots[k].kind == LG_TOUCH || !(roots[k].t > t0))) k++;
     if (k >= nr) return 0;
@@ -447,6 +522,7 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
   case SC_SOFT: {
     double t;
     int nr = soft_roots(n->soft, o, d, t0, t1, &t, 1, c->soft, &c->stats.soft);
+    if (nr < 0) c->failed = 1;
     if (nr < 1) return 0;
     h->t = t;
     h->id = node;
@@ -685,9 +761,14 @@ static void *worker_main(void *arg) {
   Tracer *T = W->T;
   for (;;) {
     if (T->cancel && atomic_load_explicit(T->cancel, memory_order_relaxed)) break;
+    if (atomic_load_explicit(&T->oom, memory_order_relaxed)) break;
     int tile = atomic_fetch_add(&T->next_tile, 1);
     if (tile >= T->ntiles) break;
     render_tile(W, tile);
+    if (W->c->failed) { /* a query ran out of memory: the picture is wrong */
+      atomic_store(&T->oom, 1);
+      break;
+    }
     atomic_fetch_add(&T->done_tiles, 1);
     progress(T);
   }
@@ -807,7 +888,6 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   memset(&T, 0, sizeof T);
   T.s = s;
   T.rs = rs;
-  T.rep = rep;
   T.grid = grid;
   T.cancel = cancel;
   pthread_mutex_init(&T.lock, NULL);
@@ -817,7 +897,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   int nthreads = rs->threads > 0 ? rs->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
   if (nthreads < 1) nthreads = 1;
   if (nthreads > 256) nthreads = 256;
-  if (collect_prims(&T, s->root, NULL)) goto oom;
+  if (collect_prims(&T, s->root)) goto oom;
   T.bounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
   T.unbounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
   T.bvh = malloc(sizeof(BvhNode) * (size_t)(2 * T.nprims + 1));
@@ -837,6 +917,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   T.ntiles = T.tiles_x * T.tiles_y;
   atomic_init(&T.next_tile, 0);
   atomic_init(&T.done_tiles, 0);
+  atomic_init(&T.oom, 0);
   T.start = now();
   workers = calloc((size_t)nthreads, sizeof *workers);
   threads = calloc((size_t)nthreads, sizeof *threads);
@@ -881,6 +962,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
     rep->unresolved += W->c->stats.lg.overflows;
     if (rep->unresolved_node < 0) rep->unresolved_node = W->c->unresolved_node;
   }
+  if (atomic_load(&T.oom)) goto oom;
   if (cancel && atomic_load(cancel) && atomic_load(&T.done_tiles) < T.ntiles) {
     rep->interrupted = 1;
     snprintf(err, errlen, "render interrupted");

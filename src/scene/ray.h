@@ -29,14 +29,25 @@ typedef struct RayStats {
 
 typedef struct SpanChunk SpanChunk;
 
+/* A set operation waiting for its right side (ray.c's explicit stack). */
+typedef struct RayFrame {
+  int node;
+  int na;              /* the left side's span count, -1 until known */
+  csg_span *a;         /* the left side's spans */
+} RayFrame;
+
 typedef struct RayCtx {
   soft_scratch *soft;
   SpanChunk *chunks;   /* the span arena */
   SpanChunk *cur;
   size_t used;
   double tol;          /* root tolerance as a distance (scene units) */
+  RayFrame *frames;    /* ray_spans' stack, grown on demand */
+  size_t cap_frames;
   RayStats stats;
   const lg_hook *hook; /* optional trace of every root search segment */
+  int failed;          /* a query ran out of memory (sticky; ray_spans
+                          sets it, and so may the caller's own queries) */
   int unresolved_node; /* a rounded node whose search left segments unsplit
                           (lg_stats.overflows grew), or -1 */
 } RayCtx;
@@ -54,7 +65,9 @@ void ray_ctx_free(RayCtx *c);
 
 /* The inside spans of node along o + t d, t in [t0, t1] (t1 may be
    infinite), sorted and disjoint, in an array owned by the ctx and valid
-   until ray_reset. Returns the count; *spans points at them. */
+   until ray_reset. Returns the count; *spans points at them. Returns -1
+   and sets c->failed when memory runs out (or a leaf's root search does:
+   lg.h, soft.h). */
 int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
               double t0, double t1, RayCtx *c, csg_span **spans);
 
