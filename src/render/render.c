@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "core/bounds.h"
+#include "render/camera.h"
 #include "scene/ray.h"
 
 #define TILE 16
@@ -318,7 +319,7 @@ typedef struct Tracer {
   int *unbounded, nunbounded;
   BvhNode *bvh;
   int nbvh;
-  double eye[3], fwd[3], right[3], upv[3];
+  Camera cam;
   double coord_scale;       /* the largest |coordinate| of the eye and bounds */
   double lights[RENDER_MAX_LIGHTS][3];
   double intensity[RENDER_MAX_LIGHTS];
@@ -691,18 +692,6 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
   }
 }
 
-/* The camera ray through image position (px, py) (pixels, top left 0). */
-static void camera_ray(const Tracer *T, double px, double py, double d[3]) {
-  const RenderSettings *rs = T->rs;
-  double h = tan(rs->fov * M_PI / 360);
-  double aspect = (double)rs->width / rs->height;
-  double u = (2 * px / rs->width - 1) * h * aspect;
-  double v = (1 - 2 * py / rs->height) * h;
-  for (int i = 0; i < 3; i++) d[i] = T->fwd[i] + u * T->right[i] + v * T->upv[i];
-  double len = sqrt(dot3(d, d));
-  for (int i = 0; i < 3; i++) d[i] /= len;
-}
-
 static void progress(Tracer *T) {
   if (!T->rs->progress) return;
   double t = now();
@@ -735,9 +724,9 @@ static void render_tile(Worker *W, int tile) {
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++) {
           double d[3], rgb[3], z, nrm[3];
-          camera_ray(T, x + (sx + 0.5) / g, y + (sy + 0.5) / g, d);
+          camera_ray(&T->cam, x + (sx + 0.5) / g, y + (sy + 0.5) / g, d);
           long w0 = ray_work(W->c);
-          shade_sample(W, T->eye, d, rgb, &z, nrm);
+          shade_sample(W, T->cam.eye, d, rgb, &z, nrm);
           long w = ray_work(W->c) - w0;
           if (w > W->max_work) W->max_work = w;
           for (int i = 0; i < 3; i++) sum[i] += rgb[i];
@@ -796,57 +785,25 @@ void render_defaults(RenderSettings *rs) {
   rs->progress = NULL;
 }
 
+/* The camera (camera.h) framing the bounded primitives, the lights and
+   the shadow offset scaled to them, and the coordinate scale. */
 static int setup_camera(Tracer *T, char *err, size_t errlen) {
   const RenderSettings *rs = T->rs;
-  double eye[3], at[3];
   Box all = box_empty();
   for (int i = 0; i < T->nprims; i++)
     if (T->prims[i].bounded) all = box_union(all, T->prims[i].box);
-  if (box_is_empty(&all)) all = (Box){{0, 0, 0}, {1, 1, 1}};
-  double c[3], R = 0;
-  for (int i = 0; i < 3; i++) {
-    c[i] = 0.5 * (all.lo[i] + all.hi[i]);
-    R += 0.25 * (all.hi[i] - all.lo[i]) * (all.hi[i] - all.lo[i]);
-  }
-  R = fmax(sqrt(R), 1e-9);
-  if (rs->camera_set) {
-    memcpy(eye, rs->eye, sizeof eye);
-    memcpy(at, rs->at, sizeof at);
-  } else {
-    /* Frame the bounds: look at their centre from the front, above and to
-       the right, far enough that the bounding sphere fits the view. */
-    double dir[3] = {0.45, 0.6, 1};
-    double len = sqrt(dot3(dir, dir));
-    double dist = R / sin(fmin(rs->fov, 120) * M_PI / 360) * 1.05;
-    for (int i = 0; i < 3; i++) {
-      at[i] = c[i];
-      eye[i] = c[i] + dir[i] / len * dist;
-    }
-  }
-  memcpy(T->eye, eye, sizeof eye);
+  if (camera_setup(&T->cam, rs, !box_is_empty(&all), all.lo, all.hi, err, errlen))
+    return -1;
+  const double *eye = T->cam.eye, *c = T->cam.centre;
+  double R = T->cam.radius;
   /* Rounded roots are placed to ray_dist_tol: max(tol, RAY_TOL_FLOOR |o|)
      along a ray from o: rays start at the eye or at a hit inside the bounds. */
   T->coord_scale = 1;
   for (int i = 0; i < 3; i++) {
     T->coord_scale = fmax(T->coord_scale, fabs(eye[i]));
-    if (!box_is_empty(&all) && isfinite(all.lo[i]) && isfinite(all.hi[i]))
-      T->coord_scale = fmax(T->coord_scale, fmax(fabs(all.lo[i]), fabs(all.hi[i])));
+    if (isfinite(T->cam.lo[i]) && isfinite(T->cam.hi[i]))
+      T->coord_scale = fmax(T->coord_scale, fmax(fabs(T->cam.lo[i]), fabs(T->cam.hi[i])));
   }
-  for (int i = 0; i < 3; i++) T->fwd[i] = at[i] - eye[i];
-  double fl = sqrt(dot3(T->fwd, T->fwd));
-  if (!(fl > 0) || !isfinite(fl)) {
-    snprintf(err, errlen, "the camera's eye and at must differ");
-    return -1;
-  }
-  for (int i = 0; i < 3; i++) T->fwd[i] /= fl;
-  cross3(T->fwd, rs->up, T->right);
-  double rl = sqrt(dot3(T->right, T->right));
-  if (!(rl > 1e-12)) {
-    snprintf(err, errlen, "the camera's up direction is zero or parallel to its view");
-    return -1;
-  }
-  for (int i = 0; i < 3; i++) T->right[i] /= rl;
-  cross3(T->right, T->fwd, T->upv);
   if (rs->nlights) {
     T->nlights = rs->nlights;
     memcpy(T->lights, rs->lights, sizeof T->lights);
