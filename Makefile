@@ -54,7 +54,7 @@ KERNEL_BINS := $(KERNEL_TESTS:%=$(BUILD)/tests/%)
 STAB_SRCS := $(sort $(wildcard tests/stability/test_*.c))
 UNIT_BINS += $(STAB_SRCS:tests/stability/%.c=$(BUILD)/tests/%)
 # The fuzz targets of fuzz/ as plain programs that replay fuzz/corpus/.
-REPLAY_BINS := $(patsubst %,$(BUILD)/fuzz/replay_%,parse eval probes image)
+REPLAY_BINS := $(patsubst %,$(BUILD)/fuzz/replay_%,parse eval probes image render)
 
 .PHONY: all units deps demo test check sanitize tsan install uninstall clean bench update-references gallery layers
 
@@ -196,7 +196,7 @@ tsan: deps
 
 # fuzz: the libFuzzer targets of fuzz/ (clang, ASan + UBSan), each run for
 # FUZZ_TIME seconds; see fuzz/README.md. FUZZ_TARGETS picks some of them.
-FUZZ_TARGETS ?= parse eval probes image
+FUZZ_TARGETS ?= parse eval probes image render
 FUZZ_TIME    ?= 60
 FUZZ_FLAGS   := -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
 .PHONY: fuzz fuzz-build fuzz-bins
