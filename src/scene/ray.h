@@ -9,9 +9,27 @@
  * whether the solid lies on the far side (flip, for subtracted objects),
  * so the caller can compute the normal there.
  *
- * Memory: a RayCtx is per thread (ray_ctx_new / ray_ctx_free); it owns
- * the span arena and the soft-object scratch and holds the counters. A
- * query allocates nothing once the arena has grown to the scene's needs. */
+ * Depth. ray_spans walks the CSG tree on an explicit stack of frames
+ * kept in the RayCtx (a left operand's spans waiting for the right's), so
+ * the C stack does not grow with the tree: a scene a million nodes deep
+ * is evaluated on a worker thread's default stack. It makes the same
+ * calls in the same order as the recursive form (an empty left side of
+ * an intersection or difference still skips the right side), so spans
+ * and counters are those of the recursion.
+ *
+ * Memory and threads: a RayCtx is per thread (ray_ctx_new /
+ * ray_ctx_free); it owns the span arena, the frame stack and the
+ * soft-object scratch and holds the counters. A query allocates nothing
+ * once the arena and the stack have grown to the scene's needs; the arena
+ * takes a request of any size (a chunk of its own). The Scene is only
+ * read, so any number of threads, each with its own RayCtx, may query it.
+ *
+ * Failure: when memory runs out (the arena, the frame stack, or a leaf's
+ * root search) ray_spans returns -1 and sets RayCtx.failed, which stays
+ * set: a caller that treats -1 as "no spans" can still find out, once per
+ * tile, that its answers are incomplete (the renderer does: render.h).
+ * Nothing here prints or exits. Units: t along o + t d (d need not be
+ * unit length); tol is a distance in scene units (ray_dist_tol). */
 #ifndef QCS_RAY_H
 #define QCS_RAY_H
 
