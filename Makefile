@@ -4,6 +4,7 @@
 #   make demo       install what is missing, build, run the bundled example
 #   make test       install what is missing, build, run every test suite
 #   make sanitize   the test suite under ASan + UBSan (clang)
+#   make tsan       the threaded tests under ThreadSanitizer (clang)
 #   make fuzz       the libFuzzer targets, FUZZ_TIME seconds each
 #   make difftest   N random programs (default 5000) through qcs and Hugs 98, SEED=
 #   make install    PREFIX=/usr/local DESTDIR=
@@ -54,9 +55,9 @@ KERNEL_BINS := $(KERNEL_TESTS:%=$(BUILD)/tests/%)
 STAB_SRCS := $(sort $(wildcard tests/stability/test_*.c))
 UNIT_BINS += $(STAB_SRCS:tests/stability/%.c=$(BUILD)/tests/%)
 # The fuzz targets of fuzz/ as plain programs that replay fuzz/corpus/.
-REPLAY_BINS := $(patsubst %,$(BUILD)/fuzz/replay_%,parse eval probes image)
+REPLAY_BINS := $(patsubst %,$(BUILD)/fuzz/replay_%,parse eval probes image render)
 
-.PHONY: all units deps demo test check sanitize install uninstall clean bench update-references gallery layers difftest
+.PHONY: all units deps demo test check sanitize tsan install uninstall clean bench update-references gallery layers difftest
 
 BIN ?= qcs
 
@@ -192,9 +193,20 @@ sanitize: deps
 	@QCS=build-san/qcs QCS_UNIT_DIR=build-san/tests \
 	  ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 sh tests/run-all.sh
 
+# tsan: the multi-threaded parts under ThreadSanitizer (clang): the render
+# and fast-path unit tests, every rendering example on 4 threads and the
+# REPL suite (tests/tsan.sh); any report fails it (halt_on_error=1).
+TSAN_FLAGS := -g -fsanitize=thread
+.PHONY: tsan
+tsan: deps
+	@$(MAKE) -s BUILD=build-tsan BIN=build-tsan/qcs CC=clang \
+	  OPT="-O1 -fno-omit-frame-pointer" CFLAGS="$(TSAN_FLAGS)" \
+	  build-tsan/qcs build-tsan/tests/test_render build-tsan/tests/test_fastpaths
+	@QCS=build-tsan/qcs QCS_UNIT_DIR=build-tsan/tests sh tests/tsan.sh
+
 # fuzz: the libFuzzer targets of fuzz/ (clang, ASan + UBSan), each run for
 # FUZZ_TIME seconds; see fuzz/README.md. FUZZ_TARGETS picks some of them.
-FUZZ_TARGETS ?= parse eval probes image
+FUZZ_TARGETS ?= parse eval probes image render
 FUZZ_TIME    ?= 60
 FUZZ_FLAGS   := -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
 .PHONY: fuzz fuzz-build fuzz-bins
@@ -228,6 +240,6 @@ uninstall:
 	rm -rf $(DESTDIR)$(PREFIX)/share/qcs
 
 clean:
-	rm -rf $(BUILD) build-san build-fuzz qcs
+	rm -rf $(BUILD) build-san build-tsan build-fuzz qcs
 
 -include $(OBJS:.o=.d)

@@ -144,6 +144,22 @@ run keys "$g" keys.qcs
 if [ "$st" -eq 0 ] && [ -s "$g/keys.png" ]; then ok gen/million-keys-work
 else fail gen/million-keys-work "status $st: $(head -c 300 "$tmp/err")"; fi
 
+# A CSG tree 10^5 nodes deep reaches the renderer: it used to render on
+# one thread and segfault on several (span evaluation recursed once per
+# node on a worker's default-size stack). Both thread counts must render
+# it, to the same picture.
+cat >"$g/deep.qcs" <<'DEEP'
+cube k = Intersection UnitCube (Halfspace ((0, 0, -1), k / 1000000))
+scene = foldr (\k acc -> Intersection (Union (cube k) acc) UnitCube) UnitCube [1 .. 100000]
+DEEP
+for th in 1 4; do
+  run deep$th "$g" --threads $th --size 16x12 -o deep$th.png deep.qcs
+  if [ "$st" -eq 0 ] && [ -s "$g/deep$th.png" ]; then ok gen/deep-csg-100k-threads-$th
+  else fail gen/deep-csg-100k-threads-$th "status $st: $(head -c 300 "$tmp/err")"; fi
+done
+if cmp -s "$g/deep1.png" "$g/deep4.png"; then ok gen/deep-csg-100k-same-image
+else fail gen/deep-csg-100k-same-image "1 and 4 threads made different pictures"; fi
+
 # A file that does not exist.
 run missing "$g" no-such-file.qcs
 want 'qcs: error: cannot read no-such-file.qcs: No such file or directory\n'

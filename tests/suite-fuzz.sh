@@ -8,7 +8,7 @@
 cd "$(dirname "$0")/.." || exit 1
 UNIT_DIR=${QCS_UNIT_DIR:-build/tests}
 BIN_DIR=$(dirname "$UNIT_DIR")/fuzz
-for t in parse eval probes image; do
+for t in parse eval probes image render; do
   bin=$BIN_DIR/replay_$t
   if [ ! -x "$bin" ]; then echo "FAIL fuzz-replay $t: $bin not built"; continue; fi
   set -- fuzz/corpus/$t

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "core/bounds.h"
+#include "render/camera.h"
 #include "scene/ray.h"
 
 #define TILE 16
@@ -49,7 +50,12 @@ static Box box_inter(Box a, Box b) {
   return a;
 }
 
-/* A convex set n.x <= d over a list of planes, or a box. */
+/* A convex set n.x <= d over a list of planes, or a box. An intersection
+   that would hold more than CONVEX_MAX_PLANES planes becomes the
+   intersection of the two boxes instead (still conservative): convex_box
+   costs the fourth power of the plane count, and a scene can intersect a
+   million halfspaces. */
+#define CONVEX_MAX_PLANES 64
 typedef struct Shape {
   int convex;
   int n, cap;
@@ -147,7 +153,8 @@ static Box shape_box(Shape *s) { return s->convex ? convex_box(s) : s->box; }
 
 /* Combine two shapes by a set operation ('u', 'i', 'd' for a - b). */
 static void shape_combine(Shape *a, Shape *b, int op) {
-  if (op == 'i' && a->convex && b->convex) {
+  if (op == 'i' && a->convex && b->convex &&
+      a->n + b->n <= CONVEX_MAX_PLANES) {
     for (int i = 0; i < b->n; i++) shape_add(a, b->pl[i], b->pl[i][3]);
     shape_free(b);
     return;
@@ -201,8 +208,8 @@ static Box csg_box(const csg_tape *t) {
   return b;
 }
 
-static void node_shape(const Scene *s, int node, Shape *out) {
-  const ScNode *n = &s->nodes[node];
+/* The shape of a leaf node (not a set operation). */
+static void leaf_shape(const ScNode *n, Shape *out) {
   switch (n->kind) {
   case SC_HALFSPACE:
     shape_plane(out, n->n, n->d);
@@ -216,20 +223,71 @@ static void node_shape(const Scene *s, int node, Shape *out) {
     shape_box_only(out, b);
     return;
   }
-  case SC_EMPTY: shape_box_only(out, box_empty()); return;
   case SC_ALL: shape_box_only(out, box_all()); return;
-  default: {
-    Shape b;
-    node_shape(s, n->a, out);
-    node_shape(s, n->b, &b);
-    shape_combine(out, &b, n->kind == SC_UNION ? 'u' : n->kind == SC_INTER ? 'i' : 'd');
+  default: shape_box_only(out, box_empty()); return; /* SC_EMPTY */
   }
+}
+
+static int is_op(ScKind k) { return k == SC_UNION || k == SC_INTER || k == SC_DIFF; }
+
+/* Grow a stack *p of *cap elements of size sz (a local array at first:
+   local) so that it holds at least need; 0, or -1 without memory. */
+static int grow_stack(void **p, int *cap, int need, size_t sz, void *local) {
+  if (need <= *cap) return 0;
+  int cap2 = *cap * 2 > need ? *cap * 2 : need;
+  void *q = *p == local ? malloc(sz * (size_t)cap2) : realloc(*p, sz * (size_t)cap2);
+  if (!q) return -1;
+  if (*p == local) memcpy(q, local, sz * (size_t)*cap);
+  *p = q;
+  *cap = cap2;
+  return 0;
+}
+
+/* The shape of node: its subtree's leaves combined children first, a then
+   b, on explicit stacks (the C stack stays flat however deep the tree).
+   0, or -1 when memory runs out (*out is then unbounded). */
+static int node_shape(const Scene *s, int node, Shape *out) {
+  if (!is_op(s->nodes[node].kind)) {
+    leaf_shape(&s->nodes[node], out);
+    return 0;
   }
+  enum { LOCAL = 32 };
+  struct Frame { int node, stage; } lf[LOCAL], *fr = lf;
+  Shape ls[LOCAL], *sh = ls;
+  int capf = LOCAL, caps = LOCAL, nf = 0, ns = 0, r = 0;
+  fr[nf++] = (struct Frame){node, 0};
+  while (nf) {
+    struct Frame *f = &fr[nf - 1];
+    const ScNode *n = &s->nodes[f->node];
+    if (!is_op(n->kind)) {
+      if (grow_stack((void **)&sh, &caps, ns + 1, sizeof *sh, ls)) goto oom;
+      leaf_shape(n, &sh[ns++]);
+      nf--;
+    } else if (f->stage < 2) {
+      int child = f->stage++ ? n->b : n->a;
+      if (grow_stack((void **)&fr, &capf, nf + 1, sizeof *fr, lf)) goto oom;
+      fr[nf++] = (struct Frame){child, 0};
+    } else {
+      Shape b = sh[--ns];
+      shape_combine(&sh[ns - 1], &b, n->kind == SC_UNION ? 'u' : n->kind == SC_INTER ? 'i' : 'd');
+      nf--;
+    }
+  }
+  *out = sh[0];
+  goto done;
+oom:
+  for (int i = 0; i < ns; i++) shape_free(&sh[i]);
+  shape_box_only(out, box_all());
+  r = -1;
+done:
+  if (fr != lf) free(fr);
+  if (sh != ls) free(sh);
+  return r;
 }
 
 int render_node_box(const Scene *s, int node, double lo[3], double hi[3]) {
   Shape sh;
-  node_shape(s, node, &sh);
+  node_shape(s, node, &sh); /* without memory: unbounded, still true */
   Box b = shape_box(&sh);
   shape_free(&sh);
   memcpy(lo, b.lo, sizeof b.lo);
@@ -261,7 +319,7 @@ typedef struct Tracer {
   int *unbounded, nunbounded;
   BvhNode *bvh;
   int nbvh;
-  double eye[3], fwd[3], right[3], upv[3];
+  Camera cam;
   double coord_scale;       /* the largest |coordinate| of the eye and bounds */
   double lights[RENDER_MAX_LIGHTS][3];
   double intensity[RENDER_MAX_LIGHTS];
@@ -275,9 +333,8 @@ typedef struct Tracer {
   pthread_mutex_t lock;
   double start, last_progress;
   int progressed;             /* the progress callback was called */
-  RenderReport *rep;
   int grid;                   /* n of the n x n samples */
-  int failed;
+  atomic_int oom;             /* a worker ran out of memory: all stop */
 } Tracer;
 
 static double now(void) {
@@ -308,21 +365,39 @@ static int add_prim(Tracer *T, int node, const double *colour) {
     memcpy(p->colour, c, sizeof p->colour);
   }
   Shape sh;
-  node_shape(T->s, node, &sh);
+  if (node_shape(T->s, node, &sh)) return -1;
   p->box = shape_box(&sh);
   shape_free(&sh);
   p->bounded = box_bounded(&p->box);
   return 0;
 }
 
-/* The top-level union, flattened into primitives; colours are inherited. */
-static int collect_prims(Tracer *T, int node, const double *colour) {
-  const ScNode *n = &T->s->nodes[node];
-  if (n->has_colour) colour = n->colour;
-  if (n->kind == SC_UNION)
-    return collect_prims(T, n->a, colour) || collect_prims(T, n->b, colour);
-  if (n->kind == SC_EMPTY) return 0;
-  return add_prim(T, node, colour);
+/* The top-level union, flattened into primitives, a before b; colours
+   are inherited. An explicit stack: a scene may be a union a million deep.
+   0, or -1 when memory runs out. */
+static int collect_prims(Tracer *T, int root) {
+  typedef struct { int node; const double *colour; } Item;
+  Item local[32], *st = local;
+  int cap = 32, n = 0, r = 0;
+  st[n++] = (Item){root, NULL};
+  while (n) {
+    Item it = st[--n];
+    const ScNode *nd = &T->s->nodes[it.node];
+    const double *colour = nd->has_colour ? nd->colour : it.colour;
+    if (nd->kind == SC_UNION) {
+      if (grow_stack((void **)&st, &cap, n + 2, sizeof *st, local)) {
+        r = -1;
+        break;
+      }
+      st[n++] = (Item){nd->b, colour};
+      st[n++] = (Item){nd->a, colour};
+    } else if (nd->kind != SC_EMPTY && add_prim(T, it.node, colour)) {
+      r = -1;
+      break;
+    }
+  }
+  if (st != local) free(st);
+  return r;
 }
 
 static int build_bvh(Tracer *T, int first, int count) {
@@ -434,6 +509,7 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
                               any ? NULL : h->grad);
     if (c->stats.lg.overflows != unsplit && c->unresolved_node < 0)
       c->unresolved_node = node;
+    if (nr < 0) c->failed = 1;
     int k = 0;
     while (k < nr && (roots[k].kind == LG_TOUCH || !(roots[k].t > t0))) k++;
     if (k >= nr) return 0;
@@ -447,6 +523,7 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
   case SC_SOFT: {
     double t;
     int nr = soft_roots(n->soft, o, d, t0, t1, &t, 1, c->soft, &c->stats.soft);
+    if (nr < 0) c->failed = 1;
     if (nr < 1) return 0;
     h->t = t;
     h->id = node;
@@ -615,18 +692,6 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
   }
 }
 
-/* The camera ray through image position (px, py) (pixels, top left 0). */
-static void camera_ray(const Tracer *T, double px, double py, double d[3]) {
-  const RenderSettings *rs = T->rs;
-  double h = tan(rs->fov * M_PI / 360);
-  double aspect = (double)rs->width / rs->height;
-  double u = (2 * px / rs->width - 1) * h * aspect;
-  double v = (1 - 2 * py / rs->height) * h;
-  for (int i = 0; i < 3; i++) d[i] = T->fwd[i] + u * T->right[i] + v * T->upv[i];
-  double len = sqrt(dot3(d, d));
-  for (int i = 0; i < 3; i++) d[i] /= len;
-}
-
 static void progress(Tracer *T) {
   if (!T->rs->progress) return;
   double t = now();
@@ -659,9 +724,9 @@ static void render_tile(Worker *W, int tile) {
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++) {
           double d[3], rgb[3], z, nrm[3];
-          camera_ray(T, x + (sx + 0.5) / g, y + (sy + 0.5) / g, d);
+          camera_ray(&T->cam, x + (sx + 0.5) / g, y + (sy + 0.5) / g, d);
           long w0 = ray_work(W->c);
-          shade_sample(W, T->eye, d, rgb, &z, nrm);
+          shade_sample(W, T->cam.eye, d, rgb, &z, nrm);
           long w = ray_work(W->c) - w0;
           if (w > W->max_work) W->max_work = w;
           for (int i = 0; i < 3; i++) sum[i] += rgb[i];
@@ -685,9 +750,14 @@ static void *worker_main(void *arg) {
   Tracer *T = W->T;
   for (;;) {
     if (T->cancel && atomic_load_explicit(T->cancel, memory_order_relaxed)) break;
+    if (atomic_load_explicit(&T->oom, memory_order_relaxed)) break;
     int tile = atomic_fetch_add(&T->next_tile, 1);
     if (tile >= T->ntiles) break;
     render_tile(W, tile);
+    if (W->c->failed) { /* a query ran out of memory: the picture is wrong */
+      atomic_store(&T->oom, 1);
+      break;
+    }
     atomic_fetch_add(&T->done_tiles, 1);
     progress(T);
   }
@@ -715,57 +785,25 @@ void render_defaults(RenderSettings *rs) {
   rs->progress = NULL;
 }
 
+/* The camera (camera.h) framing the bounded primitives, the lights and
+   the shadow offset scaled to them, and the coordinate scale. */
 static int setup_camera(Tracer *T, char *err, size_t errlen) {
   const RenderSettings *rs = T->rs;
-  double eye[3], at[3];
   Box all = box_empty();
   for (int i = 0; i < T->nprims; i++)
     if (T->prims[i].bounded) all = box_union(all, T->prims[i].box);
-  if (box_is_empty(&all)) all = (Box){{0, 0, 0}, {1, 1, 1}};
-  double c[3], R = 0;
-  for (int i = 0; i < 3; i++) {
-    c[i] = 0.5 * (all.lo[i] + all.hi[i]);
-    R += 0.25 * (all.hi[i] - all.lo[i]) * (all.hi[i] - all.lo[i]);
-  }
-  R = fmax(sqrt(R), 1e-9);
-  if (rs->camera_set) {
-    memcpy(eye, rs->eye, sizeof eye);
-    memcpy(at, rs->at, sizeof at);
-  } else {
-    /* Frame the bounds: look at their centre from the front, above and to
-       the right, far enough that the bounding sphere fits the view. */
-    double dir[3] = {0.45, 0.6, 1};
-    double len = sqrt(dot3(dir, dir));
-    double dist = R / sin(fmin(rs->fov, 120) * M_PI / 360) * 1.05;
-    for (int i = 0; i < 3; i++) {
-      at[i] = c[i];
-      eye[i] = c[i] + dir[i] / len * dist;
-    }
-  }
-  memcpy(T->eye, eye, sizeof eye);
+  if (camera_setup(&T->cam, rs, !box_is_empty(&all), all.lo, all.hi, err, errlen))
+    return -1;
+  const double *eye = T->cam.eye, *c = T->cam.centre;
+  double R = T->cam.radius;
   /* Rounded roots are placed to ray_dist_tol: max(tol, RAY_TOL_FLOOR |o|)
      along a ray from o: rays start at the eye or at a hit inside the bounds. */
   T->coord_scale = 1;
   for (int i = 0; i < 3; i++) {
     T->coord_scale = fmax(T->coord_scale, fabs(eye[i]));
-    if (!box_is_empty(&all) && isfinite(all.lo[i]) && isfinite(all.hi[i]))
-      T->coord_scale = fmax(T->coord_scale, fmax(fabs(all.lo[i]), fabs(all.hi[i])));
+    if (isfinite(T->cam.lo[i]) && isfinite(T->cam.hi[i]))
+      T->coord_scale = fmax(T->coord_scale, fmax(fabs(T->cam.lo[i]), fabs(T->cam.hi[i])));
   }
-  for (int i = 0; i < 3; i++) T->fwd[i] = at[i] - eye[i];
-  double fl = sqrt(dot3(T->fwd, T->fwd));
-  if (!(fl > 0) || !isfinite(fl)) {
-    snprintf(err, errlen, "the camera's eye and at must differ");
-    return -1;
-  }
-  for (int i = 0; i < 3; i++) T->fwd[i] /= fl;
-  cross3(T->fwd, rs->up, T->right);
-  double rl = sqrt(dot3(T->right, T->right));
-  if (!(rl > 1e-12)) {
-    snprintf(err, errlen, "the camera's up direction is zero or parallel to its view");
-    return -1;
-  }
-  for (int i = 0; i < 3; i++) T->right[i] /= rl;
-  cross3(T->right, T->fwd, T->upv);
   if (rs->nlights) {
     T->nlights = rs->nlights;
     memcpy(T->lights, rs->lights, sizeof T->lights);
@@ -807,7 +845,6 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   memset(&T, 0, sizeof T);
   T.s = s;
   T.rs = rs;
-  T.rep = rep;
   T.grid = grid;
   T.cancel = cancel;
   pthread_mutex_init(&T.lock, NULL);
@@ -817,7 +854,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   int nthreads = rs->threads > 0 ? rs->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
   if (nthreads < 1) nthreads = 1;
   if (nthreads > 256) nthreads = 256;
-  if (collect_prims(&T, s->root, NULL)) goto oom;
+  if (collect_prims(&T, s->root)) goto oom;
   T.bounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
   T.unbounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
   T.bvh = malloc(sizeof(BvhNode) * (size_t)(2 * T.nprims + 1));
@@ -837,6 +874,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   T.ntiles = T.tiles_x * T.tiles_y;
   atomic_init(&T.next_tile, 0);
   atomic_init(&T.done_tiles, 0);
+  atomic_init(&T.oom, 0);
   T.start = now();
   workers = calloc((size_t)nthreads, sizeof *workers);
   threads = calloc((size_t)nthreads, sizeof *threads);
@@ -881,6 +919,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
     rep->unresolved += W->c->stats.lg.overflows;
     if (rep->unresolved_node < 0) rep->unresolved_node = W->c->unresolved_node;
   }
+  if (atomic_load(&T.oom)) goto oom;
   if (cancel && atomic_load(cancel) && atomic_load(&T.done_tiles) < T.ntiles) {
     rep->interrupted = 1;
     snprintf(err, errlen, "render interrupted");

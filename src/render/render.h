@@ -21,8 +21,24 @@
  * per tile (Ctrl-C in the REPL): an atomic int, read with a relaxed load,
  * so a signal handler or another thread may set it at any time.
  *
+ * The camera (basis, automatic framing of the bounded primitives, primary
+ * rays) is render/camera.h's, shared with the tradeoff study.
+ *
+ * Depth: no walk of the scene here recurses with the tree (primitive
+ * collection, node boxes, spans): a scene as deep as the interpreter can
+ * build renders on worker threads' default stacks. An intersection of
+ * more than 64 planes is boxed conservatively as two boxes' intersection.
+ *
+ * Failure: if a worker runs out of memory (a span list, a root search),
+ * it raises a shared atomic flag, every worker stops at its next tile,
+ * and render_scene returns NULL with "out of memory for the render" in
+ * err: never a picture with silently missing surfaces.
+ *
  * Memory: render_scene returns an Image the caller frees with img_free; it
- * does not keep the scene. */
+ * does not keep the scene. Shared state read by the workers is the scene
+ * and the Tracer (written before the threads start), the tile counters
+ * and flags (atomics), and the progress time (under a lock); each worker
+ * writes only its own pixels and its own counters, summed after the join. */
 #ifndef QCS_RENDER_H
 #define QCS_RENDER_H
 

@@ -10,7 +10,8 @@
 
 struct SpanChunk {
   SpanChunk *next;
-  csg_span spans[CHUNK_SPANS];
+  size_t cap;          /* CHUNK_SPANS, or more for one large request */
+  csg_span spans[];
 };
 
 RayCtx *ray_ctx_new(const Scene *s, double tol) {
@@ -35,6 +36,7 @@ void ray_ctx_free(RayCtx *c) {
     free(k);
   }
   if (c->soft) soft_scratch_free(c->soft);
+  free(c->frames);
   free(c);
 }
 
@@ -43,17 +45,21 @@ void ray_reset(RayCtx *c) {
   c->used = 0;
 }
 
-/* n contiguous spans from the arena (n <= CHUNK_SPANS), or NULL. */
+/* n contiguous spans from the arena, or NULL when memory runs out. The
+   chunks are kept across rays; a request larger than a chunk gets a chunk
+   of its own, inserted before the next one. */
 static csg_span *alloc_spans(RayCtx *c, int n) {
-  if (n > CHUNK_SPANS) return NULL;
-  if (!c->cur || c->used + (size_t)n > CHUNK_SPANS) {
+  if (!c->cur || c->used + (size_t)n > c->cur->cap) {
     SpanChunk *next = c->cur ? c->cur->next : c->chunks;
-    if (!next) {
-      next = malloc(sizeof *next);
-      if (!next) return NULL;
-      next->next = NULL;
-      if (c->cur) c->cur->next = next;
-      else c->chunks = next;
+    if (!next || next->cap < (size_t)n) {
+      size_t cap = (size_t)n > CHUNK_SPANS ? (size_t)n : CHUNK_SPANS;
+      SpanChunk *k = malloc(sizeof *k + sizeof(csg_span) * cap);
+      if (!k) return NULL;
+      k->cap = cap;
+      k->next = next;
+      if (c->cur) c->cur->next = k;
+      else c->chunks = k;
+      next = k;
     }
     c->cur = next;
     c->used = 0;
@@ -178,8 +184,11 @@ static int soft_spans(const ScNode *n, int id, const double o[3],
                             out);
 }
 
-int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
-              double t0, double t1, RayCtx *c, csg_span **spans) {
+/* The spans of a leaf node (not a set operation) into *spans: the count,
+   or -1 when memory runs out. */
+static int leaf_spans(const Scene *s, int node, const double o[3],
+                      const double d[3], double t0, double t1, RayCtx *c,
+                      csg_span **spans) {
   const ScNode *n = &s->nodes[node];
   csg_span *out;
   int cnt;
@@ -199,36 +208,86 @@ int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
     if (!out) return -1;
     cnt = soft_spans(n, node, o, d, t0, t1, c, out);
     break;
-  case SC_EMPTY:
-    out = NULL;
-    cnt = 0;
-    break;
   case SC_ALL:
     out = alloc_spans(c, 1);
     if (!out) return -1;
     set_span(out, t0, t1, -1, -1, 0, 0);
     cnt = 1;
     break;
-  default: {
-    csg_span *a, *b;
-    int na = ray_spans(s, n->a, o, d, t0, t1, c, &a);
-    if (na < 0) return -1;
-    /* An empty left side of an intersection or difference decides. */
-    if (na == 0 && n->kind != SC_UNION) {
-      *spans = NULL;
-      return 0;
-    }
-    int nb = ray_spans(s, n->b, o, d, t0, t1, c, &b);
-    if (nb < 0) return -1;
-    out = alloc_spans(c, na + nb + 1);
-    if (!out) return -1;
-    if (n->kind == SC_UNION) cnt = csg_spans_union(a, na, b, nb, out);
-    else if (n->kind == SC_INTER) cnt = csg_spans_inter(a, na, b, nb, out);
-    else cnt = csg_spans_diff(a, na, b, nb, out);
-  }
+  default: /* SC_EMPTY */
+    out = NULL;
+    cnt = 0;
+    break;
   }
   *spans = out;
   return cnt;
+}
+
+static int is_op(ScKind k) { return k == SC_UNION || k == SC_INTER || k == SC_DIFF; }
+
+/* Room for one more frame on the ctx's stack; 0, or -1 without memory. */
+static int grow_frames(RayCtx *c) {
+  size_t cap = c->cap_frames ? 2 * c->cap_frames : 64;
+  RayFrame *f = realloc(c->frames, sizeof *f * cap);
+  if (!f) return -1;
+  c->frames = f;
+  c->cap_frames = cap;
+  return 0;
+}
+
+/* The recursion "spans(a), then (unless an empty a decides) spans(b),
+   then combine" run on an explicit stack of set-operation frames, so the
+   C stack stays flat however deep the tree: the same calls in the same
+   order as the recursive form, hence the same spans and counters. */
+int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
+              double t0, double t1, RayCtx *c, csg_span **spans) {
+  const ScNode *nodes = s->nodes;
+  size_t sp = 0;
+  csg_span *res;
+  int cnt;
+  for (;;) {
+    /* Descend the left spine of node to a leaf, a frame per operation. */
+    while (is_op(nodes[node].kind)) {
+      if (sp == c->cap_frames && grow_frames(c)) goto oom;
+      c->frames[sp].node = node;
+      c->frames[sp].na = -1; /* a not done yet */
+      sp++;
+      node = nodes[node].a;
+    }
+    cnt = leaf_spans(s, node, o, d, t0, t1, c, &res);
+    if (cnt < 0) goto oom;
+    /* Return the result up the stack until a frame needs its b. */
+    for (;;) {
+      if (!sp) {
+        *spans = res;
+        return cnt;
+      }
+      RayFrame *f = &c->frames[sp - 1];
+      const ScNode *n = &nodes[f->node];
+      if (f->na < 0) {
+        /* An empty left side of an intersection or difference decides. */
+        if (cnt == 0 && n->kind != SC_UNION) {
+          res = NULL;
+          sp--;
+          continue;
+        }
+        f->a = res;
+        f->na = cnt;
+        node = n->b;
+        break; /* descend into b */
+      }
+      csg_span *out = alloc_spans(c, f->na + cnt + 1);
+      if (!out) goto oom;
+      if (n->kind == SC_UNION) cnt = csg_spans_union(f->a, f->na, res, cnt, out);
+      else if (n->kind == SC_INTER) cnt = csg_spans_inter(f->a, f->na, res, cnt, out);
+      else cnt = csg_spans_diff(f->a, f->na, res, cnt, out);
+      res = out;
+      sp--;
+    }
+  }
+oom:
+  c->failed = 1;
+  return -1;
 }
 
 void ray_normal_grad(const double g[3], int flip, double n[3]) {

@@ -9,9 +9,27 @@
  * whether the solid lies on the far side (flip, for subtracted objects),
  * so the caller can compute the normal there.
  *
- * Memory: a RayCtx is per thread (ray_ctx_new / ray_ctx_free); it owns
- * the span arena and the soft-object scratch and holds the counters. A
- * query allocates nothing once the arena has grown to the scene's needs. */
+ * Depth. ray_spans walks the CSG tree on an explicit stack of frames
+ * kept in the RayCtx (a left operand's spans waiting for the right's), so
+ * the C stack does not grow with the tree: a scene a million nodes deep
+ * is evaluated on a worker thread's default stack. It makes the same
+ * calls in the same order as the recursive form (an empty left side of
+ * an intersection or difference still skips the right side), so spans
+ * and counters are those of the recursion.
+ *
+ * Memory and threads: a RayCtx is per thread (ray_ctx_new /
+ * ray_ctx_free); it owns the span arena, the frame stack and the
+ * soft-object scratch and holds the counters. A query allocates nothing
+ * once the arena and the stack have grown to the scene's needs; the arena
+ * takes a request of any size (a chunk of its own). The Scene is only
+ * read, so any number of threads, each with its own RayCtx, may query it.
+ *
+ * Failure: when memory runs out (the arena, the frame stack, or a leaf's
+ * root search) ray_spans returns -1 and sets RayCtx.failed, which stays
+ * set: a caller that treats -1 as "no spans" can still find out, once per
+ * tile, that its answers are incomplete (the renderer does: render.h).
+ * Nothing here prints or exits. Units: t along o + t d (d need not be
+ * unit length); tol is a distance in scene units (ray_dist_tol). */
 #ifndef QCS_RAY_H
 #define QCS_RAY_H
 
@@ -29,14 +47,25 @@ typedef struct RayStats {
 
 typedef struct SpanChunk SpanChunk;
 
+/* A set operation waiting for its right side (ray.c's explicit stack). */
+typedef struct RayFrame {
+  int node;
+  int na;              /* the left side's span count, -1 until known */
+  csg_span *a;         /* the left side's spans */
+} RayFrame;
+
 typedef struct RayCtx {
   soft_scratch *soft;
   SpanChunk *chunks;   /* the span arena */
   SpanChunk *cur;
   size_t used;
   double tol;          /* root tolerance as a distance (scene units) */
+  RayFrame *frames;    /* ray_spans' stack, grown on demand */
+  size_t cap_frames;
   RayStats stats;
   const lg_hook *hook; /* optional trace of every root search segment */
+  int failed;          /* a query ran out of memory (sticky; ray_spans
+                          sets it, and so may the caller's own queries) */
   int unresolved_node; /* a rounded node whose search left segments unsplit
                           (lg_stats.overflows grew), or -1 */
 } RayCtx;
@@ -54,7 +83,9 @@ void ray_ctx_free(RayCtx *c);
 
 /* The inside spans of node along o + t d, t in [t0, t1] (t1 may be
    infinite), sorted and disjoint, in an array owned by the ctx and valid
-   until ray_reset. Returns the count; *spans points at them. */
+   until ray_reset. Returns the count; *spans points at them. Returns -1
+   and sets c->failed when memory runs out (or a leaf's root search does:
+   lg.h, soft.h). */
 int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
               double t0, double t1, RayCtx *c, csg_span **spans);
 

@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "lang/interp.h"
+#include "render/camera.h"
 #include "render/render.h"
 #include "scene/scene.h"
 #include "scene/ray.h"
@@ -50,59 +51,35 @@ static Image *render_rung(const Scene *s, const RenderSettings *base,
 }
 
 /* The hit distances of a fixed sample of primary rays (one through each
-   pixel centre, the render's pinhole camera) in double precision: the
-   float Z plane cannot resolve errors below ~1e-7 of the distance. NAN
-   where the ray misses or starts inside. Returns 0, or -1 on no memory. */
+   pixel centre, the render's own camera: render/camera.h) in double
+   precision: the float Z plane cannot resolve errors below ~1e-7 of the
+   distance. NAN where the ray misses or starts inside. Returns 0, or -1
+   on no memory (or a camera the render itself would have refused). */
 static int sample_hits(const Scene *s, const RenderSettings *rs, double tol,
                        double *z) {
-  double eye[3], at[3], fwd[3], right[3], upv[3];
-  if (rs->camera_set) {
-    memcpy(eye, rs->eye, sizeof eye);
-    memcpy(at, rs->at, sizeof at);
-  } else { /* the render's framing, as far as the root's box goes */
-    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, R = 0;
-    render_node_box(s, s->root, lo, hi);
-    for (int i = 0; i < 3; i++)
-      R += 0.25 * (hi[i] - lo[i]) * (hi[i] - lo[i]);
-    R = fmax(sqrt(R), 1e-9);
-    double dir[3] = {0.45, 0.6, 1}, len = sqrt(0.45 * 0.45 + 0.36 + 1);
-    double dist = R / sin(fmin(rs->fov, 120) * M_PI / 360) * 1.05;
-    for (int i = 0; i < 3; i++) {
-      at[i] = 0.5 * (lo[i] + hi[i]);
-      eye[i] = at[i] + dir[i] / len * dist;
-    }
-  }
-  double fl = 0;
-  for (int i = 0; i < 3; i++) fwd[i] = at[i] - eye[i], fl += fwd[i] * fwd[i];
-  fl = sqrt(fl);
-  for (int i = 0; i < 3; i++) fwd[i] /= fl;
-  right[0] = fwd[1] * rs->up[2] - fwd[2] * rs->up[1];
-  right[1] = fwd[2] * rs->up[0] - fwd[0] * rs->up[2];
-  right[2] = fwd[0] * rs->up[1] - fwd[1] * rs->up[0];
-  double rl = sqrt(right[0] * right[0] + right[1] * right[1] +
-                   right[2] * right[2]);
-  for (int i = 0; i < 3; i++) right[i] /= rl;
-  upv[0] = right[1] * fwd[2] - right[2] * fwd[1];
-  upv[1] = right[2] * fwd[0] - right[0] * fwd[2];
-  upv[2] = right[0] * fwd[1] - right[1] * fwd[0];
+  double lo[3], hi[3];
+  char err[200];
+  Camera cam;
+  int has_box = camera_scene_box(s, lo, hi);
+  if (has_box < 0 || camera_setup(&cam, rs, has_box, lo, hi, err, sizeof err))
+    return -1;
   RayCtx *c = ray_ctx_new(s, tol);
   if (!c) return -1;
-  double h = tan(rs->fov * M_PI / 360), aspect = (double)rs->width / rs->height;
   for (int y = 0; y < rs->height; y++)
     for (int x = 0; x < rs->width; x++) {
-      double u = (2 * (x + 0.5) / rs->width - 1) * h * aspect;
-      double v = (1 - 2 * (y + 0.5) / rs->height) * h, d[3], dl = 0;
-      for (int i = 0; i < 3; i++)
-        d[i] = fwd[i] + u * right[i] + v * upv[i], dl += d[i] * d[i];
-      dl = sqrt(dl);
-      for (int i = 0; i < 3; i++) d[i] /= dl;
+      double d[3];
+      camera_ray(&cam, x + 0.5, y + 0.5, d);
       ray_reset(c);
       csg_span *sp;
-      int n = ray_spans(s, s->root, eye, d, 0, INFINITY, c, &sp);
+      int n = ray_spans(s, s->root, cam.eye, d, 0, INFINITY, c, &sp);
       double hit = NAN;
       if (n > 0 && sp[0].t0 > 0) hit = sp[0].t0;
       z[(size_t)y * rs->width + x] = hit;
     }
+  if (c->failed) {
+    ray_ctx_free(c);
+    return -1;
+  }
   ray_ctx_free(c);
   return 0;
 }

@@ -1,0 +1,124 @@
+/* camera.c: the pinhole camera and the automatic framing. See camera.h. */
+#include "render/camera.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static double dot3(const double a[3], const double b[3]) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double a[3], const double b[3], double c[3]) {
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* The primitives in the renderer's order (the top-level union, a before
+   b, Empty skipped), boxed by render_node_box; an explicit stack. */
+int camera_scene_box(const Scene *s, double lo[3], double hi[3]) {
+  int local[32], *st = local, cap = 32, n = 0, any = 0;
+  double blo[3] = {INFINITY, INFINITY, INFINITY};
+  double bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  if (s->root < 0) return 0;
+  st[n++] = s->root;
+  while (n) {
+    const int node = st[--n];
+    const ScNode *nd = &s->nodes[node];
+    if (nd->kind == SC_UNION) {
+      if (n + 2 > cap) {
+        int cap2 = 2 * cap;
+        int *q = st == local ? malloc(sizeof *q * (size_t)cap2)
+                             : realloc(st, sizeof *q * (size_t)cap2);
+        if (!q) {
+          if (st != local) free(st);
+          return -1;
+        }
+        if (st == local) memcpy(q, local, sizeof local);
+        st = q;
+        cap = cap2;
+      }
+      st[n++] = nd->b;
+      st[n++] = nd->a;
+      continue;
+    }
+    if (nd->kind == SC_EMPTY) continue;
+    double plo[3], phi[3];
+    if (!render_node_box(s, node, plo, phi)) continue; /* unbounded */
+    for (int i = 0; i < 3; i++) {
+      blo[i] = fmin(blo[i], plo[i]);
+      bhi[i] = fmax(bhi[i], phi[i]);
+    }
+  }
+  if (st != local) free(st);
+  any = !(blo[0] > bhi[0] || blo[1] > bhi[1] || blo[2] > bhi[2]);
+  if (any) {
+    memcpy(lo, blo, sizeof blo);
+    memcpy(hi, bhi, sizeof bhi);
+  }
+  return any;
+}
+
+int camera_setup(Camera *cam, const RenderSettings *rs, int has_box,
+                 const double lo[3], const double hi[3], char *err,
+                 size_t errlen) {
+  memset(cam, 0, sizeof *cam);
+  cam->has_box = has_box;
+  for (int i = 0; i < 3; i++) {
+    cam->lo[i] = has_box ? lo[i] : 0;
+    cam->hi[i] = has_box ? hi[i] : 1;
+  }
+  double R = 0, at[3];
+  for (int i = 0; i < 3; i++) {
+    cam->centre[i] = 0.5 * (cam->lo[i] + cam->hi[i]);
+    R += 0.25 * (cam->hi[i] - cam->lo[i]) * (cam->hi[i] - cam->lo[i]);
+  }
+  R = fmax(sqrt(R), 1e-9);
+  cam->radius = R;
+  if (rs->camera_set) {
+    memcpy(cam->eye, rs->eye, sizeof cam->eye);
+    memcpy(at, rs->at, sizeof at);
+  } else {
+    /* Frame the box: look at its centre from the front, above and to the
+       right, far enough that the bounding sphere fits the view. */
+    double dir[3] = {0.45, 0.6, 1};
+    double len = sqrt(dot3(dir, dir));
+    double dist = R / sin(fmin(rs->fov, 120) * M_PI / 360) * 1.05;
+    for (int i = 0; i < 3; i++) {
+      at[i] = cam->centre[i];
+      cam->eye[i] = cam->centre[i] + dir[i] / len * dist;
+    }
+  }
+  for (int i = 0; i < 3; i++) cam->fwd[i] = at[i] - cam->eye[i];
+  double fl = sqrt(dot3(cam->fwd, cam->fwd));
+  if (!(fl > 0) || !isfinite(fl)) {
+    snprintf(err, errlen, "the camera's eye and at must differ");
+    return -1;
+  }
+  for (int i = 0; i < 3; i++) cam->fwd[i] /= fl;
+  cross3(cam->fwd, rs->up, cam->right);
+  double rl = sqrt(dot3(cam->right, cam->right));
+  if (!(rl > 1e-12)) {
+    snprintf(err, errlen, "the camera's up direction is zero or parallel to its view");
+    return -1;
+  }
+  for (int i = 0; i < 3; i++) cam->right[i] /= rl;
+  cross3(cam->right, cam->fwd, cam->upv);
+  cam->width = rs->width;
+  cam->height = rs->height;
+  cam->tan_half = tan(rs->fov * M_PI / 360);
+  cam->aspect = (double)rs->width / rs->height;
+  return 0;
+}
+
+void camera_ray(const Camera *cam, double px, double py, double d[3]) {
+  double h = cam->tan_half;
+  double u = (2 * px / cam->width - 1) * h * cam->aspect;
+  double v = (1 - 2 * py / cam->height) * h;
+  for (int i = 0; i < 3; i++)
+    d[i] = cam->fwd[i] + u * cam->right[i] + v * cam->upv[i];
+  double len = sqrt(dot3(d, d));
+  for (int i = 0; i < 3; i++) d[i] /= len;
+}

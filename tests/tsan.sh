@@ -1,0 +1,32 @@
+#!/bin/sh
+# tsan.sh (make tsan): the threaded parts of qcs under ThreadSanitizer.
+# QCS and QCS_UNIT_DIR name a -fsanitize=thread build (build-tsan). Runs
+# the render and fast-path unit tests, every rendering example on 4
+# threads, and the REPL suite; prints "ok NAME" / "FAIL NAME: why" lines
+# and a closing "N passed, N failed". halt_on_error=1: the first report
+# ends the program with status 66, which is a failure here.
+cd "$(dirname "$0")/.." || exit 1
+QCS=${QCS:-build-tsan/qcs}; export QCS
+UNIT_DIR=${QCS_UNIT_DIR:-build-tsan/tests}
+TSAN_OPTIONS="halt_on_error=1 exitcode=66 second_deadlock_stack=1 ${TSAN_OPTIONS:-}"
+[ -f tools/tsan.supp ] && TSAN_OPTIONS="$TSAN_OPTIONS suppressions=$PWD/tools/tsan.supp"
+export TSAN_OPTIONS
+log=$(mktemp); tmp=$(mktemp -d); trap 'rm -rf "$log" "$tmp"' EXIT
+
+for t in test_render test_fastpaths; do
+  if "$UNIT_DIR/$t" >"$tmp/$t.out" 2>&1; then echo "ok tsan/$t" >>"$log"
+  else echo "FAIL tsan/$t: status $?: $(grep -m3 -E 'WARNING: ThreadSanitizer|FAIL|SUMMARY' "$tmp/$t.out" | tr '\n' ' ')" >>"$log"; fi
+done
+for f in examples/*.qcs; do
+  grep -q -E '^[^/]*render(With)? ' "$f" || continue
+  n=$(basename "$f" .qcs)
+  if timeout 600 "$QCS" --threads 4 --size 120x76 -o "$tmp/$n.exr" "$f" >/dev/null 2>"$tmp/$n.err" </dev/null &&
+     ! grep -q ThreadSanitizer "$tmp/$n.err"; then echo "ok tsan/example-$n" >>"$log"
+  else echo "FAIL tsan/example-$n: $(grep -m3 -E 'ThreadSanitizer|error' "$tmp/$n.err" | tr '\n' ' ')" >>"$log"; fi
+done
+sh tests/suite-repl.sh 2>&1 | sed 's/^\(ok\|FAIL\|skip\) /\1 tsan\//' >>"$log"
+
+grep -E '^(FAIL|skip) ' "$log"
+passed=$(grep -c '^ok ' "$log"); failed=$(grep -c '^FAIL ' "$log")
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]
