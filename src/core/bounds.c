@@ -187,29 +187,7 @@ static csg_tape *bound(const dt_tape *tp, double level, int kind, int *flagp) {
       right[i] = stk[--sp];
       left[i] = stk[--sp];
       int x = left[i], y = right[i];
-      double a[4] = {lo[x], hi[x], lo[y], hi[y]}, l = 0, h = 0;
-      switch (in->op) {
-      case DT_SUM: l = a[0] + a[2]; h = a[1] + a[3]; break;
-      case DT_DIFF: l = a[0] - a[3]; h = a[1] - a[2]; break;
-      case DT_RDIFF: l = a[2] - a[1]; h = a[3] - a[0]; break;
-      case DT_PRODUCT:
-      case DT_UNION: {
-        /* Union 1 - (1-x)(1-y) as a product of complements. */
-        int u = in->op == DT_UNION;
-        double p0 = u ? 1 - a[1] : a[0], p1 = u ? 1 - a[0] : a[1];
-        double q0 = u ? 1 - a[3] : a[2], q1 = u ? 1 - a[2] : a[3];
-        double pr[4] = {p0 * q0, p0 * q1, p1 * q0, p1 * q1};
-        l = h = pr[0];
-        for (int k = 1; k < 4; k++) {
-          if (pr[k] < l) l = pr[k];
-          if (pr[k] > h) h = pr[k];
-        }
-        if (u) { double tmp = l; l = 1 - h; h = 1 - tmp; }
-        break;
-      }
-      }
-      lo[i] = l;
-      hi[i] = h;
+      dt_range_op(in->op, lo[x], hi[x], lo[y], hi[y], &lo[i], &hi[i]);
     }
     if (hi[i] > 1) flags |= BND_RANGE;
     stk[sp++] = i;

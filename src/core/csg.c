@@ -1,5 +1,6 @@
 /* csg.c: sharp CSG tapes, point classification and Roth span lists. */
 #include "core/csg.h"
+#include "core/vec.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -319,7 +320,7 @@ int csg_inside(const csg_tape *t, const double p[3]) {
     switch (in->op) {
     case CSG_PLANE: {
       const csg_plane *pl = &t->planes[in->arg];
-      st[sp++] = pl->n[0] * p[0] + pl->n[1] * p[1] + pl->n[2] * p[2] < pl->d;
+      st[sp++] = vec3_dot(pl->n, p) < pl->d;
       break;
     }
     case CSG_EMPTY: st[sp++] = 0; break;
@@ -413,8 +414,8 @@ int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
  * are fine: t* = -s0/k scales with 1/|d| exactly as the parameter does. */
 static int plane_span(const csg_plane *p, int id, const double o[3],
                       const double d[3], double s0, double s1, csg_span *out) {
-  double base = p->n[0] * o[0] + p->n[1] * o[1] + p->n[2] * o[2] - p->d;
-  double k = p->n[0] * d[0] + p->n[1] * d[1] + p->n[2] * d[2];
+  double base = vec3_dot(p->n, o) - p->d;
+  double k = vec3_dot(p->n, d);
   csg_span s = {s0, s1, -1, -1, 0, 0};
   if (k == 0) {
     if (!(base < 0)) return 0;
@@ -444,8 +445,8 @@ static int convex_span(const csg_tape *t, int g, const double o[3],
   const struct csg_gplane *end = t->gpl + t->gstart[g + 1];
   for (; p < end; p++) {
     int id = p->id;
-    double base = p->n[0] * o[0] + p->n[1] * o[1] + p->n[2] * o[2] - p->d;
-    double kd = p->n[0] * d[0] + p->n[1] * d[1] + p->n[2] * d[2];
+    double base = vec3_dot(p->n, o) - p->d;
+    double kd = vec3_dot(p->n, d);
     /* The plane's own span [a, b] within [s0, s1], as plane_span has it. */
     double a = s0, b = s1;
     if (kd == 0) {

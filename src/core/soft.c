@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/vec.h"
+
 /* eq. (1) as a cubic in s = r^2/R^2: C = 1 + A1 s + A2 s^2 + A3 s^3. */
 #define A1 (-22.0 / 9.0)
 #define A2 (17.0 / 9.0)
@@ -312,17 +314,12 @@ static void apply_a(const skey_t *k, const double p[3], double ap[3])
   }
 }
 
-static double dot3(const double a[3], const double b[3])
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* s of eq. (1) (r^2/R^2, or u'Mu/R^2 for a quadric, eq. 5) for key k at the
  * point whose offset from the centre is p, with A p into ap. */
 static double key_s(const skey_t *k, const double p[3], double ap[3])
 {
   apply_a(k, p, ap);
-  return dot3(p, ap) + k->k;
+  return vec3_dot(p, ap) + k->k;
 }
 
 /* eq. (1), summed (the paper's "sum of the effects of the individual keys"):
@@ -474,7 +471,7 @@ static int hit_key(const ray_t *r, const skey_t *k, double *te, double *tx)
   double p[3] = {r->o[0] - k->x0[0], r->o[1] - k->x0[1], r->o[2] - k->x0[2]};
   double ad[3], ap[3];
   apply_a(k, r->d, ad);
-  double a2 = dot3(r->d, ad), b = dot3(p, ad);
+  double a2 = vec3_dot(r->d, ad), b = vec3_dot(p, ad);
   double tc = -b / a2;
   double pc[3] = {p[0] + tc * r->d[0], p[1] + tc * r->d[1], p[2] + tc * r->d[2]};
   double smin = key_s(k, pc, ap);
@@ -502,7 +499,7 @@ static void interval_s(const soft_obj *o, const ray_t *r, const kev_t *act,
     double p[3] = {x[0] - k->x0[0], x[1] - k->x0[1], x[2] - k->x0[2]}, ap[3], ad[3];
     double s0 = key_s(k, p, ap);
     apply_a(k, r->d, ad);
-    double s1 = 2 * h * dot3(r->d, ap), s2 = h * h * dot3(r->d, ad);
+    double s1 = 2 * h * vec3_dot(r->d, ap), s2 = h * h * vec3_dot(r->d, ad);
     sq[3 * j] = s0; sq[3 * j + 1] = s1; sq[3 * j + 2] = s2;
     double smax = s0 + fabs(s1) + s2;
     double smin = fabs(s1) < 2 * s2 ? s0 - s1 * s1 / (4 * s2) : s0 - fabs(s1) + s2;

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "core/bounds.h"
+#include "core/vec.h"
 #include "scene/ray.h"
 
 #define TILE 16
@@ -75,14 +76,6 @@ static int shape_add(Shape *s, const double n[3], double d) {
   return 0;
 }
 
-static void cross3(const double a[3], const double b[3], double c[3]) {
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-static double dot3(const double a[3], const double b[3]) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 
 /* The box of the convex set {x : n_j . x <= d_j} (unit normals). It is
    bounded iff its recession cone {u : n_j . u <= 0} is {0}; the cone's
@@ -96,17 +89,17 @@ static Box convex_box(const Shape *s) {
   for (int j = 0; j < n; j++)
     for (int k = j + 1; k < n; k++) {
       double u[3];
-      cross3(s->pl[j], s->pl[k], u);
-      double len = sqrt(dot3(u, u));
+      vec3_cross(s->pl[j], s->pl[k], u);
+      double len = sqrt(vec3_dot(u, u));
       if (len < 1e-12) continue;
       for (int sgn = -1; sgn <= 1; sgn += 2) {
         int ray = 1;
         for (int i = 0; i < n && ray; i++)
-          if (sgn * dot3(s->pl[i], u) / len > 1e-12) ray = 0;
+          if (sgn * vec3_dot(s->pl[i], u) / len > 1e-12) ray = 0;
         if (ray) return box_all();
       }
       for (int i = 0; i < n && !rank3; i++)
-        if (fabs(dot3(s->pl[i], u)) / len > 1e-9) rank3 = 1;
+        if (fabs(vec3_dot(s->pl[i], u)) / len > 1e-9) rank3 = 1;
     }
   if (!rank3) return box_all();
   Box b = box_empty();
@@ -117,17 +110,17 @@ static Box convex_box(const Shape *s) {
       for (int e = c + 1; e < n; e++) {
         const double *p = s->pl[a], *q = s->pl[c], *r = s->pl[e];
         double qr[3], rp[3], pq[3];
-        cross3(q, r, qr);
-        cross3(r, p, rp);
-        cross3(p, q, pq);
-        double det = dot3(p, qr);
+        vec3_cross(q, r, qr);
+        vec3_cross(r, p, rp);
+        vec3_cross(p, q, pq);
+        double det = vec3_dot(p, qr);
         if (fabs(det) < 1e-12) continue;
         double v[3];
         for (int i = 0; i < 3; i++)
           v[i] = (p[3] * qr[i] + q[3] * rp[i] + r[3] * pq[i]) / det;
         int inside = 1;
         for (int i = 0; i < n && inside; i++)
-          if (dot3(s->pl[i], v) > s->pl[i][3] + 1e-9 * scale) inside = 0;
+          if (vec3_dot(s->pl[i], v) > s->pl[i][3] + 1e-9 * scale) inside = 0;
         if (!inside) continue;
         for (int i = 0; i < 3; i++) {
           b.lo[i] = fmin(b.lo[i], v[i]);
@@ -415,9 +408,9 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
   const ScNode *n = &s->nodes[node];
   switch (n->kind) {
   case SC_HALFSPACE: {
-    double nd = dot3(n->n, d);
+    double nd = vec3_dot(n->n, d);
     if (nd == 0) return 0;
-    double t = (n->d - dot3(n->n, o)) / nd;
+    double t = (n->d - vec3_dot(n->n, o)) / nd;
     if (!(t > t0 && t < t1)) return 0;
     h->t = t;
     h->id = node;
@@ -577,21 +570,21 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
   } else {
     ray_normal(T->s, h.id, h.flip, p, n);
   }
-  if (dot3(n, d) > 0)
+  if (vec3_dot(n, d) > 0)
     for (int i = 0; i < 3; i++) n[i] = -n[i];
   *z = h.t; /* d is unit length: t is the distance */
   memcpy(nrm, n, sizeof n);
   const double *col = T->prims[h.prim].colour;
   for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
-  double scale = fmax(1.0, sqrt(dot3(p, p)));
+  double scale = fmax(1.0, sqrt(vec3_dot(p, p)));
   double eps = T->eps * scale;
   for (int l = 0; l < T->nlights; l++) {
     double L[3];
     for (int i = 0; i < 3; i++) L[i] = T->lights[l][i] - p[i];
-    double dist = sqrt(dot3(L, L));
+    double dist = sqrt(vec3_dot(L, L));
     if (!(dist > 0)) continue;
     for (int i = 0; i < 3; i++) L[i] /= dist;
-    double ndl = dot3(n, L);
+    double ndl = vec3_dot(n, L);
     if (ndl <= 0) continue;
     if (rs->shadows) {
       double so[3];
@@ -601,10 +594,10 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
       if (trace(T, so, L, 0, dist, c, &sh, 1)) continue;
     }
     double H[3] = {L[0] - d[0], L[1] - d[1], L[2] - d[2]};
-    double hl = sqrt(dot3(H, H));
+    double hl = sqrt(vec3_dot(H, H));
     double spec = 0;
     if (hl > 0) {
-      double ndh = dot3(n, H) / hl;
+      double ndh = vec3_dot(n, H) / hl;
       if (ndh > 0) { /* 0.3 ndh^32 by five squarings */
         double p2 = ndh * ndh, p4 = p2 * p2, p8 = p4 * p4, p16 = p8 * p8;
         spec = 0.3 * p16 * p16;
@@ -623,7 +616,7 @@ static void camera_ray(const Tracer *T, double px, double py, double d[3]) {
   double u = (2 * px / rs->width - 1) * h * aspect;
   double v = (1 - 2 * py / rs->height) * h;
   for (int i = 0; i < 3; i++) d[i] = T->fwd[i] + u * T->right[i] + v * T->upv[i];
-  double len = sqrt(dot3(d, d));
+  double len = sqrt(vec3_dot(d, d));
   for (int i = 0; i < 3; i++) d[i] /= len;
 }
 
@@ -735,7 +728,7 @@ static int setup_camera(Tracer *T, char *err, size_t errlen) {
     /* Frame the bounds: look at their centre from the front, above and to
        the right, far enough that the bounding sphere fits the view. */
     double dir[3] = {0.45, 0.6, 1};
-    double len = sqrt(dot3(dir, dir));
+    double len = sqrt(vec3_dot(dir, dir));
     double dist = R / sin(fmin(rs->fov, 120) * M_PI / 360) * 1.05;
     for (int i = 0; i < 3; i++) {
       at[i] = c[i];
@@ -752,20 +745,20 @@ static int setup_camera(Tracer *T, char *err, size_t errlen) {
       T->coord_scale = fmax(T->coord_scale, fmax(fabs(all.lo[i]), fabs(all.hi[i])));
   }
   for (int i = 0; i < 3; i++) T->fwd[i] = at[i] - eye[i];
-  double fl = sqrt(dot3(T->fwd, T->fwd));
+  double fl = sqrt(vec3_dot(T->fwd, T->fwd));
   if (!(fl > 0) || !isfinite(fl)) {
     snprintf(err, errlen, "the camera's eye and at must differ");
     return -1;
   }
   for (int i = 0; i < 3; i++) T->fwd[i] /= fl;
-  cross3(T->fwd, rs->up, T->right);
-  double rl = sqrt(dot3(T->right, T->right));
+  vec3_cross(T->fwd, rs->up, T->right);
+  double rl = sqrt(vec3_dot(T->right, T->right));
   if (!(rl > 1e-12)) {
     snprintf(err, errlen, "the camera's up direction is zero or parallel to its view");
     return -1;
   }
   for (int i = 0; i < 3; i++) T->right[i] /= rl;
-  cross3(T->right, T->fwd, T->upv);
+  vec3_cross(T->right, T->fwd, T->upv);
   if (rs->nlights) {
     T->nlights = rs->nlights;
     memcpy(T->lights, rs->lights, sizeof T->lights);
