@@ -1,8 +1,10 @@
 /* csg.c: sharp CSG tapes, point classification and Roth span lists. */
 #include "core/csg.h"
+#include "core/tape.h"
 #include "core/vec.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -161,50 +163,14 @@ int csg_builder_op(csg_builder *b, csg_op op) {
   return CSG_OK;
 }
 
-/* Sethi-Ullman reordering, as in density.c: the operand needing more
- * stack goes first (a difference then becomes CSG_RDIFF). */
+/* Operands of a csg tape (planes and constants), for tape_reorder. */
+static int operand(int op) { return op <= CSG_ALL; }
+
+/* Sethi-Ullman reordering (tape.h), which finds op as the first member. */
+_Static_assert(offsetof(csg_instr, op) == 0, "tape_reorder reads op first");
 static int reorder(const csg_instr *in, int n, csg_instr *out, int *depth) {
-  int *left = malloc(((size_t)n * 5 + 2) * sizeof(int));
-  if (!left) return CSG_ENOMEM;
-  int *right = left + n, *need = left + 2 * n, *stk = left + 3 * n;
-  int sp = 0;
-  for (int i = 0; i < n; i++) {
-    if (in[i].op <= CSG_ALL) {
-      left[i] = right[i] = -1;
-      need[i] = 1;
-    } else {
-      right[i] = stk[--sp];
-      left[i] = stk[--sp];
-      int nl = need[left[i]], nr = need[right[i]];
-      need[i] = nl == nr ? nl + 1 : (nl > nr ? nl : nr);
-    }
-    stk[sp++] = i;
-  }
-  *depth = need[n - 1];
-  int no = 0;
-  sp = 0;
-  stk[sp++] = n - 1;
-  while (sp) {
-    int e = stk[--sp];
-    if (e < 0) {
-      int i = ~e;
-      csg_instr o = in[i];
-      if (need[right[i]] > need[left[i]]) {
-        if (o.op == CSG_DIFF) o.op = CSG_RDIFF;
-        else if (o.op == CSG_RDIFF) o.op = CSG_DIFF;
-      }
-      out[no++] = o;
-      continue;
-    }
-    if (left[e] < 0) { out[no++] = in[e]; continue; }
-    int first = left[e], second = right[e];
-    if (need[second] > need[first]) { first = right[e]; second = left[e]; }
-    stk[sp++] = ~e;
-    stk[sp++] = second;
-    stk[sp++] = first;
-  }
-  free(left);
-  return CSG_OK;
+  return tape_reorder(in, out, sizeof *in, n, operand, CSG_DIFF, CSG_RDIFF,
+                      depth) == TAPE_OK ? CSG_OK : CSG_ENOMEM;
 }
 
 /* The ray program of t (csg.h): maximal subtrees of intersected planes

@@ -1,8 +1,10 @@
 /* density.c: building and evaluating density tapes (paper Section 2). */
 #include "core/density.h"
+#include "core/tape.h"
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -100,51 +102,14 @@ int dt_builder_op(dt_builder *b, dt_op op) {
   return DT_OK;
 }
 
-/* Sethi-Ullman reordering: emit the operand that needs more stack first,
- * so a tree of n leaves needs at most log2(n)+1 slots.  Iterative, since
- * builder trees may be long chains. */
+/* Operands of a density tape, for tape_reorder. */
+static int operand(int op) { return op == DT_LEAF || op == DT_CONST; }
+
+/* Sethi-Ullman reordering (tape.h), which finds op as the first member. */
+_Static_assert(offsetof(dt_instr, op) == 0, "tape_reorder reads op first");
 static int reorder(const dt_instr *in, int n, dt_instr *out, int *depth) {
-  /* stk needs up to 2 entries per tree level plus one: 2n + 2 ints. */
-  int *left = malloc(((size_t)n * 5 + 2) * sizeof(int));
-  if (!left) return DT_ENOMEM;
-  int *right = left + n, *need = left + 2 * n, *stk = left + 3 * n;
-  int sp = 0;
-  for (int i = 0; i < n; i++) {
-    if (in[i].op == DT_LEAF || in[i].op == DT_CONST) {
-      left[i] = right[i] = -1;
-      need[i] = 1;
-    } else {
-      right[i] = stk[--sp];
-      left[i] = stk[--sp];
-      int nl = need[left[i]], nr = need[right[i]];
-      need[i] = nl == nr ? nl + 1 : (nl > nr ? nl : nr);
-    }
-    stk[sp++] = i;
-  }
-  *depth = need[n - 1];
-  /* Explicit DFS: stk holds nodes, the sign bit of an entry marks "both
-   * children emitted". */
-  int no = 0;
-  sp = 0;
-  stk[sp++] = n - 1;
-  while (sp) {
-    int e = stk[--sp];
-    if (e < 0) {
-      int i = ~e;
-      dt_instr o = in[i];
-      if (need[right[i]] > need[left[i]] && o.op == DT_DIFF) o.op = DT_RDIFF;
-      out[no++] = o;
-      continue;
-    }
-    if (left[e] < 0) { out[no++] = in[e]; continue; }
-    int first = left[e], second = right[e];
-    if (need[second] > need[first]) { first = right[e]; second = left[e]; }
-    stk[sp++] = ~e;
-    stk[sp++] = second;
-    stk[sp++] = first;
-  }
-  free(left);
-  return DT_OK;
+  return tape_reorder(in, out, sizeof *in, n, operand, DT_DIFF, DT_RDIFF,
+                      depth) == TAPE_OK ? DT_OK : DT_ENOMEM;
 }
 
 static void tape_range(dt_tape *t) {
