@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "core/bounds.h"
+#include "core/bvh.h"
 #include "core/vec.h"
 #include "scene/ray.h"
 
@@ -239,12 +240,6 @@ typedef struct Prim {
   double colour[3];
 } Prim;
 
-typedef struct BvhNode {
-  Box box;
-  int left, right;   /* children, or -1 */
-  int first, count;  /* prims of a leaf */
-} BvhNode;
-
 typedef struct Tracer {
   const Scene *s;
   const RenderSettings *rs;
@@ -252,8 +247,7 @@ typedef struct Tracer {
   int nprims, capprims;
   int *bounded, nbounded;     /* prim indices in BVH order */
   int *unbounded, nunbounded;
-  BvhNode *bvh;
-  int nbvh;
+  bvh bvh;                    /* over the bounded prims (core/bvh.h) */
   double eye[3], fwd[3], right[3], upv[3];
   double coord_scale;       /* the largest |coordinate| of the eye and bounds */
   double lights[RENDER_MAX_LIGHTS][3];
@@ -318,60 +312,41 @@ static int collect_prims(Tracer *T, int node, const double *colour) {
   return add_prim(T, node, colour);
 }
 
-static int build_bvh(Tracer *T, int first, int count) {
-  int idx = T->nbvh++;
-  BvhNode *b = &T->bvh[idx];
-  b->left = b->right = -1;
-  b->box = box_empty();
-  for (int i = first; i < first + count; i++)
-    b->box = box_union(b->box, T->prims[T->bounded[i]].box);
-  if (count <= 2) {
-    b->first = first;
-    b->count = count;
-    return idx;
-  }
-  /* Median split along the widest spread of centres. */
-  double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int i = first; i < first + count; i++)
-    for (int k = 0; k < 3; k++) {
+/* The BVH over the bounded prims: median split on the widest spread of
+   box centres, leaves of 2, ties in prim order (BVH_SORT); bounded is then
+   put in leaf order. */
+static int build_bvh(Tracer *T) {
+  int n = T->nbounded, err = BVH_ENOMEM;
+  bvh_item *it = malloc(sizeof *it * (size_t)n);
+  int *order = malloc(sizeof *order * (size_t)n);
+  if (it && order) {
+    for (int i = 0; i < n; i++) {
       const Box *pb = &T->prims[T->bounded[i]].box;
-      double c = 0.5 * (pb->lo[k] + pb->hi[k]);
-      clo[k] = fmin(clo[k], c);
-      chi[k] = fmax(chi[k], c);
+      for (int k = 0; k < 3; k++) {
+        it[i].lo[k] = pb->lo[k];
+        it[i].hi[k] = pb->hi[k];
+        it[i].c[k] = 0.5 * (pb->lo[k] + pb->hi[k]);
+      }
     }
-  int axis = 0;
-  for (int k = 1; k < 3; k++)
-    if (chi[k] - clo[k] > chi[axis] - clo[axis]) axis = k;
-  /* Insertion-free selection: sort this range by centre on the axis. */
-  for (int i = first + 1; i < first + count; i++) {
-    int v = T->bounded[i], j = i - 1;
-    const Box *vb = &T->prims[v].box;
-    double cv = vb->lo[axis] + vb->hi[axis];
-    while (j >= first) {
-      const Box *jb = &T->prims[T->bounded[j]].box;
-      if (jb->lo[axis] + jb->hi[axis] <= cv) break;
-      T->bounded[j + 1] = T->bounded[j];
-      j--;
-    }
-    T->bounded[j + 1] = v;
+    err = bvh_build(&T->bvh, it, n, 2, BVH_SORT);
   }
-  int half = count / 2;
-  int l = build_bvh(T, first, half);
-  int r = build_bvh(T, first + half, count - half);
-  T->bvh[idx].left = l;
-  T->bvh[idx].right = r;
-  T->bvh[idx].count = 0;
-  return idx;
+  if (!err) {
+    for (int i = 0; i < n; i++) order[i] = T->bounded[T->bvh.idx[i]];
+    memcpy(T->bounded, order, sizeof *order * (size_t)n);
+  }
+  free(it);
+  free(order);
+  return err;
 }
 
 /* Slab test: the part of [t0, t1] inside the box. */
-static int box_hit(const Box *b, const double o[3], const double inv[3],
-                   double t0, double t1, double *enter) {
+static int box_hit(const double lo[3], const double hi[3], const double o[3],
+                   const double inv[3], double t0, double t1, double *enter) {
   for (int k = 0; k < 3; k++) {
-    double a = (b->lo[k] - o[k]) * inv[k];
-    double c = (b->hi[k] - o[k]) * inv[k];
+    double a = (lo[k] - o[k]) * inv[k];
+    double c = (hi[k] - o[k]) * inv[k];
     if (isnan(a) || isnan(c)) { /* parallel and on a slab plane */
-      if (o[k] < b->lo[k] || o[k] > b->hi[k]) return 0;
+      if (o[k] < lo[k] || o[k] > hi[k]) return 0;
       continue;
     }
     if (a > c) {
@@ -486,19 +461,20 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
       if (any) return 1;
     }
   }
-  if (!T->nbvh) return found;
+  if (!T->bvh.nnodes) return found;
   double inv[3] = {1 / d[0], 1 / d[1], 1 / d[2]};
-  int stack[128], sp = 0;
+  int stack[BVH_STACK], sp = 0;   /* enough for any tree (core/bvh.h) */
   stack[sp++] = 0;
   while (sp) {
-    const BvhNode *b = &T->bvh[stack[--sp]];
+    const bvh_node *b = &T->bvh.nodes[stack[--sp]];
     double enter;
-    if (!box_hit(&b->box, o, inv, t0, t1, &enter)) continue;
-    if (b->count || b->left < 0) {
+    if (!box_hit(b->lo, b->hi, o, inv, t0, t1, &enter)) continue;
+    if (b->count) {
       for (int i = b->first; i < b->first + b->count; i++) {
         int pi = T->bounded[i];
+        const Box *pb = &T->prims[pi].box;
         double e2;
-        if (!box_hit(&T->prims[pi].box, o, inv, t0, t1, &e2)) continue;
+        if (!box_hit(pb->lo, pb->hi, o, inv, t0, t1, &e2)) continue;
         Hit h;
         if (prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
           *best = h;
@@ -510,22 +486,22 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
       continue;
     }
     /* Visit the nearer child first. */
+    const bvh_node *l = &T->bvh.nodes[b->first], *r = l + 1;
     double el = INFINITY, er = INFINITY;
-    int hl = box_hit(&T->bvh[b->left].box, o, inv, t0, t1, &el);
-    int hr = box_hit(&T->bvh[b->right].box, o, inv, t0, t1, &er);
-    if (sp + 2 > 128) continue;
+    int hl = box_hit(l->lo, l->hi, o, inv, t0, t1, &el);
+    int hr = box_hit(r->lo, r->hi, o, inv, t0, t1, &er);
     if (hl && hr) {
       if (el < er) {
-        stack[sp++] = b->right;
-        stack[sp++] = b->left;
+        stack[sp++] = b->first + 1;
+        stack[sp++] = b->first;
       } else {
-        stack[sp++] = b->left;
-        stack[sp++] = b->right;
+        stack[sp++] = b->first;
+        stack[sp++] = b->first + 1;
       }
     } else if (hl) {
-      stack[sp++] = b->left;
+      stack[sp++] = b->first;
     } else if (hr) {
-      stack[sp++] = b->right;
+      stack[sp++] = b->first + 1;
     }
   }
   return found;
@@ -813,14 +789,13 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   if (collect_prims(&T, s->root, NULL)) goto oom;
   T.bounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
   T.unbounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
-  T.bvh = malloc(sizeof(BvhNode) * (size_t)(2 * T.nprims + 1));
-  if (!T.bounded || !T.unbounded || !T.bvh) goto oom;
+  if (!T.bounded || !T.unbounded) goto oom;
   for (int i = 0; i < T.nprims; i++) {
     if (box_is_empty(&T.prims[i].box)) continue; /* nothing to see */
     if (T.prims[i].bounded) T.bounded[T.nbounded++] = i;
     else T.unbounded[T.nunbounded++] = i;
   }
-  if (T.nbounded) build_bvh(&T, 0, T.nbounded);
+  if (T.nbounded && build_bvh(&T)) goto oom;
   if (setup_camera(&T, err, errlen)) goto fail;
   im = img_new(rs->width, rs->height, rs->aovs);
   if (!im) goto oom;
@@ -894,7 +869,7 @@ done:
   free(T.prims);
   free(T.bounded);
   free(T.unbounded);
-  free(T.bvh);
+  bvh_free(&T.bvh);
   pthread_mutex_destroy(&T.lock);
   return im;
 }
