@@ -6,8 +6,10 @@
  * Product, Difference and the density Union a+b-ab) and finished into a
  * dt_tape: a flat array of instructions evaluated with a small fixed
  * stack, no pointer chasing and no allocation per evaluation.  Finishing
- * reorders the tape (Sethi-Ullman) so any tree needs at most DT_STACK_MAX
- * stack slots.
+ * reorders the tape (Sethi-Ullman, tape.h) so any tree needs at most
+ * DT_STACK_MAX stack slots.  The kernel of eq. (2) and the interval rules
+ * of the ops (interval.h) are defined here once, static inline, for every
+ * evaluator of the core.
  *
  * Memory: dt_builder_new returns a builder owned by the caller; it is
  * freed by dt_builder_finish (which always consumes it) or by
