@@ -22,6 +22,7 @@
  * and at every node: outer = Empty if hi <= t, Everything if t < lo;
  * inner = Everything if lo >= t, Empty if hi < t. */
 #include "core/bounds.h"
+#include "core/tape.h"
 
 #include <float.h>
 #include <math.h>
@@ -171,48 +172,26 @@ static csg_tape *bound(const dt_tape *tp, double level, int kind, int *flagp) {
   int n = tp->ncode, flags = 0;
   node *nd = calloc((size_t)n, sizeof *nd);
   double *lo = malloc((size_t)n * 2 * sizeof(double));
-  int *left = malloc((size_t)n * 3 * sizeof(int));
+  int *left = malloc((size_t)n * 3 * sizeof(int) + (size_t)n);
   csg_builder *b = csg_builder_new();
   csg_tape *out = NULL;
   if (!nd || !lo || !left || !b) goto done;
   double *hi = lo + n;
-  int *right = left + n, *stk = left + 2 * n, sp = 0;
-  /* Tree shape and exact ranges (leaves in [0,1]). */
+  int *right = left + n, *stk = left + 2 * n;
+  unsigned char *leaf = (unsigned char *)(left + 3 * n);
+  /* Tree shape (tape.h) and exact ranges (leaves in [0,1]). */
+  for (int i = 0; i < n; i++)
+    leaf[i] = tp->code[i].op == DT_LEAF || tp->code[i].op == DT_CONST;
+  tape_shape(leaf, n, left, right, stk);
   for (int i = 0; i < n; i++) {
     const dt_instr *in = &tp->code[i];
-    left[i] = right[i] = -1;
     if (in->op == DT_LEAF) { lo[i] = 0; hi[i] = 1; }
     else if (in->op == DT_CONST) { lo[i] = hi[i] = in->c; }
     else {
-      right[i] = stk[--sp];
-      left[i] = stk[--sp];
       int x = left[i], y = right[i];
-      double a[4] = {lo[x], hi[x], lo[y], hi[y]}, l = 0, h = 0;
-      switch (in->op) {
-      case DT_SUM: l = a[0] + a[2]; h = a[1] + a[3]; break;
-      case DT_DIFF: l = a[0] - a[3]; h = a[1] - a[2]; break;
-      case DT_RDIFF: l = a[2] - a[1]; h = a[3] - a[0]; break;
-      case DT_PRODUCT:
-      case DT_UNION: {
-        /* Union 1 - (1-x)(1-y) as a product of complements. */
-        int u = in->op == DT_UNION;
-        double p0 = u ? 1 - a[1] : a[0], p1 = u ? 1 - a[0] : a[1];
-        double q0 = u ? 1 - a[3] : a[2], q1 = u ? 1 - a[2] : a[3];
-        double pr[4] = {p0 * q0, p0 * q1, p1 * q0, p1 * q1};
-        l = h = pr[0];
-        for (int k = 1; k < 4; k++) {
-          if (pr[k] < l) l = pr[k];
-          if (pr[k] > h) h = pr[k];
-        }
-        if (u) { double tmp = l; l = 1 - h; h = 1 - tmp; }
-        break;
-      }
-      }
-      lo[i] = l;
-      hi[i] = h;
+      dt_range_op(in->op, lo[x], hi[x], lo[y], hi[y], &lo[i], &hi[i]);
     }
     if (hi[i] > 1) flags |= BND_RANGE;
-    stk[sp++] = i;
   }
   /* Top-down decisions. */
   request(nd, n - 1, kind, level);

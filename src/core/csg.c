@@ -1,7 +1,10 @@
 /* csg.c: sharp CSG tapes, point classification and Roth span lists. */
 #include "core/csg.h"
+#include "core/tape.h"
+#include "core/vec.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -160,50 +163,14 @@ int csg_builder_op(csg_builder *b, csg_op op) {
   return CSG_OK;
 }
 
-/* Sethi-Ullman reordering, as in density.c: the operand needing more
- * stack goes first (a difference then becomes CSG_RDIFF). */
+/* Operands of a csg tape (planes and constants), for tape_reorder. */
+static int operand(int op) { return op <= CSG_ALL; }
+
+/* Sethi-Ullman reordering (tape.h), which finds op as the first member. */
+_Static_assert(offsetof(csg_instr, op) == 0, "tape_reorder reads op first");
 static int reorder(const csg_instr *in, int n, csg_instr *out, int *depth) {
-  int *left = malloc(((size_t)n * 5 + 2) * sizeof(int));
-  if (!left) return CSG_ENOMEM;
-  int *right = left + n, *need = left + 2 * n, *stk = left + 3 * n;
-  int sp = 0;
-  for (int i = 0; i < n; i++) {
-    if (in[i].op <= CSG_ALL) {
-      left[i] = right[i] = -1;
-      need[i] = 1;
-    } else {
-      right[i] = stk[--sp];
-      left[i] = stk[--sp];
-      int nl = need[left[i]], nr = need[right[i]];
-      need[i] = nl == nr ? nl + 1 : (nl > nr ? nl : nr);
-    }
-    stk[sp++] = i;
-  }
-  *depth = need[n - 1];
-  int no = 0;
-  sp = 0;
-  stk[sp++] = n - 1;
-  while (sp) {
-    int e = stk[--sp];
-    if (e < 0) {
-      int i = ~e;
-      csg_instr o = in[i];
-      if (need[right[i]] > need[left[i]]) {
-        if (o.op == CSG_DIFF) o.op = CSG_RDIFF;
-        else if (o.op == CSG_RDIFF) o.op = CSG_DIFF;
-      }
-      out[no++] = o;
-      continue;
-    }
-    if (left[e] < 0) { out[no++] = in[e]; continue; }
-    int first = left[e], second = right[e];
-    if (need[second] > need[first]) { first = right[e]; second = left[e]; }
-    stk[sp++] = ~e;
-    stk[sp++] = second;
-    stk[sp++] = first;
-  }
-  free(left);
-  return CSG_OK;
+  return tape_reorder(in, out, sizeof *in, n, operand, CSG_DIFF, CSG_RDIFF,
+                      depth) == TAPE_OK ? CSG_OK : CSG_ENOMEM;
 }
 
 /* The ray program of t (csg.h): maximal subtrees of intersected planes
@@ -319,7 +286,7 @@ int csg_inside(const csg_tape *t, const double p[3]) {
     switch (in->op) {
     case CSG_PLANE: {
       const csg_plane *pl = &t->planes[in->arg];
-      st[sp++] = pl->n[0] * p[0] + pl->n[1] * p[1] + pl->n[2] * p[2] < pl->d;
+      st[sp++] = vec3_dot(pl->n, p) < pl->d;
       break;
     }
     case CSG_EMPTY: st[sp++] = 0; break;
@@ -413,8 +380,8 @@ int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
  * are fine: t* = -s0/k scales with 1/|d| exactly as the parameter does. */
 static int plane_span(const csg_plane *p, int id, const double o[3],
                       const double d[3], double s0, double s1, csg_span *out) {
-  double base = p->n[0] * o[0] + p->n[1] * o[1] + p->n[2] * o[2] - p->d;
-  double k = p->n[0] * d[0] + p->n[1] * d[1] + p->n[2] * d[2];
+  double base = vec3_dot(p->n, o) - p->d;
+  double k = vec3_dot(p->n, d);
   csg_span s = {s0, s1, -1, -1, 0, 0};
   if (k == 0) {
     if (!(base < 0)) return 0;
@@ -444,8 +411,8 @@ static int convex_span(const csg_tape *t, int g, const double o[3],
   const struct csg_gplane *end = t->gpl + t->gstart[g + 1];
   for (; p < end; p++) {
     int id = p->id;
-    double base = p->n[0] * o[0] + p->n[1] * o[1] + p->n[2] * o[2] - p->d;
-    double kd = p->n[0] * d[0] + p->n[1] * d[1] + p->n[2] * d[2];
+    double base = vec3_dot(p->n, o) - p->d;
+    double kd = vec3_dot(p->n, d);
     /* The plane's own span [a, b] within [s0, s1], as plane_span has it. */
     double a = s0, b = s1;
     if (kd == 0) {

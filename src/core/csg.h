@@ -4,8 +4,8 @@
  * Leaves are sharp halfspaces n.x < d (n normalised when the leaf is
  * added) or the constants Empty and Everything; ops are Union,
  * Intersection and Difference.  Constants are folded as the tape is
- * built, and finishing reorders it (Sethi-Ullman) so evaluation needs at
- * most CSG_STACK_MAX stack slots.  The bounds of bounds.h are csg tapes.
+ * built, and finishing reorders it (Sethi-Ullman, tape.h) so evaluation
+ * needs at most CSG_STACK_MAX stack slots.  The bounds of bounds.h are csg tapes.
  *
  * Memory: csg_builder_new returns a builder owned by the caller, consumed
  * by csg_builder_finish (always) or freed by csg_builder_free; the

@@ -1,8 +1,10 @@
 /* density.c: building and evaluating density tapes (paper Section 2). */
 #include "core/density.h"
+#include "core/tape.h"
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -100,81 +102,14 @@ int dt_builder_op(dt_builder *b, dt_op op) {
   return DT_OK;
 }
 
-/* Interval product [a0,a1]*[b0,b1]. */
-static void imul(double a0, double a1, double b0, double b1,
-                 double *lo, double *hi) {
-  double p[4] = {a0 * b0, a0 * b1, a1 * b0, a1 * b1};
-  *lo = *hi = p[0];
-  for (int i = 1; i < 4; i++) {
-    if (p[i] < *lo) *lo = p[i];
-    if (p[i] > *hi) *hi = p[i];
-  }
-}
+/* Operands of a density tape, for tape_reorder. */
+static int operand(int op) { return op == DT_LEAF || op == DT_CONST; }
 
-/* The range of each op's result from its operands' ranges: x below, y on
- * top.  Shared by the tape's M bound and (through lg.c's own copy of the
- * rules) the per-segment bounds. */
-static void range_op(int op, double xl, double xh, double yl, double yh,
-                     double *lo, double *hi) {
-  switch (op) {
-  case DT_SUM: *lo = xl + yl; *hi = xh + yh; break;
-  case DT_DIFF: *lo = xl - yh; *hi = xh - yl; break;
-  case DT_RDIFF: *lo = yl - xh; *hi = yh - xl; break;
-  case DT_PRODUCT: imul(xl, xh, yl, yh, lo, hi); break;
-  default: { /* DT_UNION: 1 - (1-x)(1-y) */
-    double l, h;
-    imul(1 - xh, 1 - xl, 1 - yh, 1 - yl, &l, &h);
-    *lo = 1 - h;
-    *hi = 1 - l;
-  }
-  }
-}
-
-/* Sethi-Ullman reordering: emit the operand that needs more stack first,
- * so a tree of n leaves needs at most log2(n)+1 slots.  Iterative, since
- * builder trees may be long chains. */
+/* Sethi-Ullman reordering (tape.h), which finds op as the first member. */
+_Static_assert(offsetof(dt_instr, op) == 0, "tape_reorder reads op first");
 static int reorder(const dt_instr *in, int n, dt_instr *out, int *depth) {
-  /* stk needs up to 2 entries per tree level plus one: 2n + 2 ints. */
-  int *left = malloc(((size_t)n * 5 + 2) * sizeof(int));
-  if (!left) return DT_ENOMEM;
-  int *right = left + n, *need = left + 2 * n, *stk = left + 3 * n;
-  int sp = 0;
-  for (int i = 0; i < n; i++) {
-    if (in[i].op == DT_LEAF || in[i].op == DT_CONST) {
-      left[i] = right[i] = -1;
-      need[i] = 1;
-    } else {
-      right[i] = stk[--sp];
-      left[i] = stk[--sp];
-      int nl = need[left[i]], nr = need[right[i]];
-      need[i] = nl == nr ? nl + 1 : (nl > nr ? nl : nr);
-    }
-    stk[sp++] = i;
-  }
-  *depth = need[n - 1];
-  /* Explicit DFS: stk holds nodes, the sign bit of an entry marks "both
-   * children emitted". */
-  int no = 0;
-  sp = 0;
-  stk[sp++] = n - 1;
-  while (sp) {
-    int e = stk[--sp];
-    if (e < 0) {
-      int i = ~e;
-      dt_instr o = in[i];
-      if (need[right[i]] > need[left[i]] && o.op == DT_DIFF) o.op = DT_RDIFF;
-      out[no++] = o;
-      continue;
-    }
-    if (left[e] < 0) { out[no++] = in[e]; continue; }
-    int first = left[e], second = right[e];
-    if (need[second] > need[first]) { first = right[e]; second = left[e]; }
-    stk[sp++] = ~e;
-    stk[sp++] = second;
-    stk[sp++] = first;
-  }
-  free(left);
-  return DT_OK;
+  return tape_reorder(in, out, sizeof *in, n, operand, DT_DIFF, DT_RDIFF,
+                      depth) == TAPE_OK ? DT_OK : DT_ENOMEM;
 }
 
 static void tape_range(dt_tape *t) {
@@ -185,8 +120,8 @@ static void tape_range(dt_tape *t) {
     if (in->op == DT_LEAF) { lo[sp] = 0; hi[sp] = 1; sp++; continue; }
     if (in->op == DT_CONST) { lo[sp] = hi[sp] = in->c; sp++; continue; }
     sp--;
-    range_op(in->op, lo[sp - 1], hi[sp - 1], lo[sp], hi[sp],
-             &lo[sp - 1], &hi[sp - 1]);
+    dt_range_op(in->op, lo[sp - 1], hi[sp - 1], lo[sp], hi[sp],
+                &lo[sp - 1], &hi[sp - 1]);
   }
   t->lo = lo[0];
   t->hi = hi[0];
@@ -231,20 +166,6 @@ double dt_max(const dt_tape *t) {
   return t->hi;
 }
 
-/* eq. (2): alpha = s/r; (1-alpha)^2 (2+alpha)/4 inside the filter. */
-double dt_halfspace(double s, double r) {
-  if (r <= 0) return s < 0 ? 1.0 : (s > 0 ? 0.0 : 0.5);
-  double a = s / r;
-  if (a >= 1) return 0;
-  if (a <= -1) return 1;
-  return (1 - a) * (1 - a) * (2 + a) * 0.25;
-}
-
-/* Signed distance of p from a leaf's plane, positive outside. */
-static double leaf_dist(const dt_leaf *lf, const double p[3]) {
-  return lf->n[0] * p[0] + lf->n[1] * p[1] + lf->n[2] * p[2] - lf->d;
-}
-
 /* Apply a binary op to stack values x (below) and y (top). */
 static double apply(int op, double x, double y) {
   switch (op) {
@@ -264,7 +185,7 @@ double dt_density(const dt_tape *t, const double p[3]) {
     const dt_instr *in = &t->code[i];
     if (in->op == DT_LEAF) {
       const dt_leaf *lf = &t->leaves[in->arg];
-      st[sp++] = dt_halfspace(leaf_dist(lf, p), lf->r);
+      st[sp++] = dt_halfspace(dt_leaf_dist(lf, p), lf->r);
     } else if (in->op == DT_CONST) {
       st[sp++] = in->c;
     } else {
@@ -273,15 +194,6 @@ double dt_density(const dt_tape *t, const double p[3]) {
     }
   }
   return st[0];
-}
-
-/* Value and derivative of one leaf as a function of alpha = s/r:
- * rho = (1-a)^2(2+a)/4, drho/da = 3/4 (a^2 - 1) (Section 2.4). */
-static double leaf_va(double a, double *dda) {
-  if (a >= 1) { *dda = 0; return 0; }
-  if (a <= -1) { *dda = 0; return 1; }
-  *dda = 0.75 * (a * a - 1);
-  return (1 - a) * (1 - a) * (2 + a) * 0.25;
 }
 
 /* Section 2.4: gradient by the usual differentiation rules. */
@@ -296,8 +208,8 @@ double dt_density_grad(const dt_tape *t, const double p[3], double grad[3]) {
     const dt_instr *in = &t->code[i];
     if (in->op == DT_LEAF) {
       const dt_leaf *lf = &t->leaves[in->arg];
-      double s = leaf_dist(lf, p), dda = 0;
-      if (lf->r > 0) v[sp] = leaf_va(s * lf->inv_r, &dda);
+      double s = dt_leaf_dist(lf, p), dda = 0;
+      if (lf->r > 0) v[sp] = dt_halfspace_da(s * lf->inv_r, &dda);
       else v[sp] = dt_halfspace(s, 0);
       z[sp] = dda == 0;
       if (!z[sp])
@@ -371,8 +283,8 @@ void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],
                    dt_ray_leaf *rl) {
   for (int i = 0; i < t->nleaves; i++) {
     const dt_leaf *lf = &t->leaves[i];
-    rl[i].base = leaf_dist(lf, o);
-    rl[i].nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+    rl[i].base = dt_leaf_dist(lf, o);
+    rl[i].nd = vec3_dot(lf->n, d);
   }
 }
 
@@ -388,7 +300,7 @@ double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
       const dt_leaf *lf = &t->leaves[in->arg];
       double nd = rl[in->arg].nd;
       double dist = rl[in->arg].base + s * nd, dda = 0;
-      if (lf->r > 0) v[sp] = leaf_va(dist * lf->inv_r, &dda);
+      if (lf->r > 0) v[sp] = dt_halfspace_da(dist * lf->inv_r, &dda);
       else v[sp] = dt_halfspace(dist, 0);
       dv[sp] = dda * nd * lf->inv_r;
       sp++;
@@ -576,8 +488,8 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
           base = rl[li].base;
           nd = rl[li].nd;
         } else {
-          nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
-          base = leaf_dist(lf, o);
+          nd = vec3_dot(lf->n, d);
+          base = dt_leaf_dist(lf, o);
         }
         double lc = leaf_const(lf, base, nd, s0, s1);
         if (lc == 0) { c = 0; break; }   /* a product with a 0 is 0 */

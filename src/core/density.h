@@ -6,8 +6,10 @@
  * Product, Difference and the density Union a+b-ab) and finished into a
  * dt_tape: a flat array of instructions evaluated with a small fixed
  * stack, no pointer chasing and no allocation per evaluation.  Finishing
- * reorders the tape (Sethi-Ullman) so any tree needs at most DT_STACK_MAX
- * stack slots.
+ * reorders the tape (Sethi-Ullman, tape.h) so any tree needs at most
+ * DT_STACK_MAX stack slots.  The kernel of eq. (2) and the interval rules
+ * of the ops (interval.h) are defined here once, static inline, for every
+ * evaluator of the core.
  *
  * Memory: dt_builder_new returns a builder owned by the caller; it is
  * freed by dt_builder_finish (which always consumes it) or by
@@ -20,6 +22,9 @@
 #define QCS_DENSITY_H
 
 #include <stddef.h>
+
+#include "core/interval.h"
+#include "core/vec.h"
 
 #define DT_STACK_MAX 64
 
@@ -107,9 +112,50 @@ void dt_builder_free(dt_builder *b);
 void dt_tape_free(dt_tape *t);
 const char *dt_strerror(int err);
 
+/* eq. (2), the smoothed-halfspace kernel, defined once here for every
+ * evaluator (density.c, lg.c, the study): in alpha = s/r, the density
+ * (1-alpha)^2 (2+alpha)/4 = 1/2 - 3/4 alpha + 1/4 alpha^3 inside the
+ * filter (|alpha| < 1), 1 for alpha <= -1 and 0 for alpha >= 1, and its
+ * derivative d rho/d alpha = 3/4 (alpha^2 - 1) (0 outside; Section 2.4)
+ * into *dda.  static inline: it is the innermost operation of every
+ * evaluation, and a caller that ignores *dda pays nothing for it. */
+static inline double dt_halfspace_da(double a, double *dda) {
+  if (a >= 1) { *dda = 0; return 0; }
+  if (a <= -1) { *dda = 0; return 1; }
+  *dda = 0.75 * (a * a - 1);
+  return (1 - a) * (1 - a) * (2 + a) * 0.25;
+}
+
+/* The kernel's value alone, in alpha. */
+static inline double dt_halfspace_a(double a) {
+  double dda;
+  return dt_halfspace_da(a, &dda);
+}
+
 /* eq. (2): one smoothed halfspace's density at signed distance s from its
  * plane (positive outside), radius r (r = 0: 1, 0.5, 0 for s <,=,> 0). */
-double dt_halfspace(double s, double r);
+static inline double dt_halfspace(double s, double r) {
+  if (r <= 0) return s < 0 ? 1.0 : (s > 0 ? 0.0 : 0.5);
+  return dt_halfspace_a(s / r);
+}
+
+/* Signed distance of p from a leaf's plane, positive outside. */
+static inline double dt_leaf_dist(const dt_leaf *lf, const double p[3]) {
+  return vec3_dot(lf->n, p) - lf->d;
+}
+
+/* The range of a density op's result (dt_op, not DT_LEAF/DT_CONST) from
+ * its operands' ranges, x below and y on top of the stack (interval.h). */
+static inline void dt_range_op(int op, double xl, double xh, double yl,
+                               double yh, double *lo, double *hi) {
+  switch (op) {
+  case DT_SUM: iv_add(xl, xh, yl, yh, lo, hi); break;
+  case DT_DIFF: iv_sub(xl, xh, yl, yh, lo, hi); break;
+  case DT_RDIFF: iv_sub(yl, yh, xl, xh, lo, hi); break;
+  case DT_PRODUCT: iv_mul(xl, xh, yl, yh, lo, hi); break;
+  default: iv_union(xl, xh, yl, yh, lo, hi); break;
+  }
+}
 
 /* Figure 4: the density at point p. */
 double dt_density(const dt_tape *t, const double p[3]);

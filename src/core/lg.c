@@ -25,13 +25,6 @@ static double maxabs(double lo, double hi) {
   return fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi);
 }
 
-/* dt_halfspace(a, 1) for a in [-1, 1], inline. */
-static inline double halfspace1(double a) {
-  if (a >= 1) return 0;
-  if (a <= -1) return 1;
-  return (1 - a) * (1 - a) * (2 + a) * 0.25;
-}
-
 /* eq. (2) and its alpha-derivatives over the segment for one leaf. */
 static void leaf_bounds(const dt_leaf *lf, double base, double nd, double a,
                         double b, double *lo, double *hi, double *L,
@@ -59,8 +52,8 @@ static void leaf_bounds(const dt_leaf *lf, double base, double nd, double a,
   }
   if (amin < -1) amin = -1;
   if (amax > 1) amax = 1;
-  *lo = halfspace1(amax);
-  *hi = halfspace1(amin);
+  *lo = dt_halfspace_a(amax);
+  *hi = dt_halfspace_a(amin);
   double near = amin <= 0 && amax >= 0 ? 0 : min2(fabs(amin), fabs(amax));
   double far = max2(fabs(amin), fabs(amax));
   double k = fabs(nd) * lf->inv_r;
@@ -85,8 +78,8 @@ static void eval_bounds(const dt_tape *t, const dt_ray_leaf *ray,
         base = ray[in->arg].base;
         nd = ray[in->arg].nd;
       } else {
-        nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
-        base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
+        nd = vec3_dot(lf->n, d);
+        base = dt_leaf_dist(lf, o);
       }
       leaf_bounds(lf, base, nd, a, b, &lo[sp], &hi[sp], &L[sp], &G[sp],
                   &out->split);
@@ -102,13 +95,11 @@ static void eval_bounds(const dt_tape *t, const dt_ray_leaf *ray,
     sp--;
     int x = sp - 1, y = sp;
     double rl, rh, rL, rG;
+    dt_range_op(in->op, lo[x], hi[x], lo[y], hi[y], &rl, &rh);
     switch (in->op) {
     case DT_SUM:
     case DT_DIFF:
     case DT_RDIFF:
-      if (in->op == DT_SUM) { rl = lo[x] + lo[y]; rh = hi[x] + hi[y]; }
-      else if (in->op == DT_DIFF) { rl = lo[x] - hi[y]; rh = hi[x] - lo[y]; }
-      else { rl = lo[y] - hi[x]; rh = hi[y] - lo[x]; }
       rL = L[x] + L[y];
       rG = G[x] + G[y];
       break;
@@ -116,16 +107,8 @@ static void eval_bounds(const dt_tape *t, const dt_ray_leaf *ray,
       /* Product x*y, or Union 1 - (1-x)(1-y) = 1 - X*Y with X = 1-x:
        * (XY)' = X'Y + XY', (XY)'' = X''Y + 2X'Y' + XY''. */
       int u = in->op == DT_UNION;
-      double xl = u ? 1 - hi[x] : lo[x], xh = u ? 1 - lo[x] : hi[x];
-      double yl = u ? 1 - hi[y] : lo[y], yh = u ? 1 - lo[y] : hi[y];
-      double p[4] = {xl * yl, xl * yh, xh * yl, xh * yh};
-      rl = rh = p[0];
-      for (int k = 1; k < 4; k++) {
-        if (p[k] < rl) rl = p[k];
-        if (p[k] > rh) rh = p[k];
-      }
-      if (u) { double tmp = rl; rl = 1 - rh; rh = 1 - tmp; }
-      double mx = maxabs(xl, xh), my = maxabs(yl, yh);
+      double mx = u ? maxabs(1 - hi[x], 1 - lo[x]) : maxabs(lo[x], hi[x]);
+      double my = u ? maxabs(1 - hi[y], 1 - lo[y]) : maxabs(lo[y], hi[y]);
       rL = mulnn(L[x], my) + mulnn(mx, L[y]);
       rG = mulnn(G[x], my) + 2 * mulnn(L[x], L[y]) + mulnn(mx, G[y]);
     }
@@ -444,8 +427,8 @@ static void ray_leaves_hull(const dt_tape *t, const double o[3],
   double l = INFINITY, h = -INFINITY;
   for (int i = 0; i < t->nleaves; i++) {
     const dt_leaf *lf = &t->leaves[i];
-    double base = lf->n[0] * o[0] + lf->n[1] * o[1] + lf->n[2] * o[2] - lf->d;
-    double nd = lf->n[0] * d[0] + lf->n[1] * d[1] + lf->n[2] * d[2];
+    double base = dt_leaf_dist(lf, o);
+    double nd = vec3_dot(lf->n, d);
     rl[i].base = base;
     rl[i].nd = nd;
     if (nd == 0) continue;

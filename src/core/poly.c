@@ -9,16 +9,14 @@
 
 #define U (DBL_EPSILON / 2)  /* unit roundoff */
 
-int poly_degree(const double *c, int deg)
-{
+int poly_degree(const double *c, int deg) {
   while (deg > 0 && c[deg] == 0.0) deg--;
   return deg;
 }
 
 /* Horner with Higham's running error bound (Accuracy and Stability of
  * Numerical Algorithms, Alg. 5.1): |fl(p(x)) - p(x)| <= u (2 mu - |y|). */
-double poly_eval(const double *c, int deg, double x, double *err)
-{
+double poly_eval(const double *c, int deg, double x, double *err) {
   double y = c[deg], mu = fabs(y) / 2, ax = fabs(x);
   for (int i = deg - 1; i >= 0; i--) {
     y = x * y + c[i];
@@ -28,8 +26,7 @@ double poly_eval(const double *c, int deg, double x, double *err)
   return y;
 }
 
-double poly_eval_d(const double *c, int deg, double x, double *dp, double *err)
-{
+double poly_eval_d(const double *c, int deg, double x, double *dp, double *err) {
   double y = c[deg], d = 0, mu = fabs(y) / 2, ax = fabs(x);
   for (int i = deg - 1; i >= 0; i--) {
     d = x * d + y;
@@ -41,8 +38,7 @@ double poly_eval_d(const double *c, int deg, double x, double *dp, double *err)
   return y;
 }
 
-int poly_deriv(const double *c, int deg, double *out)
-{
+int poly_deriv(const double *c, int deg, double *out) {
   if (deg <= 0) { out[0] = 0; return 0; }
   for (int i = 1; i <= deg; i++) out[i - 1] = i * c[i];
   return deg - 1;
@@ -50,8 +46,7 @@ int poly_deriv(const double *c, int deg, double *out)
 
 /* Repeated synthetic division by (x - x0): after pass k, t[k] holds
  * p^(k)(x0)/k!. */
-void poly_shift(const double *c, int deg, double x0, double *out)
-{
+void poly_shift(const double *c, int deg, double x0, double *out) {
   double t[POLY_MAX_DEG + 1];
   for (int i = 0; i <= deg; i++) t[i] = c[i];
   for (int k = 0; k < deg; k++)
@@ -67,8 +62,7 @@ void poly_shift(const double *c, int deg, double x0, double *out)
  * ever shrinks, so a sign change cannot be lost. Stops when p is zero to
  * within its rounding bound or the bracket is a few ulps wide. */
 static double bracket_root(const double *c, int n, double lo, double hi,
-                           int slo)
-{
+                           int slo) {
   double x = 0.5 * (lo + hi), dxold = hi - lo, dx = dxold;
   for (int it = 0; it < 200; it++) {
     double dp, err, p = poly_eval_d(c, n, x, &dp, &err);
@@ -97,8 +91,7 @@ static double bracket_root(const double *c, int n, double lo, double hi,
  * (found recursively) cut [a, b] into pieces on which p is monotone, so each
  * piece holds a crossing exactly when its end states differ. */
 static int cascade(const double *c, int n, double a, double b, int sa,
-                   int sb, double *out)
-{
+                   int sb, double *out) {
   double crit[POLY_MAX_DEG];
   int m = 0;
   if (n >= 2) {
@@ -123,15 +116,13 @@ static int cascade(const double *c, int n, double a, double b, int sa,
 
 /* ---- Laguerre's method (Ralston 1965; Numerical Recipes' laguer) ------ */
 
-static double cmag(double complex z)
-{
+static double cmag(double complex z) {
   return sqrt(creal(z) * creal(z) + cimag(z) * cimag(z));
 }
 
 /* Refine *x towards a root of the degree-m complex polynomial a. Returns 0
  * if it did not converge within the iteration limit. */
-static int laguer(const double complex *a, int m, double complex *x)
-{
+static int laguer(const double complex *a, int m, double complex *x) {
   static const double frac[9] = {0, .5, .25, .75, .13, .38, .62, .88, 1};
   for (int iter = 1; iter <= 80; iter++) {
     double complex b = a[m], d = 0, f = 0;
@@ -158,8 +149,7 @@ static int laguer(const double complex *a, int m, double complex *x)
   return 0;
 }
 
-static void sort_doubles(double *v, int n)
-{
+static void sort_doubles(double *v, int n) {
   for (int i = 1; i < n; i++) {
     double t = v[i];
     int j = i - 1;
@@ -175,8 +165,7 @@ static void sort_doubles(double *v, int n)
  * alternate; otherwise returns -1 and the caller falls back. */
 static int laguerre_crossings(const double *c, int n, const double *q,
                               double m, double h, double a, double b,
-                              int sa, int sb, double *out)
-{
+                              int sa, int sb, double *out) {
   double complex ad[POLY_MAX_DEG + 1], orig[POLY_MAX_DEG + 1];
   double complex z[POLY_MAX_DEG];
   for (int i = 0; i <= n; i++) { ad[i] = q[i]; orig[i] = c[i]; }
@@ -232,8 +221,7 @@ static int laguerre_crossings(const double *c, int n, const double *q,
 /* ---- driver ---------------------------------------------------------- */
 
 int poly_crossings(const double *c, int deg, double a, double b, int pos_a,
-                   int pos_b, unsigned opts, double *roots, poly_stats *st)
-{
+                   int pos_b, unsigned opts, double *roots, poly_stats *st) {
   pos_a = pos_a != 0;
   pos_b = pos_b != 0;
   if (st) st->solves++;
@@ -279,8 +267,7 @@ int poly_crossings(const double *c, int deg, double a, double b, int pos_a,
 }
 
 int poly_roots(const double *c, int deg, double a, double b, double *roots,
-               poly_stats *st)
-{
+               poly_stats *st) {
   int sa = poly_eval(c, deg, a, NULL) > 0;
   int sb = poly_eval(c, deg, b, NULL) > 0;
   return poly_crossings(c, deg, a, b, sa, sb, 0, roots, st);

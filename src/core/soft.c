@@ -8,6 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/bvh.h"
+#include "core/heap.h"
+#include "core/vec.h"
+
 /* eq. (1) as a cubic in s = r^2/R^2: C = 1 + A1 s + A2 s^2 + A3 s^3. */
 #define A1 (-22.0 / 9.0)
 #define A2 (17.0 / 9.0)
@@ -25,55 +29,48 @@ typedef struct {
   double lo[3], hi[3];  /* bounding box of s < 1 (empty: lo > hi) */
   int sphere;      /* A = a[0] I */
   int empty;       /* acts nowhere */
-} skey_t;
-
-typedef struct {
-  double lo[3], hi[3];
-  int first;       /* inner: index of the left child (right = first + 1);
-                      leaf: first key */
-  int count;       /* 0 for an inner node */
-} node_t;
+} nkey;
 
 struct soft_obj {
-  skey_t *keys;     /* in BVH leaf order */
+  nkey *keys;       /* in BVH leaf order */
   size_t nkeys;
-  node_t *nodes;
-  int nnodes;
+  bvh tree;         /* over the keys' bounds, leaves index keys directly */
   double magic;
   double lo[3], hi[3];
 };
 
-typedef struct { double t; int i; } hent_t;            /* heap entry */
-typedef struct { double te, tx; int i; } kev_t;        /* key events */
+/* A BVH node met by the ray at t, and a key met from te to tx. */
+typedef struct { double t; int i; } node_ent;
+typedef struct { double te, tx; int i; } key_event;
+HEAP_DEFINE(nheap, node_ent, t)    /* BVH nodes by entry */
+HEAP_DEFINE(kheap, key_event, te)  /* discovered keys by entry */
 
 struct soft_scratch {
-  size_t cap;      /* keys */
-  hent_t *nheap;   /* BVH nodes by entry, 2 cap */
-  kev_t *kheap;    /* discovered keys by entry, cap */
-  kev_t *act;      /* active keys, cap */
-  double *sq;      /* s(v) coefficients of the active keys, 3 cap */
+  size_t cap;        /* keys */
+  node_ent *nheap;   /* BVH nodes by entry, 2 cap */
+  key_event *kheap;  /* discovered keys by entry, cap */
+  key_event *act;    /* active keys, cap */
+  double *sq;        /* s(v) coefficients of the active keys, 3 cap */
 };
 
 /* eq. (1) in the factored form C(s) = (1 - s)^2 (1 - 4s/9): the same
  * polynomial, but with full relative accuracy near the edge of the key's
  * bound (s -> 1), where the expanded form's cancellation leaves only an
  * absolute eps. */
-static double cfield(double s)
-{
+static double cfield(double s) {
   if (s >= 1) return 0;
   double u = 1 - s;
   return u * u * (1 - s * (4.0 / 9.0));
 }
 
-static double cslope(double s)  /* dC/ds */
-{
+/* dC/ds */
+static double cslope(double s) {
   return s >= 1 ? 0 : A1 + s * (2 * A2 + s * 3 * A3);
 }
 
 /* ---- building -------------------------------------------------------- */
 
-const char *soft_strerror(int err)
-{
+const char *soft_strerror(int err) {
   switch (err) {
   case SOFT_OK: return "no error";
   case SOFT_ERR_RADIUS: return "radius of influence must be finite and > 0";
@@ -87,8 +84,7 @@ const char *soft_strerror(int err)
 }
 
 /* Normalise one key; returns an error code. */
-static int make_key(const soft_key *in, skey_t *k)
-{
+static int make_key(const soft_key *in, nkey *k) {
   memset(k, 0, sizeof *k);
   if (!(in->R > 0) || !isfinite(in->R)) return SOFT_ERR_RADIUS;
   if (!isfinite(in->w)) return SOFT_ERR_NONFINITE;
@@ -153,93 +149,25 @@ static int make_key(const soft_key *in, skey_t *k)
   return SOFT_OK;
 }
 
-/* The BVH is built over an index array (the keys themselves, 152 bytes
- * each, are moved once at the end into leaf order): the centroid of key
- * idx[j] on an axis is cen[axis][idx[j]]. */
-typedef struct {
-  soft_obj *o;
-  const skey_t *keys;  /* in input order */
-  int *idx;
-  double *cen[3];
-} bvh_build;
-
-/* Quickselect: order idx[0..n) so that idx[mid] has the median centroid. */
-static void select_median(int *idx, const double *c, int n, int mid)
-{
-  int lo = 0, hi = n - 1;
-  while (lo < hi) {
-    double pv = c[idx[(lo + hi) / 2]];
-    int i = lo, j = hi;
-    while (i <= j) {
-      while (c[idx[i]] < pv) i++;
-      while (c[idx[j]] > pv) j--;
-      if (i <= j) { int t = idx[i]; idx[i] = idx[j]; idx[j] = t; i++; j--; }
+/* The keys' bounds and centres as BVH items (into items, returned). */
+static bvh_item *items_of(bvh_item *items, const nkey *k, size_t n) {
+  for (size_t j = 0; j < n; j++)
+    for (int i = 0; i < 3; i++) {
+      items[j].lo[i] = k[j].lo[i];
+      items[j].hi[i] = k[j].hi[i];
+      items[j].c[i] = k[j].x0[i];
     }
-    if (mid <= j) hi = j;
-    else if (mid >= i) lo = i;
-    else break;
-  }
-}
-
-/* Median split on the longest axis of the centroids; children of a node
- * are adjacent. Depth is at most ceil(log2 n) + 1. A leaf's box is that of
- * its keys, an inner node's the union of its children's, so the boxes cost
- * O(n) in all. */
-static void build_node(bvh_build *b, int ni, int first, int n)
-{
-  soft_obj *o = b->o;
-  const int *idx = b->idx + first;
-  if (n <= LEAF_MAX) {
-    node_t *nd = &o->nodes[ni];
-    for (int i = 0; i < 3; i++) { nd->lo[i] = INFINITY; nd->hi[i] = -INFINITY; }
-    for (int j = 0; j < n; j++) {
-      const skey_t *k = &b->keys[idx[j]];
-      for (int i = 0; i < 3; i++) {
-        if (k->lo[i] < nd->lo[i]) nd->lo[i] = k->lo[i];
-        if (k->hi[i] > nd->hi[i]) nd->hi[i] = k->hi[i];
-      }
-    }
-    nd->first = first;
-    nd->count = n;
-    return;
-  }
-  int axis = 0;
-  double ext[3];
-  for (int i = 0; i < 3; i++) {
-    const double *c = b->cen[i];
-    double clo = INFINITY, chi = -INFINITY;
-    for (int j = 0; j < n; j++) {
-      double x = c[idx[j]];
-      if (x < clo) clo = x;
-      if (x > chi) chi = x;
-    }
-    ext[i] = chi - clo;
-    if (ext[i] > ext[axis]) axis = i;
-  }
-  int half = n / 2;
-  select_median(b->idx + first, b->cen[axis], n, half);
-  int left = o->nnodes;
-  o->nnodes += 2;
-  build_node(b, left, first, half);
-  build_node(b, left + 1, first + half, n - half);
-  node_t *nd = &o->nodes[ni], *l = &o->nodes[left], *r = &o->nodes[left + 1];
-  for (int i = 0; i < 3; i++) {
-    nd->lo[i] = fmin(l->lo[i], r->lo[i]);
-    nd->hi[i] = fmax(l->hi[i], r->hi[i]);
-  }
-  nd->first = left;
-  nd->count = 0;
+  return items;
 }
 
 int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
-               size_t *bad_key)
-{
+               size_t *bad_key) {
   *out = NULL;
   *bad_key = n;
   if (!(magic > 0) || !isfinite(magic)) return SOFT_ERR_MAGIC;
   if (n > (size_t)(1 << 28)) return SOFT_ERR_NOMEM;
   soft_obj *o = calloc(1, sizeof *o);
-  skey_t *all = malloc((n ? n : 1) * sizeof *all);
+  nkey *all = malloc((n ? n : 1) * sizeof *all);
   if (!o || !all) { free(o); free(all); return SOFT_ERR_NOMEM; }
   o->magic = magic;
   size_t live = 0;
@@ -249,25 +177,18 @@ int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
     if (!all[live].empty && all[live].w != 0) live++;  /* others act nowhere */
   }
   o->nkeys = live;
-  o->nodes = malloc((2 * live + 1) * sizeof *o->nodes);
-  bvh_build b = {o, all, malloc((live ? live : 1) * sizeof(int)), {NULL}};
-  for (int i = 0; i < 3; i++) b.cen[i] = malloc((live ? live : 1) * sizeof(double));
+  /* The BVH over the keys' bounds, split at the median of their centres;
+   * the keys (152 bytes each) then move once into its leaf order. */
+  bvh_item *items = malloc((live ? live : 1) * sizeof *items);
   o->keys = malloc((live ? live : 1) * sizeof *o->keys);
-  if (!o->nodes || !b.idx || !b.cen[0] || !b.cen[1] || !b.cen[2] || !o->keys) {
-    free(o->nodes); free(o->keys); free(b.idx);
-    for (int i = 0; i < 3; i++) free(b.cen[i]);
-    free(all); free(o);
+  if (!items || !o->keys ||
+      bvh_build(&o->tree, items_of(items, all, live), (int)live, LEAF_MAX,
+                BVH_SELECT) != BVH_OK) {
+    free(items); free(o->keys); free(all); free(o);
     return SOFT_ERR_NOMEM;
   }
-  for (size_t j = 0; j < live; j++) {
-    b.idx[j] = (int)j;
-    for (int i = 0; i < 3; i++) b.cen[i][j] = all[j].x0[i];
-  }
-  o->nnodes = 1;
-  build_node(&b, 0, 0, (int)live);
-  for (size_t j = 0; j < live; j++) o->keys[j] = all[b.idx[j]];
-  free(b.idx);
-  for (int i = 0; i < 3; i++) free(b.cen[i]);
+  free(items);
+  for (size_t j = 0; j < live; j++) o->keys[j] = all[o->tree.idx[j]];
   free(all);
   all = o->keys;
   for (int i = 0; i < 3; i++) { o->lo[i] = INFINITY; o->hi[i] = -INFINITY; }
@@ -281,19 +202,17 @@ int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
   return SOFT_OK;
 }
 
-void soft_free(soft_obj *obj)
-{
+void soft_free(soft_obj *obj) {
   if (!obj) return;
   free(obj->keys);
-  free(obj->nodes);
+  bvh_free(&obj->tree);
   free(obj);
 }
 
 size_t soft_nkeys(const soft_obj *obj) { return obj->nkeys; }
 double soft_magic(const soft_obj *obj) { return obj->magic; }
 
-int soft_bounds(const soft_obj *obj, double lo[3], double hi[3])
-{
+int soft_bounds(const soft_obj *obj, double lo[3], double hi[3]) {
   for (int i = 0; i < 3; i++) { lo[i] = obj->lo[i]; hi[i] = obj->hi[i]; }
   return obj->lo[0] <= obj->hi[0];
 }
@@ -301,8 +220,7 @@ int soft_bounds(const soft_obj *obj, double lo[3], double hi[3])
 /* ---- field and gradient ---------------------------------------------- */
 
 /* ap = A p for the key's matrix A. */
-static void apply_a(const skey_t *k, const double p[3], double ap[3])
-{
+static void apply_a(const nkey *k, const double p[3], double ap[3]) {
   if (k->sphere) {
     for (int i = 0; i < 3; i++) ap[i] = k->a[0] * p[i];
   } else {
@@ -312,41 +230,31 @@ static void apply_a(const skey_t *k, const double p[3], double ap[3])
   }
 }
 
-static double dot3(const double a[3], const double b[3])
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* s of eq. (1) (r^2/R^2, or u'Mu/R^2 for a quadric, eq. 5) for key k at the
  * point whose offset from the centre is p, with A p into ap. */
-static double key_s(const skey_t *k, const double p[3], double ap[3])
-{
+static double key_s(const nkey *k, const double p[3], double ap[3]) {
   apply_a(k, p, ap);
-  return dot3(p, ap) + k->k;
+  return vec3_dot(p, ap) + k->k;
 }
 
 /* eq. (1), summed (the paper's "sum of the effects of the individual keys"):
- * keys found through the BVH, with an explicit stack (depth is bounded by
- * the median split). */
-static double field_at(const soft_obj *o, const double x[3], double g[3])
-{
+ * keys found through the BVH, depth first. */
+static double field_at(const soft_obj *o, const double x[3], double g[3]) {
   double f = 0;
   if (g) g[0] = g[1] = g[2] = 0;
   if (o->nkeys == 0) return 0;
-  int stack[128], sp = 0;
+  int stack[BVH_STACK], sp = 0;  /* enough for any tree (bvh.h) */
   stack[sp++] = 0;
   while (sp > 0) {
-    const node_t *nd = &o->nodes[stack[--sp]];
-    if (x[0] < nd->lo[0] || x[0] > nd->hi[0] || x[1] < nd->lo[1] ||
-        x[1] > nd->hi[1] || x[2] < nd->lo[2] || x[2] > nd->hi[2])
-      continue;
+    const bvh_node *nd = &o->tree.nodes[stack[--sp]];
+    if (!bvh_node_has(nd, x)) continue;
     if (nd->count == 0) {
       stack[sp++] = nd->first;
       stack[sp++] = nd->first + 1;
       continue;
     }
     for (int j = nd->first; j < nd->first + nd->count; j++) {
-      const skey_t *k = &o->keys[j];
+      const nkey *k = &o->keys[j];
       double p[3] = {x[0] - k->x0[0], x[1] - k->x0[1], x[2] - k->x0[2]}, ap[3];
       double s = key_s(k, p, ap);
       if (s >= 1) continue;
@@ -360,20 +268,17 @@ static double field_at(const soft_obj *o, const double x[3], double g[3])
   return f;
 }
 
-double soft_field(const soft_obj *obj, const double p[3])
-{
+double soft_field(const soft_obj *obj, const double p[3]) {
   return field_at(obj, p, NULL);
 }
 
-double soft_field_grad(const soft_obj *obj, const double p[3], double g[3])
-{
+double soft_field_grad(const soft_obj *obj, const double p[3], double g[3]) {
   return field_at(obj, p, g);
 }
 
 /* ---- scratch ----------------------------------------------------------- */
 
-soft_scratch *soft_scratch_new(size_t max_keys)
-{
+soft_scratch *soft_scratch_new(size_t max_keys) {
   soft_scratch *s = calloc(1, sizeof *s);
   if (!s) return NULL;
   size_t cap = max_keys ? max_keys : 1;
@@ -386,8 +291,7 @@ soft_scratch *soft_scratch_new(size_t max_keys)
   return s;
 }
 
-void soft_scratch_free(soft_scratch *s)
-{
+void soft_scratch_free(soft_scratch *s) {
   if (!s) return;
   free(s->nheap);
   free(s->kheap);
@@ -396,66 +300,16 @@ void soft_scratch_free(soft_scratch *s)
   free(s);
 }
 
-/* ---- binary min-heaps ---------------------------------------------------- */
-
-static void npush(hent_t *h, int *n, double t, int i)
-{
-  int j = (*n)++;
-  while (j > 0 && h[(j - 1) / 2].t > t) { h[j] = h[(j - 1) / 2]; j = (j - 1) / 2; }
-  h[j].t = t;
-  h[j].i = i;
-}
-
-static hent_t npop(hent_t *h, int *n)
-{
-  hent_t top = h[0], last = h[--*n];
-  int j = 0;
-  for (;;) {
-    int c = 2 * j + 1;
-    if (c >= *n) break;
-    if (c + 1 < *n && h[c + 1].t < h[c].t) c++;
-    if (h[c].t >= last.t) break;
-    h[j] = h[c];
-    j = c;
-  }
-  h[j] = last;
-  return top;
-}
-
-static void kpush(kev_t *h, int *n, kev_t e)
-{
-  int j = (*n)++;
-  while (j > 0 && h[(j - 1) / 2].te > e.te) { h[j] = h[(j - 1) / 2]; j = (j - 1) / 2; }
-  h[j] = e;
-}
-
-static kev_t kpop(kev_t *h, int *n)
-{
-  kev_t top = h[0], last = h[--*n];
-  int j = 0;
-  for (;;) {
-    int c = 2 * j + 1;
-    if (c >= *n) break;
-    if (c + 1 < *n && h[c + 1].te < h[c].te) c++;
-    if (h[c].te >= last.te) break;
-    h[j] = h[c];
-    j = c;
-  }
-  h[j] = last;
-  return top;
-}
-
 /* ---- ray tracing --------------------------------------------------------- */
 
 typedef struct {
   double o[3], d[3], inv[3];  /* origin, unit direction, 1/direction */
   double ta, tb;              /* the search range, in units of length */
-} ray_t;
+} soft_ray;
 
 /* Slab test; returns entry in *tn or 0 if the box is missed in [ta, tb]. */
-static int hit_box(const ray_t *r, const double lo[3], const double hi[3],
-                   double *tn)
-{
+static int hit_box(const soft_ray *r, const double lo[3], const double hi[3],
+                   double *tn) {
   double t0 = r->ta, t1 = r->tb;
   for (int i = 0; i < 3; i++) {
     double a = (lo[i] - r->o[i]) * r->inv[i], b = (hi[i] - r->o[i]) * r->inv[i];
@@ -469,12 +323,11 @@ static int hit_box(const ray_t *r, const double lo[3], const double hi[3],
 
 /* eq. (2) into the key's quadric: s(t) = a2 (t - tc)^2 + smin along the
  * ray; the key acts where s < 1. Returns 0 if the ray misses its bound. */
-static int hit_key(const ray_t *r, const skey_t *k, double *te, double *tx)
-{
+static int hit_key(const soft_ray *r, const nkey *k, double *te, double *tx) {
   double p[3] = {r->o[0] - k->x0[0], r->o[1] - k->x0[1], r->o[2] - k->x0[2]};
   double ad[3], ap[3];
   apply_a(k, r->d, ad);
-  double a2 = dot3(r->d, ad), b = dot3(p, ad);
+  double a2 = vec3_dot(r->d, ad), b = vec3_dot(p, ad);
   double tc = -b / a2;
   double pc[3] = {p[0] + tc * r->d[0], p[1] + tc * r->d[1], p[2] + tc * r->d[2]};
   double smin = key_s(k, pc, ap);
@@ -491,18 +344,17 @@ static int hit_key(const ray_t *r, const skey_t *k, double *te, double *tx)
  * the ray origin. Also bounds the field over the interval: C falls as s
  * grows, and s is convex in v, so each key's field lies between C at the
  * largest s (an end) and C at the smallest. */
-static void interval_s(const soft_obj *o, const ray_t *r, const kev_t *act,
+static void interval_s(const soft_obj *o, const soft_ray *r, const key_event *act,
                        int nact, double tm, double h, double *sq,
-                       double *flo, double *fhi)
-{
+                       double *flo, double *fhi) {
   double x[3] = {r->o[0] + tm * r->d[0], r->o[1] + tm * r->d[1], r->o[2] + tm * r->d[2]};
   double lo = 0, hi = 0, wsum = 0;
   for (int j = 0; j < nact; j++) {
-    const skey_t *k = &o->keys[act[j].i];
+    const nkey *k = &o->keys[act[j].i];
     double p[3] = {x[0] - k->x0[0], x[1] - k->x0[1], x[2] - k->x0[2]}, ap[3], ad[3];
     double s0 = key_s(k, p, ap);
     apply_a(k, r->d, ad);
-    double s1 = 2 * h * dot3(r->d, ap), s2 = h * h * dot3(r->d, ad);
+    double s1 = 2 * h * vec3_dot(r->d, ap), s2 = h * h * vec3_dot(r->d, ad);
     sq[3 * j] = s0; sq[3 * j + 1] = s1; sq[3 * j + 2] = s2;
     double smax = s0 + fabs(s1) + s2;
     double smin = fabs(s1) < 2 * s2 ? s0 - s1 * s1 / (4 * s2) : s0 - fabs(s1) + s2;
@@ -517,9 +369,8 @@ static void interval_s(const soft_obj *o, const ray_t *r, const kev_t *act,
 
 /* eq. (4): the weighted sum of C(s(v)) over the active keys, minus magic,
  * as a sextic in v in [-1, 1]. */
-static void interval_poly(const soft_obj *o, const kev_t *act, int nact,
-                          const double *sq, double *c)
-{
+static void interval_poly(const soft_obj *o, const key_event *act, int nact,
+                          const double *sq, double *c) {
   double w0 = 0, w1[3] = {0, 0, 0}, w2[5] = {0, 0, 0, 0, 0}, w3[7] = {0};
   for (int j = 0; j < nact; j++) {
     double w = o->keys[act[j].i].w;
@@ -556,8 +407,7 @@ static void interval_poly(const soft_obj *o, const kev_t *act, int nact,
  * neighbours, so a root on a boundary is found once. */
 int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
                double t0, double t1, double *out, int maxout,
-               soft_scratch *scratch, soft_stats *stats)
-{
+               soft_scratch *scratch, soft_stats *stats) {
   soft_stats dummy;
   if (!stats) { memset(&dummy, 0, sizeof dummy); stats = &dummy; }
   stats->rays++;
@@ -576,7 +426,7 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
   if (!scratch || scratch->cap < obj->nkeys) return -1;
 
   /* Work in units of length along the unit direction (tau = t |d|). */
-  ray_t r;
+  soft_ray r;
   for (int i = 0; i < 3; i++) {
     r.o[i] = o[i];
     r.d[i] = d[i] / len;
@@ -586,11 +436,13 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
   r.ta = t0 * len;
   r.tb = t1 * len;
 
-  hent_t *nheap = scratch->nheap;
-  kev_t *kheap = scratch->kheap, *act = scratch->act;
+  node_ent *nheap = scratch->nheap;
+  key_event *kheap = scratch->kheap, *act = scratch->act;
   int nn = 0, nk = 0, na = 0, nout = 0;
   double tn;
-  if (hit_box(&r, obj->nodes[0].lo, obj->nodes[0].hi, &tn)) npush(nheap, &nn, tn, 0);
+  const bvh_node *root = &obj->tree.nodes[0];
+  if (hit_box(&r, root->lo, root->hi, &tn))
+    nheap_push(nheap, &nn, (node_ent){tn, 0});
 
   double cur = r.ta;
   int state = -1;          /* at cur: 1 inside, 0 outside, -1 not yet known */
@@ -604,22 +456,23 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
     if (nk && kheap[0].te < tnext) tnext = kheap[0].te;
     if (amin < tnext) tnext = amin;
     if (tfront < tnext) {  /* a key may still enter before tnext: discover */
-      hent_t e = npop(nheap, &nn);
-      const node_t *nd = &obj->nodes[e.i];
+      node_ent e = nheap_pop(nheap, &nn);
+      const bvh_node *nd = &obj->tree.nodes[e.i];
       stats->nodes++;
       if (nd->count == 0) {
         for (int c = 0; c < 2; c++) {
-          const node_t *ch = &obj->nodes[nd->first + c];
-          if (hit_box(&r, ch->lo, ch->hi, &tn)) npush(nheap, &nn, fmax(tn, cur), nd->first + c);
+          const bvh_node *ch = &obj->tree.nodes[nd->first + c];
+          if (hit_box(&r, ch->lo, ch->hi, &tn))
+            nheap_push(nheap, &nn, (node_ent){fmax(tn, cur), nd->first + c});
         }
       } else {
         for (int j = nd->first; j < nd->first + nd->count; j++) {
-          kev_t ev;
+          key_event ev;
           if (!hit_key(&r, &obj->keys[j], &ev.te, &ev.tx) || ev.tx <= cur) continue;
           stats->keys++;
           ev.te = fmax(ev.te, cur);
           ev.i = j;
-          kpush(kheap, &nk, ev);
+          kheap_push(kheap, &nk, ev);
         }
       }
       continue;
@@ -692,7 +545,7 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
       if (act[j].tx <= cur) act[j] = act[--na];
       else j++;
     }
-    while (nk && kheap[0].te <= cur) act[na++] = kpop(kheap, &nk);
+    while (nk && kheap[0].te <= cur) act[na++] = kheap_pop(kheap, &nk);
     amin = INFINITY;
     for (int j = 0; j < na; j++) if (act[j].tx < amin) amin = act[j].tx;
   }

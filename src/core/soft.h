@@ -4,7 +4,7 @@
  * consecutive entries/exits of the keys' bounds along the ray.
  *
  * Memory: soft_build copies the keys into a soft_obj it mallocs (with its
- * BVH over the key bounds); the caller owns it and releases it with
+ * BVH over the key bounds, bvh.h); the caller owns it and releases it with
  * soft_free. It is read-only afterwards, so any number of threads may query
  * it at once. Each tracing thread owns one soft_scratch (soft_scratch_new /
  * soft_scratch_free), sized for the largest object it will trace; soft_roots

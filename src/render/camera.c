@@ -6,15 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-static double dot3(const double a[3], const double b[3]) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+#include "core/vec.h"
 
-static void cross3(const double a[3], const double b[3], double c[3]) {
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 /* The primitives in the renderer's order (the top-level union, a before
    b, Empty skipped), boxed by render_node_box; an explicit stack. */
@@ -84,7 +77,7 @@ int camera_setup(Camera *cam, const RenderSettings *rs, int has_box,
     /* Frame the box: look at its centre from the front, above and to the
        right, far enough that the bounding sphere fits the view. */
     double dir[3] = {0.45, 0.6, 1};
-    double len = sqrt(dot3(dir, dir));
+    double len = sqrt(vec3_dot(dir, dir));
     double dist = R / sin(fmin(rs->fov, 120) * M_PI / 360) * 1.05;
     for (int i = 0; i < 3; i++) {
       at[i] = cam->centre[i];
@@ -92,20 +85,20 @@ int camera_setup(Camera *cam, const RenderSettings *rs, int has_box,
     }
   }
   for (int i = 0; i < 3; i++) cam->fwd[i] = at[i] - cam->eye[i];
-  double fl = sqrt(dot3(cam->fwd, cam->fwd));
+  double fl = sqrt(vec3_dot(cam->fwd, cam->fwd));
   if (!(fl > 0) || !isfinite(fl)) {
     snprintf(err, errlen, "the camera's eye and at must differ");
     return -1;
   }
   for (int i = 0; i < 3; i++) cam->fwd[i] /= fl;
-  cross3(cam->fwd, rs->up, cam->right);
-  double rl = sqrt(dot3(cam->right, cam->right));
+  vec3_cross(cam->fwd, rs->up, cam->right);
+  double rl = sqrt(vec3_dot(cam->right, cam->right));
   if (!(rl > 1e-12)) {
     snprintf(err, errlen, "the camera's up direction is zero or parallel to its view");
     return -1;
   }
   for (int i = 0; i < 3; i++) cam->right[i] /= rl;
-  cross3(cam->right, cam->fwd, cam->upv);
+  vec3_cross(cam->right, cam->fwd, cam->upv);
   cam->width = rs->width;
   cam->height = rs->height;
   cam->tan_half = tan(rs->fov * M_PI / 360);
@@ -119,6 +112,6 @@ void camera_ray(const Camera *cam, double px, double py, double d[3]) {
   double v = (1 - 2 * py / cam->height) * h;
   for (int i = 0; i < 3; i++)
     d[i] = cam->fwd[i] + u * cam->right[i] + v * cam->upv[i];
-  double len = sqrt(dot3(d, d));
+  double len = sqrt(vec3_dot(d, d));
   for (int i = 0; i < 3; i++) d[i] /= len;
 }

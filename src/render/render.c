@@ -11,6 +11,8 @@
 
 #include "core/bounds.h"
 #include "render/camera.h"
+#include "core/bvh.h"
+#include "core/vec.h"
 #include "scene/ray.h"
 
 #define TILE 16
@@ -81,14 +83,6 @@ static int shape_add(Shape *s, const double n[3], double d) {
   return 0;
 }
 
-static void cross3(const double a[3], const double b[3], double c[3]) {
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-static double dot3(const double a[3], const double b[3]) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 
 /* The box of the convex set {x : n_j . x <= d_j} (unit normals). It is
    bounded iff its recession cone {u : n_j . u <= 0} is {0}; the cone's
@@ -102,17 +96,17 @@ static Box convex_box(const Shape *s) {
   for (int j = 0; j < n; j++)
     for (int k = j + 1; k < n; k++) {
       double u[3];
-      cross3(s->pl[j], s->pl[k], u);
-      double len = sqrt(dot3(u, u));
+      vec3_cross(s->pl[j], s->pl[k], u);
+      double len = sqrt(vec3_dot(u, u));
       if (len < 1e-12) continue;
       for (int sgn = -1; sgn <= 1; sgn += 2) {
         int ray = 1;
         for (int i = 0; i < n && ray; i++)
-          if (sgn * dot3(s->pl[i], u) / len > 1e-12) ray = 0;
+          if (sgn * vec3_dot(s->pl[i], u) / len > 1e-12) ray = 0;
         if (ray) return box_all();
       }
       for (int i = 0; i < n && !rank3; i++)
-        if (fabs(dot3(s->pl[i], u)) / len > 1e-9) rank3 = 1;
+        if (fabs(vec3_dot(s->pl[i], u)) / len > 1e-9) rank3 = 1;
     }
   if (!rank3) return box_all();
   Box b = box_empty();
@@ -123,17 +117,17 @@ static Box convex_box(const Shape *s) {
       for (int e = c + 1; e < n; e++) {
         const double *p = s->pl[a], *q = s->pl[c], *r = s->pl[e];
         double qr[3], rp[3], pq[3];
-        cross3(q, r, qr);
-        cross3(r, p, rp);
-        cross3(p, q, pq);
-        double det = dot3(p, qr);
+        vec3_cross(q, r, qr);
+        vec3_cross(r, p, rp);
+        vec3_cross(p, q, pq);
+        double det = vec3_dot(p, qr);
         if (fabs(det) < 1e-12) continue;
         double v[3];
         for (int i = 0; i < 3; i++)
           v[i] = (p[3] * qr[i] + q[3] * rp[i] + r[3] * pq[i]) / det;
         int inside = 1;
         for (int i = 0; i < n && inside; i++)
-          if (dot3(s->pl[i], v) > s->pl[i][3] + 1e-9 * scale) inside = 0;
+          if (vec3_dot(s->pl[i], v) > s->pl[i][3] + 1e-9 * scale) inside = 0;
         if (!inside) continue;
         for (int i = 0; i < 3; i++) {
           b.lo[i] = fmin(b.lo[i], v[i]);
@@ -304,12 +298,6 @@ typedef struct Prim {
   double colour[3];
 } Prim;
 
-typedef struct BvhNode {
-  Box box;
-  int left, right;   /* children, or -1 */
-  int first, count;  /* prims of a leaf */
-} BvhNode;
-
 typedef struct Tracer {
   const Scene *s;
   const RenderSettings *rs;
@@ -317,8 +305,7 @@ typedef struct Tracer {
   int nprims, capprims;
   int *bounded, nbounded;     /* prim indices in BVH order */
   int *unbounded, nunbounded;
-  BvhNode *bvh;
-  int nbvh;
+  bvh bvh;                    /* over the bounded prims (core/bvh.h) */
   Camera cam;
   double coord_scale;       /* the largest |coordinate| of the eye and bounds */
   double lights[RENDER_MAX_LIGHTS][3];
@@ -400,60 +387,41 @@ static int collect_prims(Tracer *T, int root) {
   return r;
 }
 
-static int build_bvh(Tracer *T, int first, int count) {
-  int idx = T->nbvh++;
-  BvhNode *b = &T->bvh[idx];
-  b->left = b->right = -1;
-  b->box = box_empty();
-  for (int i = first; i < first + count; i++)
-    b->box = box_union(b->box, T->prims[T->bounded[i]].box);
-  if (count <= 2) {
-    b->first = first;
-    b->count = count;
-    return idx;
-  }
-  /* Median split along the widest spread of centres. */
-  double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int i = first; i < first + count; i++)
-    for (int k = 0; k < 3; k++) {
+/* The BVH over the bounded prims: median split on the widest spread of
+   box centres, leaves of 2, ties in prim order (BVH_SORT); bounded is then
+   put in leaf order. */
+static int build_bvh(Tracer *T) {
+  int n = T->nbounded, err = BVH_ENOMEM;
+  bvh_item *it = malloc(sizeof *it * (size_t)n);
+  int *order = malloc(sizeof *order * (size_t)n);
+  if (it && order) {
+    for (int i = 0; i < n; i++) {
       const Box *pb = &T->prims[T->bounded[i]].box;
-      double c = 0.5 * (pb->lo[k] + pb->hi[k]);
-      clo[k] = fmin(clo[k], c);
-      chi[k] = fmax(chi[k], c);
+      for (int k = 0; k < 3; k++) {
+        it[i].lo[k] = pb->lo[k];
+        it[i].hi[k] = pb->hi[k];
+        it[i].c[k] = 0.5 * (pb->lo[k] + pb->hi[k]);
+      }
     }
-  int axis = 0;
-  for (int k = 1; k < 3; k++)
-    if (chi[k] - clo[k] > chi[axis] - clo[axis]) axis = k;
-  /* Insertion-free selection: sort this range by centre on the axis. */
-  for (int i = first + 1; i < first + count; i++) {
-    int v = T->bounded[i], j = i - 1;
-    const Box *vb = &T->prims[v].box;
-    double cv = vb->lo[axis] + vb->hi[axis];
-    while (j >= first) {
-      const Box *jb = &T->prims[T->bounded[j]].box;
-      if (jb->lo[axis] + jb->hi[axis] <= cv) break;
-      T->bounded[j + 1] = T->bounded[j];
-      j--;
-    }
-    T->bounded[j + 1] = v;
+    err = bvh_build(&T->bvh, it, n, 2, BVH_SORT);
   }
-  int half = count / 2;
-  int l = build_bvh(T, first, half);
-  int r = build_bvh(T, first + half, count - half);
-  T->bvh[idx].left = l;
-  T->bvh[idx].right = r;
-  T->bvh[idx].count = 0;
-  return idx;
+  if (!err) {
+    for (int i = 0; i < n; i++) order[i] = T->bounded[T->bvh.idx[i]];
+    memcpy(T->bounded, order, sizeof *order * (size_t)n);
+  }
+  free(it);
+  free(order);
+  return err;
 }
 
 /* Slab test: the part of [t0, t1] inside the box. */
-static int box_hit(const Box *b, const double o[3], const double inv[3],
-                   double t0, double t1, double *enter) {
+static int box_hit(const double lo[3], const double hi[3], const double o[3],
+                   const double inv[3], double t0, double t1, double *enter) {
   for (int k = 0; k < 3; k++) {
-    double a = (b->lo[k] - o[k]) * inv[k];
-    double c = (b->hi[k] - o[k]) * inv[k];
+    double a = (lo[k] - o[k]) * inv[k];
+    double c = (hi[k] - o[k]) * inv[k];
     if (isnan(a) || isnan(c)) { /* parallel and on a slab plane */
-      if (o[k] < b->lo[k] || o[k] > b->hi[k]) return 0;
+      if (o[k] < lo[k] || o[k] > hi[k]) return 0;
       continue;
     }
     if (a > c) {
@@ -490,9 +458,9 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
   const ScNode *n = &s->nodes[node];
   switch (n->kind) {
   case SC_HALFSPACE: {
-    double nd = dot3(n->n, d);
+    double nd = vec3_dot(n->n, d);
     if (nd == 0) return 0;
-    double t = (n->d - dot3(n->n, o)) / nd;
+    double t = (n->d - vec3_dot(n->n, o)) / nd;
     if (!(t > t0 && t < t1)) return 0;
     h->t = t;
     h->id = node;
@@ -570,19 +538,20 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
       if (any) return 1;
     }
   }
-  if (!T->nbvh) return found;
+  if (!T->bvh.nnodes) return found;
   double inv[3] = {1 / d[0], 1 / d[1], 1 / d[2]};
-  int stack[128], sp = 0;
+  int stack[BVH_STACK], sp = 0;   /* enough for any tree (core/bvh.h) */
   stack[sp++] = 0;
   while (sp) {
-    const BvhNode *b = &T->bvh[stack[--sp]];
+    const bvh_node *b = &T->bvh.nodes[stack[--sp]];
     double enter;
-    if (!box_hit(&b->box, o, inv, t0, t1, &enter)) continue;
-    if (b->count || b->left < 0) {
+    if (!box_hit(b->lo, b->hi, o, inv, t0, t1, &enter)) continue;
+    if (b->count) {
       for (int i = b->first; i < b->first + b->count; i++) {
         int pi = T->bounded[i];
+        const Box *pb = &T->prims[pi].box;
         double e2;
-        if (!box_hit(&T->prims[pi].box, o, inv, t0, t1, &e2)) continue;
+        if (!box_hit(pb->lo, pb->hi, o, inv, t0, t1, &e2)) continue;
         Hit h;
         if (prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
           *best = h;
@@ -594,22 +563,22 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
       continue;
     }
     /* Visit the nearer child first. */
+    const bvh_node *l = &T->bvh.nodes[b->first], *r = l + 1;
     double el = INFINITY, er = INFINITY;
-    int hl = box_hit(&T->bvh[b->left].box, o, inv, t0, t1, &el);
-    int hr = box_hit(&T->bvh[b->right].box, o, inv, t0, t1, &er);
-    if (sp + 2 > 128) continue;
+    int hl = box_hit(l->lo, l->hi, o, inv, t0, t1, &el);
+    int hr = box_hit(r->lo, r->hi, o, inv, t0, t1, &er);
     if (hl && hr) {
       if (el < er) {
-        stack[sp++] = b->right;
-        stack[sp++] = b->left;
+        stack[sp++] = b->first + 1;
+        stack[sp++] = b->first;
       } else {
-        stack[sp++] = b->left;
-        stack[sp++] = b->right;
+        stack[sp++] = b->first;
+        stack[sp++] = b->first + 1;
       }
     } else if (hl) {
-      stack[sp++] = b->left;
+      stack[sp++] = b->first;
     } else if (hr) {
-      stack[sp++] = b->right;
+      stack[sp++] = b->first + 1;
     }
   }
   return found;
@@ -654,21 +623,21 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
   } else {
     ray_normal(T->s, h.id, h.flip, p, n);
   }
-  if (dot3(n, d) > 0)
+  if (vec3_dot(n, d) > 0)
     for (int i = 0; i < 3; i++) n[i] = -n[i];
   *z = h.t; /* d is unit length: t is the distance */
   memcpy(nrm, n, sizeof n);
   const double *col = T->prims[h.prim].colour;
   for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
-  double scale = fmax(1.0, sqrt(dot3(p, p)));
+  double scale = fmax(1.0, sqrt(vec3_dot(p, p)));
   double eps = T->eps * scale;
   for (int l = 0; l < T->nlights; l++) {
     double L[3];
     for (int i = 0; i < 3; i++) L[i] = T->lights[l][i] - p[i];
-    double dist = sqrt(dot3(L, L));
+    double dist = sqrt(vec3_dot(L, L));
     if (!(dist > 0)) continue;
     for (int i = 0; i < 3; i++) L[i] /= dist;
-    double ndl = dot3(n, L);
+    double ndl = vec3_dot(n, L);
     if (ndl <= 0) continue;
     if (rs->shadows) {
       double so[3];
@@ -678,10 +647,10 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
       if (trace(T, so, L, 0, dist, c, &sh, 1)) continue;
     }
     double H[3] = {L[0] - d[0], L[1] - d[1], L[2] - d[2]};
-    double hl = sqrt(dot3(H, H));
+    double hl = sqrt(vec3_dot(H, H));
     double spec = 0;
     if (hl > 0) {
-      double ndh = dot3(n, H) / hl;
+      double ndh = vec3_dot(n, H) / hl;
       if (ndh > 0) { /* 0.3 ndh^32 by five squarings */
         double p2 = ndh * ndh, p4 = p2 * p2, p8 = p4 * p4, p16 = p8 * p8;
         spec = 0.3 * p16 * p16;
@@ -857,14 +826,13 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   if (collect_prims(&T, s->root)) goto oom;
   T.bounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
   T.unbounded = malloc(sizeof(int) * (size_t)(T.nprims + 1));
-  T.bvh = malloc(sizeof(BvhNode) * (size_t)(2 * T.nprims + 1));
-  if (!T.bounded || !T.unbounded || !T.bvh) goto oom;
+  if (!T.bounded || !T.unbounded) goto oom;
   for (int i = 0; i < T.nprims; i++) {
     if (box_is_empty(&T.prims[i].box)) continue; /* nothing to see */
     if (T.prims[i].bounded) T.bounded[T.nbounded++] = i;
     else T.unbounded[T.nunbounded++] = i;
   }
-  if (T.nbounded) build_bvh(&T, 0, T.nbounded);
+  if (T.nbounded && build_bvh(&T)) goto oom;
   if (setup_camera(&T, err, errlen)) goto fail;
   im = img_new(rs->width, rs->height, rs->aovs);
   if (!im) goto oom;
@@ -940,7 +908,7 @@ done:
   free(T.prims);
   free(T.bounded);
   free(T.unbounded);
-  free(T.bvh);
+  bvh_free(&T.bvh);
   pthread_mutex_destroy(&T.lock);
   return im;
 }
