@@ -256,6 +256,33 @@ static Value *force_patsel(Interp *I, Value *v) {
   qcs_error(pat->pos, "internal error: pattern variable lost");
 }
 
+/* Where the thunk saved in f was written, or a no-position: a delayed
+   application (V_APTHUNK, made by ++, ranges and built-ins) has none. */
+static Pos forcing_pos(const Forcing *f) {
+  if (f->saved.kind == V_THUNK) return f->saved.u.thunk.e->pos;
+  if (f->saved.kind == V_PATSEL) return f->saved.u.patsel.pat->pos;
+  return pos_none;
+}
+
+/* v, a V_BLACKHOLE, is being forced again while its own forcing is under
+   way. A blackhole keeps the union of what it was, but not its kind: the
+   kind is in the forcing stack, whose entries from v's up to the top are
+   the cycle. The error points at the first of them written in the user's
+   code, else at any with a position (the prelude's), else at the item. */
+static _Noreturn void cycle_error(Interp *I, Value *v) {
+  int k = I->nforcing - 1;
+  while (k >= 0 && I->forcing[k].v != v) k--;
+  Pos pos = pos_none, any = pos_none;
+  for (int i = k < 0 ? 0 : k; i < I->nforcing && !pos.line; i++) {
+    Pos p = forcing_pos(&I->forcing[i]);
+    if (!p.line) continue;
+    if (!any.line) any = p;
+    if (p.src != I->prelude_src) pos = p;
+  }
+  if (!pos.line) pos = any.line ? any : I->item_pos;
+  qcs_error(pos, "this value depends on itself (an infinite loop)");
+}
+
 Value *force(Interp *I, Value *v) {
   switch (v->kind) {
   case V_THUNK:
@@ -278,9 +305,7 @@ Value *force(Interp *I, Value *v) {
     return v;
   }
   case V_BLACKHOLE:
-    qcs_error(v->u.thunk.e && v->u.thunk.e->pos.line ? v->u.thunk.e->pos
-                                                     : pos_none,
-              "this value depends on itself (an infinite loop)");
+    cycle_error(I, v);
   default:
     return v;
   }
