@@ -88,6 +88,12 @@ struct Def {
   Clause **clauses;
   Pat *pat;      /* pattern binding */
   const char *sig; /* its type signature's text, if one was given */
+  /* A where/let binding `C args = e` with C capitalised is parsed as the
+     function C. If C is a constructor when the program is checked, it
+     becomes the pattern binding `C args` (interp.c, settle_defs);
+     guard_pos is then where its first guard's '|' stood, if it has one (a
+     pattern binding takes none). */
+  Pos guard_pos;
 };
 
 /* Type declarations: constructors with their arities. */

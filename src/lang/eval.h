@@ -11,6 +11,7 @@
 #define QCS_EVAL_H
 
 #include "lang/interp.h"
+#include "lang/limits.h"
 #include "lang/value.h"
 
 Value *eval(Interp *I, Expr *e, Env *env);
@@ -44,15 +45,6 @@ void eval_restore(Interp *I, int nforcing);
    loop). */
 void eval_check(Interp *I, Pos pos);
 
-/* An error for a resource limit hit (see interp.h): the message, then
-   "(limit NAME; raise it with :set NAME N or --NAME N)". Without a
-   position at hand, the top-level item's is used. */
-_Noreturn void eval_limit_error(Interp *I, Pos pos, const char *limit,
-                                const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-/* "WHAT more than SIZE of stackAFTER" as a max-stack error. */
-_Noreturn void eval_stack_error(Interp *I, Pos pos, const char *what,
-                                const char *after);
 /* Before one large allocation (a String): bytes more would pass
    max-memory -> the limit's error. */
 void eval_alloc_check(Interp *I, Pos pos, size_t bytes);
@@ -60,12 +52,6 @@ void eval_alloc_check(Interp *I, Pos pos, size_t bytes);
 _Noreturn void eval_list_limit(Interp *I, Pos pos, unsigned long long n);
 static inline void eval_list_count(Interp *I, Pos pos, unsigned long long n) {
   if (n > I->max_list && I->max_list) eval_list_limit(I, pos, n);
-}
-/* The stack check alone (the parser and the static checker use it). */
-static inline void eval_stack_check(Interp *I, Pos pos, const char *what) {
-  char probe;
-  if ((size_t)(I->stack_base - &probe) > I->stack_limit)
-    eval_stack_error(I, pos, what, "");
 }
 
 /* For a position inside the prelude, the innermost call from the user's

@@ -152,6 +152,64 @@ static _Noreturn void check_unknown(Check *C, Sym *s, Scope *sc, Pos pos) {
 static void check_expr(Check *C, Expr *e, Scope *sc);
 static void check_defs(Check *C, int n, Def **defs, Scope *sc);
 
+/* ---- settling what the parser left open ---- */
+
+static int is_upper(const Sym *s) { return s->name[0] >= 'A' && s->name[0] <= 'Z'; }
+static int is_con_def(const Def *d) {
+  return d->name && is_upper(d->name) && d->name->con_arity >= 0;
+}
+
+/* A where or let block's `C args = e` with C a constructor is a pattern
+   binding, not a function C: the parser cannot tell (it registers no
+   constructors), so the block is rewritten here, once constructors are
+   installed. Clauses the parser merged (`C a = ..; C b = ..`) become one
+   pattern binding each. */
+static void settle_defs(int *n, Def ***defs) {
+  int extra = 0, any = 0;
+  for (int i = 0; i < *n; i++)
+    if (is_con_def((*defs)[i])) {
+      any = 1;
+      extra += (*defs)[i]->nclauses - 1;
+    }
+  if (!any) return;
+  Def **out = GC_MALLOC(sizeof(Def *) * (size_t)(*n + extra));
+  int m = 0;
+  for (int i = 0; i < *n; i++) {
+    Def *d = (*defs)[i];
+    if (!is_con_def(d)) {
+      out[m++] = d;
+      continue;
+    }
+    for (int c = 0; c < d->nclauses; c++) {
+      Clause *cl = d->clauses[c];
+      if (cl->nbodies > 1 || cl->guards[0])
+        qcs_error(c == 0 && d->guard_pos.line ? d->guard_pos
+                  : cl->guards[0] ? cl->guards[0]->pos : cl->pos,
+                  "a pattern binding takes no guards");
+      Pat *p = GC_MALLOC(sizeof *p);
+      p->kind = P_CON;
+      p->pos = cl->pos;
+      p->u.con.con = d->name;
+      p->u.con.n = cl->npats;
+      p->u.con.args = cl->pats;
+      Clause *pc = GC_MALLOC(sizeof *pc);
+      *pc = *cl;
+      pc->npats = 0;
+      pc->pats = NULL;
+      Def *pd = GC_MALLOC(sizeof *pd);
+      pd->pos = cl->pos;
+      pd->pat = p;
+      pd->nclauses = 1;
+      pd->clauses = GC_MALLOC(sizeof(Clause *));
+      pd->clauses[0] = pc;
+      out[m++] = pd;
+    }
+  }
+  *n = m;
+  *defs = out;
+}
+
+
 static void check_var(Check *C, Sym *s, Scope *sc, Pos pos) {
   for (Scope *x = sc; x; x = x->up)
     for (int i = 0; i < x->n; i++)
@@ -166,6 +224,7 @@ static void check_def(Check *C, Def *d, Scope *sc) {
     Scope s = {sc, 0, 0, NULL};
     for (int i = 0; i < cl->npats; i++) pat_scope(C, cl->pats[i], &s);
     if (cl->nwhere) {
+      settle_defs(&cl->nwhere, &cl->where);
       for (int i = 0; i < cl->nwhere; i++) {
         Def *w = cl->where[i];
         if (w->pat) pat_scope(C, w->pat, &s);
@@ -207,6 +266,7 @@ static void check_expr_body(Check *C, Expr *e, Scope *sc) {
     break;
   case E_LAMBDA: check_def(C, e->u.lambda, sc); break;
   case E_LET: {
+    settle_defs(&e->u.let.n, &e->u.let.defs);
     Scope s = {sc, 0, 0, NULL};
     for (int i = 0; i < e->u.let.n; i++) {
       Def *w = e->u.let.defs[i];
@@ -281,6 +341,10 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
   }
   for (int i = 0; i < n; i++)
     if (items[i]->kind == ITEM_TYPE) install_type(I, items[i]);
+  for (int i = 0; i < n; i++)
+    if (items[i]->kind == ITEM_DEF && items[i]->def->name->con_arity >= 0)
+      qcs_error(items[i]->def->pos, "'%s' is a constructor; a function needs "
+                "another name", items[i]->def->name->name);
   for (int i = 0; i < n; i++) {
     if (items[i]->kind == ITEM_DEF) {
       Def *d = items[i]->def;
