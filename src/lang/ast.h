@@ -34,7 +34,10 @@ struct Expr {
     double num;
     const char *str;
     int b;
-    Sym *var;
+    /* E_VAR: the name, and where resolve.c found its binding: vslot > 0,
+       binding vslot - 1 of the frame vdepth up the Env chain; RES_GLOBAL,
+       the global; 0 (not resolved) or RES_SCAN, look it up by name. */
+    struct { Sym *var; int vdepth, vslot; };
     struct { Expr *fn; int n; Expr **args; } app;
     Def *lambda;                                  /* one clause, no name */
     struct { int n; Def **defs; Expr *body; } let;

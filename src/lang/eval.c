@@ -9,6 +9,7 @@
 
 #include "lang/parse.h"
 #include "lang/print.h"
+#include "lang/resolve.h"
 
 /* ---- checks ---- */
 
@@ -107,17 +108,36 @@ Value *eval_con_value(Interp *I, Sym *s) {
   return s->con_value;
 }
 
-static Value *lookup(Interp *I, Sym *s, Env *env, Pos pos) {
-  for (Env *e = env; e; e = e->up)
-    for (int i = e->n - 1; i >= 0; i--)
-      if (e->names[i] == s) return e->vals[i];
+/* A local binding of e (an E_VAR) in env, or NULL if it has none (a
+   global). Resolved variables (resolve.h) go straight to their frame and
+   slot; the name there is checked, and a variable that was not resolved,
+   or whose slot holds another name, is found by scanning as before. */
+static inline Value *lookup_local(Expr *e, Env *env) {
+  int slot = e->u.vslot;
+  if (slot == RES_GLOBAL) return NULL;
+  Sym *s = e->u.var;
+  if (slot > 0) {
+    Env *f = env;
+    for (int d = e->u.vdepth; d > 0 && f; d--) f = f->up;
+    if (f && slot <= f->n && f->names[slot - 1] == s) return f->vals[slot - 1];
+  }
+  for (Env *f = env; f; f = f->up)
+    for (int i = f->n - 1; i >= 0; i--)
+      if (f->names[i] == s) return f->vals[i];
+  return NULL;
+}
+
+static Value *lookup(Interp *I, Expr *e, Env *env) {
+  Value *v = lookup_local(e, env);
+  if (v) return v;
+  Sym *s = e->u.var;
   if (s->con_arity >= 0) return eval_con_value(I, s);
   /* The prelude's code sees the prelude's definitions, so a user's own
      `floor` (the scenes' name for the ground plane) cannot break fract. */
-  if (pos.src == I->prelude_src && pos.src && s->prelude_value)
+  if (e->pos.src == I->prelude_src && e->pos.src && s->prelude_value)
     return s->prelude_value;
   if (s->global) return s->global;
-  unknown_name(I, s, env, pos);
+  unknown_name(I, s, env, e->pos);
 }
 
 /* ---- thunks ---- */
@@ -143,13 +163,7 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
     *out = e->u.num;
     return 1;
   case E_VAR: {
-    Value *v = NULL;
-    for (Env *f = env; f && !v; f = f->up)
-      for (int i = f->n - 1; i >= 0; i--)
-        if (f->names[i] == e->u.var) {
-          v = f->vals[i];
-          break;
-        }
+    Value *v = lookup_local(e, env);
     if (!v || v->kind != V_NUM) return 0;
     *out = v->u.num;
     return 1;
@@ -183,7 +197,7 @@ Value *delay(Interp *I, Expr *e, Env *env) {
   case E_NUM: return val_num(e->u.num);
   case E_STR: return val_str(e->u.str);
   case E_BOOL: return val_bool(I, e->u.b);
-  case E_VAR: return lookup(I, e->u.var, env, e->pos);
+  case E_VAR: return lookup(I, e, env);
   default: return mk_thunk(e, env);
   }
 }
@@ -937,7 +951,7 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       result = val_bool(I, e->u.b);
       goto done;
     case E_VAR:
-      result = force(I, lookup(I, e->u.var, env, e->pos));
+      result = force(I, lookup(I, e, env));
       goto done;
     case E_WILD:
       qcs_error(e->pos, "'_' stands only in patterns");
