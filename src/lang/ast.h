@@ -2,9 +2,24 @@
  *
  * Expressions, patterns and definitions, each carrying the Pos of the
  * source that made it. Names are interned Syms (see value.h), so the
- * evaluator compares pointers. Nodes are allocated in the GC heap by the
- * parser and shared freely (closures made on one REPL line keep pointing at
- * that line's AST). */
+ * evaluator compares pointers.
+ *
+ * Owner: the parser makes the nodes, in the GC heap; nothing frees them
+ * (closures made on one REPL line keep pointing at that line's AST).
+ * After parsing, one pass writes to them (resolve.h): it rewrites a
+ * where/let block whose `C x = e` is a constructor's pattern binding, and
+ * fills in each E_VAR's vdepth/vslot. From then on the AST is read-only:
+ * the evaluator never changes it.
+ *
+ * Invariants: the parser shares no node between two places in the tree
+ * (the resolver's slot for an E_VAR depends on where it stands; a node it
+ * reaches twice in different scopes is marked RES_SCAN, looked up by
+ * name). Zeroed fields mean "absent" (GC_MALLOC zeroes): vslot 0 is "not
+ * resolved", guard_pos.line 0 "no guard". Every Def has >= 1 clause, and
+ * every clause of a Def has its arity in patterns (merge_clause checks).
+ *
+ * Threads: as the Interp that parsed it; an AST is not shared between
+ * interpreters. */
 #ifndef QCS_AST_H
 #define QCS_AST_H
 

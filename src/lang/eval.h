@@ -6,7 +6,26 @@
  * are needed. Tail calls (function bodies, if, let, guards) reuse the C
  * frame, so loops written as recursion run in constant C stack; deep
  * non-tail recursion is stopped with "recursion too deep" before the C
- * stack runs out. Errors are raised with qcs_error (see error.h). */
+ * stack runs out. Errors are raised with qcs_error (see error.h).
+ *
+ * Variables: a local is read from the frame and slot resolve.c recorded
+ * in the E_VAR (its name there is checked; one it never resolved is found
+ * by scanning the Env chain); a global from its Sym at the time of the
+ * lookup: the prelude's own code sees Sym.prelude_value, everything else
+ * Sym.global, so REPL redefinitions and --set overrides take effect.
+ *
+ * Invariants: a thunk being forced is a V_BLACKHOLE and has an entry in
+ * I->forcing (its contents before, for eval_restore); forcing a blackhole
+ * is a cycle, reported as "this value depends on itself" at the first
+ * thunk of the cycle with a position in the user's code. After any error,
+ * the handler must call eval_restore (interp.c's do), or thunks the error
+ * interrupted stay blackholes and later report false cycles. I->ntrace is
+ * the call depth, restored by every return.
+ *
+ * Threads: one evaluation at a time per Interp, on the thread whose stack
+ * base it was given (the stack check measures that thread's stack); values
+ * are allocated by that thread only (val_cell). Render workers never call
+ * in here. */
 #ifndef QCS_EVAL_H
 #define QCS_EVAL_H
 
