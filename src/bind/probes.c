@@ -129,6 +129,11 @@ static Value *csg_to_value(Interp *I, const csg_tape *t, Pos pos) {
   return stack[0];
 }
 
+/* Cleanups for err_defer (error.h). */
+static void free_csg_tape(void *b) { csg_tape_free(b); }
+static void free_scene(void *s) { scene_free(s); }
+static void free_ray_ctx(void *c) { ray_ctx_free(c); }
+
 static Value *bounds_probe(Interp *I, Value **args, Pos pos, int outer) {
   double r = get_radius(I, args[0], pos);
   double t = force_num(I, args[1], pos, "the density threshold");
@@ -146,17 +151,11 @@ static Value *bounds_probe(Interp *I, Value **args, Pos pos, int outer) {
   if (flags & BND_FALLBACK)
     compile_warn_once(I, pos, "no theorem applies to part of this tree: a "
                     "looser, still safe bound was used there");
-  ErrFrame f;
-  Value *v = NULL;
-  if (ERR_TRY(f)) {
-    v = csg_to_value(I, b, pos);
-    err_pop(&f);
-    csg_tape_free(b);
-  } else {
-    err_pop(&f);
-    csg_tape_free(b);
-    err_rethrow();
-  }
+  ErrCleanup cu; /* the tape must not leak if an error unwinds */
+  err_defer(&cu, free_csg_tape, b);
+  Value *v = csg_to_value(I, b, pos);
+  err_release(&cu);
+  csg_tape_free(b);
   return v;
 }
 
@@ -206,26 +205,22 @@ static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook) {
     qcs_error(pos, "out of memory");
   }
   c->hook = hook;
-  Value *v = NULL;
-  ErrFrame f;
-  if (ERR_TRY(f)) {
-    v = roots_list(I, s, o, d, c, pos);
-    if (c->unresolved_node >= 0)
-      qcs_warning(compile_node_pos(s, c->unresolved_node),
-                  "the root search left %ld segment%s of this object "
-                  "undecided (the ray runs within rounding of its surface "
-                  "for a long stretch): crossings that only touch the ray "
-                  "there may be missing", c->stats.lg.overflows,
-                  c->stats.lg.overflows == 1 ? "" : "s");
-    err_pop(&f);
-    ray_ctx_free(c);
-    scene_free(s);
-  } else {
-    err_pop(&f);
-    ray_ctx_free(c);
-    scene_free(s);
-    err_rethrow();
-  }
+  /* The scene and the context must not leak if an error unwinds. */
+  ErrCleanup cu_scene, cu_ctx;
+  err_defer(&cu_scene, free_scene, s);
+  err_defer(&cu_ctx, free_ray_ctx, c);
+  Value *v = roots_list(I, s, o, d, c, pos);
+  if (c->unresolved_node >= 0)
+    qcs_warning(compile_node_pos(s, c->unresolved_node),
+                "the root search left %ld segment%s of this object "
+                "undecided (the ray runs within rounding of its surface "
+                "for a long stretch): crossings that only touch the ray "
+                "there may be missing", c->stats.lg.overflows,
+                c->stats.lg.overflows == 1 ? "" : "s");
+  err_release(&cu_ctx);
+  err_release(&cu_scene);
+  ray_ctx_free(c);
+  scene_free(s);
   return v;
 }
 

@@ -2,9 +2,24 @@
  *
  * Expressions, patterns and definitions, each carrying the Pos of the
  * source that made it. Names are interned Syms (see value.h), so the
- * evaluator compares pointers. Nodes are allocated in the GC heap by the
- * parser and shared freely (closures made on one REPL line keep pointing at
- * that line's AST). */
+ * evaluator compares pointers.
+ *
+ * Owner: the parser makes the nodes, in the GC heap; nothing frees them
+ * (closures made on one REPL line keep pointing at that line's AST).
+ * After parsing, one pass writes to them (resolve.h): it rewrites a
+ * where/let block whose `C x = e` is a constructor's pattern binding, and
+ * fills in each E_VAR's vdepth/vslot. From then on the AST is read-only:
+ * the evaluator never changes it.
+ *
+ * Invariants: the parser shares no node between two places in the tree
+ * (the resolver's slot for an E_VAR depends on where it stands; a node it
+ * reaches twice in different scopes is marked RES_SCAN, looked up by
+ * name). Zeroed fields mean "absent" (GC_MALLOC zeroes): vslot 0 is "not
+ * resolved", guard_pos.line 0 "no guard". Every Def has >= 1 clause, and
+ * every clause of a Def has its arity in patterns (merge_clause checks).
+ *
+ * Threads: as the Interp that parsed it; an AST is not shared between
+ * interpreters. */
 #ifndef QCS_AST_H
 #define QCS_AST_H
 
@@ -34,7 +49,10 @@ struct Expr {
     double num;
     const char *str;
     int b;
-    Sym *var;
+    /* E_VAR: the name, and where resolve.c found its binding: vslot > 0,
+       binding vslot - 1 of the frame vdepth up the Env chain; RES_GLOBAL,
+       the global; 0 (not resolved) or RES_SCAN, look it up by name. */
+    struct { Sym *var; int vdepth, vslot; };
     struct { Expr *fn; int n; Expr **args; } app;
     Def *lambda;                                  /* one clause, no name */
     struct { int n; Def **defs; Expr *body; } let;
@@ -88,6 +106,12 @@ struct Def {
   Clause **clauses;
   Pat *pat;      /* pattern binding */
   const char *sig; /* its type signature's text, if one was given */
+  /* A where/let binding `C args = e` with C capitalised is parsed as the
+     function C. If C is a constructor when the program is checked, it
+     becomes the pattern binding `C args` (interp.c, settle_defs);
+     guard_pos is then where its first guard's '|' stood, if it has one (a
+     pattern binding takes none). */
+  Pos guard_pos;
 };
 
 /* Type declarations: constructors with their arities. */

@@ -1,5 +1,14 @@
 /* builtins.h: the table of functions written in C (see builtins.c).
- * Adding one is one line here and its function in builtins.c. */
+ * Adding one is one line here and its function in builtins.c.
+ *
+ * Each is installed as a global Sym holding a V_FUNC of kind F_BUILTIN,
+ * before the prelude loads (so the prelude may use and wrap them). A
+ * built-in gets its arguments unforced (thunks) and forces what it needs
+ * with the checked helpers of eval.h, which name the argument in their
+ * errors; it raises errors with qcs_error and returns a Value in weak-head
+ * normal form or a delayed application. Built-ins that loop over a list
+ * call eval_check and eval_list_count per element, so the interrupt and
+ * the limits reach them. Same thread rules as the evaluator. */
 #ifndef QCS_BUILTINS_H
 #define QCS_BUILTINS_H
 

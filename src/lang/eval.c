@@ -9,30 +9,9 @@
 
 #include "lang/parse.h"
 #include "lang/print.h"
+#include "lang/resolve.h"
 
 /* ---- checks ---- */
-
-_Noreturn void eval_limit_error(Interp *I, Pos pos, const char *limit,
-                                const char *fmt, ...) {
-  char msg[700];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(msg, sizeof msg, fmt, ap);
-  va_end(ap);
-  const char *arg =
-      !strcmp(limit, "max-stack") || !strcmp(limit, "max-memory") ? "SIZE"
-                                                                  : "N";
-  qcs_error(pos.line ? pos : I->item_pos, "%s (limit %s; raise it with :set "
-            "%s %s or --%s %s)", msg, limit, limit, arg, limit, arg);
-}
-
-void eval_stack_error(Interp *I, Pos pos, const char *what,
-                      const char *after) {
-  char sz[32];
-  interp_format_size(sz, sizeof sz, I->stack_limit);
-  eval_limit_error(I, pos, "max-stack", "%s more than %s of stack%s", what, sz,
-                   after);
-}
 
 /* Runs at every evaluation step: no system calls, no allocation. */
 void eval_check(Interp *I, Pos pos) {
@@ -129,17 +108,36 @@ Value *eval_con_value(Interp *I, Sym *s) {
   return s->con_value;
 }
 
-static Value *lookup(Interp *I, Sym *s, Env *env, Pos pos) {
-  for (Env *e = env; e; e = e->up)
-    for (int i = e->n - 1; i >= 0; i--)
-      if (e->names[i] == s) return e->vals[i];
+/* A local binding of e (an E_VAR) in env, or NULL if it has none (a
+   global). Resolved variables (resolve.h) go straight to their frame and
+   slot; the name there is checked, and a variable that was not resolved,
+   or whose slot holds another name, is found by scanning as before. */
+static inline Value *lookup_local(Expr *e, Env *env) {
+  int slot = e->u.vslot;
+  if (slot == RES_GLOBAL) return NULL;
+  Sym *s = e->u.var;
+  if (slot > 0) {
+    Env *f = env;
+    for (int d = e->u.vdepth; d > 0 && f; d--) f = f->up;
+    if (f && slot <= f->n && f->names[slot - 1] == s) return f->vals[slot - 1];
+  }
+  for (Env *f = env; f; f = f->up)
+    for (int i = f->n - 1; i >= 0; i--)
+      if (f->names[i] == s) return f->vals[i];
+  return NULL;
+}
+
+static Value *lookup(Interp *I, Expr *e, Env *env) {
+  Value *v = lookup_local(e, env);
+  if (v) return v;
+  Sym *s = e->u.var;
   if (s->con_arity >= 0) return eval_con_value(I, s);
   /* The prelude's code sees the prelude's definitions, so a user's own
      `floor` (the scenes' name for the ground plane) cannot break fract. */
-  if (pos.src == I->prelude_src && pos.src && s->prelude_value)
+  if (e->pos.src == I->prelude_src && e->pos.src && s->prelude_value)
     return s->prelude_value;
   if (s->global) return s->global;
-  unknown_name(I, s, env, pos);
+  unknown_name(I, s, env, e->pos);
 }
 
 /* ---- thunks ---- */
@@ -165,13 +163,7 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
     *out = e->u.num;
     return 1;
   case E_VAR: {
-    Value *v = NULL;
-    for (Env *f = env; f && !v; f = f->up)
-      for (int i = f->n - 1; i >= 0; i--)
-        if (f->names[i] == e->u.var) {
-          v = f->vals[i];
-          break;
-        }
+    Value *v = lookup_local(e, env);
     if (!v || v->kind != V_NUM) return 0;
     *out = v->u.num;
     return 1;
@@ -205,7 +197,7 @@ Value *delay(Interp *I, Expr *e, Env *env) {
   case E_NUM: return val_num(e->u.num);
   case E_STR: return val_str(e->u.str);
   case E_BOOL: return val_bool(I, e->u.b);
-  case E_VAR: return lookup(I, e->u.var, env, e->pos);
+  case E_VAR: return lookup(I, e, env);
   default: return mk_thunk(e, env);
   }
 }
@@ -256,6 +248,33 @@ static Value *force_patsel(Interp *I, Value *v) {
   qcs_error(pat->pos, "internal error: pattern variable lost");
 }
 
+/* Where the thunk saved in f was written, or a no-position: a delayed
+   application (V_APTHUNK, made by ++, ranges and built-ins) has none. */
+static Pos forcing_pos(const Forcing *f) {
+  if (f->saved.kind == V_THUNK) return f->saved.u.thunk.e->pos;
+  if (f->saved.kind == V_PATSEL) return f->saved.u.patsel.pat->pos;
+  return pos_none;
+}
+
+/* v, a V_BLACKHOLE, is being forced again while its own forcing is under
+   way. A blackhole keeps the union of what it was, but not its kind: the
+   kind is in the forcing stack, whose entries from v's up to the top are
+   the cycle. The error points at the first of them written in the user's
+   code, else at any with a position (the prelude's), else at the item. */
+static _Noreturn void cycle_error(Interp *I, Value *v) {
+  int k = I->nforcing - 1;
+  while (k >= 0 && I->forcing[k].v != v) k--;
+  Pos pos = pos_none, any = pos_none;
+  for (int i = k < 0 ? 0 : k; i < I->nforcing && !pos.line; i++) {
+    Pos p = forcing_pos(&I->forcing[i]);
+    if (!p.line) continue;
+    if (!any.line) any = p;
+    if (p.src != I->prelude_src) pos = p;
+  }
+  if (!pos.line) pos = any.line ? any : I->item_pos;
+  qcs_error(pos, "this value depends on itself (an infinite loop)");
+}
+
 Value *force(Interp *I, Value *v) {
   switch (v->kind) {
   case V_THUNK:
@@ -278,9 +297,7 @@ Value *force(Interp *I, Value *v) {
     return v;
   }
   case V_BLACKHOLE:
-    qcs_error(v->u.thunk.e && v->u.thunk.e->pos.line ? v->u.thunk.e->pos
-                                                     : pos_none,
-              "this value depends on itself (an infinite loop)");
+    cycle_error(I, v);
   default:
     return v;
   }
@@ -939,7 +956,7 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       result = val_bool(I, e->u.b);
       goto done;
     case E_VAR:
-      result = force(I, lookup(I, e->u.var, env, e->pos));
+      result = force(I, lookup(I, e, env));
       goto done;
     case E_WILD:
       qcs_error(e->pos, "'_' stands only in patterns");

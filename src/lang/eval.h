@@ -6,11 +6,31 @@
  * are needed. Tail calls (function bodies, if, let, guards) reuse the C
  * frame, so loops written as recursion run in constant C stack; deep
  * non-tail recursion is stopped with "recursion too deep" before the C
- * stack runs out. Errors are raised with qcs_error (see error.h). */
+ * stack runs out. Errors are raised with qcs_error (see error.h).
+ *
+ * Variables: a local is read from the frame and slot resolve.c recorded
+ * in the E_VAR (its name there is checked; one it never resolved is found
+ * by scanning the Env chain); a global from its Sym at the time of the
+ * lookup: the prelude's own code sees Sym.prelude_value, everything else
+ * Sym.global, so REPL redefinitions and --set overrides take effect.
+ *
+ * Invariants: a thunk being forced is a V_BLACKHOLE and has an entry in
+ * I->forcing (its contents before, for eval_restore); forcing a blackhole
+ * is a cycle, reported as "this value depends on itself" at the first
+ * thunk of the cycle with a position in the user's code. After any error,
+ * the handler must call eval_restore (interp.c's do), or thunks the error
+ * interrupted stay blackholes and later report false cycles. I->ntrace is
+ * the call depth, restored by every return.
+ *
+ * Threads: one evaluation at a time per Interp, on the thread whose stack
+ * base it was given (the stack check measures that thread's stack); values
+ * are allocated by that thread only (val_cell). Render workers never call
+ * in here. */
 #ifndef QCS_EVAL_H
 #define QCS_EVAL_H
 
 #include "lang/interp.h"
+#include "lang/limits.h"
 #include "lang/value.h"
 
 Value *eval(Interp *I, Expr *e, Env *env);
@@ -44,15 +64,6 @@ void eval_restore(Interp *I, int nforcing);
    loop). */
 void eval_check(Interp *I, Pos pos);
 
-/* An error for a resource limit hit (see interp.h): the message, then
-   "(limit NAME; raise it with :set NAME N or --NAME N)". Without a
-   position at hand, the top-level item's is used. */
-_Noreturn void eval_limit_error(Interp *I, Pos pos, const char *limit,
-                                const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-/* "WHAT more than SIZE of stackAFTER" as a max-stack error. */
-_Noreturn void eval_stack_error(Interp *I, Pos pos, const char *what,
-                                const char *after);
 /* Before one large allocation (a String): bytes more would pass
    max-memory -> the limit's error. */
 void eval_alloc_check(Interp *I, Pos pos, size_t bytes);
@@ -60,12 +71,6 @@ void eval_alloc_check(Interp *I, Pos pos, size_t bytes);
 _Noreturn void eval_list_limit(Interp *I, Pos pos, unsigned long long n);
 static inline void eval_list_count(Interp *I, Pos pos, unsigned long long n) {
   if (n > I->max_list && I->max_list) eval_list_limit(I, pos, n);
-}
-/* The stack check alone (the parser and the static checker use it). */
-static inline void eval_stack_check(Interp *I, Pos pos, const char *what) {
-  char probe;
-  if ((size_t)(I->stack_base - &probe) > I->stack_limit)
-    eval_stack_error(I, pos, what, "");
 }
 
 /* For a position inside the prelude, the innermost call from the user's

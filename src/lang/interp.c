@@ -1,7 +1,8 @@
 /* interp.c: running source text. See interp.h.
  *
- * A run parses the whole text first (a syntax error runs nothing), checks
- * every name it uses (an unknown name is reported before anything is
+ * A run parses the whole text first (a syntax error runs nothing), installs
+ * its type declarations' constructors, resolves and checks every name it
+ * uses (resolve.h: an unknown name is reported before anything is
  * evaluated, with a suggestion), installs the definitions, and then
  * evaluates the top-level expressions in order. */
 #include "lang/interp.h"
@@ -16,6 +17,7 @@
 #include "lang/eval.h"
 #include "lang/parse.h"
 #include "lang/print.h"
+#include "lang/resolve.h"
 
 #include "prelude.inc"
 
@@ -68,178 +70,6 @@ static void unwind(Interp *I, int nforcing) {
   qcs_interrupted = 0;
 }
 
-/* ---- the static check ---- */
-
-typedef struct Scope {
-  struct Scope *up;
-  int n, cap;
-  Sym **names;
-} Scope;
-
-typedef struct Check {
-  Interp *I;
-  Item **items;
-  int nitems;
-  int depth;  /* of check_expr calls: one per 8 KB of max-stack at most */
-} Check;
-
-static void scope_add(Scope *s, Sym *name) {
-  if (s->n == s->cap) {
-    s->cap = s->cap ? 2 * s->cap : 8;
-    Sym **a = GC_MALLOC(sizeof(Sym *) * (size_t)s->cap);
-    if (s->n) memcpy(a, s->names, sizeof(Sym *) * (size_t)s->n);
-    s->names = a;
-  }
-  s->names[s->n++] = name;
-}
-
-static void pat_scope(Check *C, Pat *p, Scope *s) {
-  switch (p->kind) {
-  case P_VAR: scope_add(s, p->u.var); break;
-  case P_CON:
-    if (p->u.con.con->con_arity < 0) {
-      qcs_error(p->pos, "'%s' in a pattern is not a constructor",
-                p->u.con.con->name);
-    }
-    if (p->u.con.con->con_arity != p->u.con.n)
-      qcs_error(p->pos, "constructor %s takes %d argument%s, this pattern "
-                "gives %d", p->u.con.con->name, p->u.con.con->con_arity,
-                p->u.con.con->con_arity == 1 ? "" : "s", p->u.con.n);
-    for (int i = 0; i < p->u.con.n; i++) pat_scope(C, p->u.con.args[i], s);
-    break;
-  case P_TUPLE: case P_LIST:
-    for (int i = 0; i < p->u.tuple.n; i++) pat_scope(C, p->u.tuple.items[i], s);
-    break;
-  case P_CONS:
-    pat_scope(C, p->u.cons.head, s);
-    pat_scope(C, p->u.cons.tail, s);
-    break;
-  default: break;
-  }
-}
-
-static int defined_in_batch(Check *C, Sym *s) {
-  for (int i = 0; i < C->nitems; i++)
-    if (C->items[i]->kind == ITEM_DEF && C->items[i]->def->name == s) return 1;
-  return 0;
-}
-
-static _Noreturn void check_unknown(Check *C, Sym *s, Scope *sc, Pos pos) {
-  const char *best = NULL;
-  int bestd = s->name[1] ? 3 : 1;
-  for (Scope *x = sc; x; x = x->up)
-    for (int i = 0; i < x->n; i++) {
-      int d = edit_distance(s->name, x->names[i]->name);
-      if (d < bestd && x->names[i]->name[0] != '%')
-        bestd = d, best = x->names[i]->name;
-    }
-  for (int i = 0; i < C->nitems; i++)
-    if (C->items[i]->kind == ITEM_DEF && C->items[i]->def->name) {
-      int d = edit_distance(s->name, C->items[i]->def->name->name);
-      if (d < bestd) bestd = d, best = C->items[i]->def->name->name;
-    }
-  Interp *I = C->I;
-  for (size_t h = 0; h < I->symcap; h++)
-    for (Sym *g = I->symtab[h]; g; g = g->next)
-      if ((g->global || g->con_arity >= 0) && g->name[0] != '%') {
-        int d = edit_distance(s->name, g->name);
-        if (d < bestd) bestd = d, best = g->name;
-      }
-  if (best) qcs_error(pos, "unknown name '%s' (did you mean '%s'?)", s->name, best);
-  qcs_error(pos, "unknown name '%s'", s->name);
-}
-
-static void check_expr(Check *C, Expr *e, Scope *sc);
-static void check_defs(Check *C, int n, Def **defs, Scope *sc);
-
-static void check_var(Check *C, Sym *s, Scope *sc, Pos pos) {
-  for (Scope *x = sc; x; x = x->up)
-    for (int i = 0; i < x->n; i++)
-      if (x->names[i] == s) return;
-  if (s->con_arity >= 0 || s->global || defined_in_batch(C, s)) return;
-  check_unknown(C, s, sc, pos);
-}
-
-static void check_def(Check *C, Def *d, Scope *sc) {
-  for (int c = 0; c < d->nclauses; c++) {
-    Clause *cl = d->clauses[c];
-    Scope s = {sc, 0, 0, NULL};
-    for (int i = 0; i < cl->npats; i++) pat_scope(C, cl->pats[i], &s);
-    if (cl->nwhere) {
-      for (int i = 0; i < cl->nwhere; i++) {
-        Def *w = cl->where[i];
-        if (w->pat) pat_scope(C, w->pat, &s);
-        else scope_add(&s, w->name);
-      }
-      check_defs(C, cl->nwhere, cl->where, &s);
-    }
-    for (int b = 0; b < cl->nbodies; b++) {
-      if (cl->guards[b]) check_expr(C, cl->guards[b], &s);
-      check_expr(C, cl->bodies[b], &s);
-    }
-  }
-}
-
-static void check_defs(Check *C, int n, Def **defs, Scope *sc) {
-  for (int i = 0; i < n; i++) check_def(C, defs[i], sc);
-}
-
-/* The AST's depth is bounded here, before anything runs: a chain of a
-   million '+' would otherwise recurse a million deep in eval. */
-static void check_expr_body(Check *C, Expr *e, Scope *sc);
-static void check_expr(Check *C, Expr *e, Scope *sc) {
-  if ((size_t)++C->depth > C->I->stack_limit >> 13)
-    eval_limit_error(C->I, e->pos, "max-stack",
-                     "expression nested too deeply to evaluate");
-  eval_stack_check(C->I, e->pos,
-                   "expression nested too deeply: checking it needs");
-  check_expr_body(C, e, sc);
-  C->depth--;
-}
-
-static void check_expr_body(Check *C, Expr *e, Scope *sc) {
-  switch (e->kind) {
-  case E_VAR: check_var(C, e->u.var, sc, e->pos); break;
-  case E_WILD: qcs_error(e->pos, "'_' stands only in patterns");
-  case E_APP:
-    check_expr(C, e->u.app.fn, sc);
-    for (int i = 0; i < e->u.app.n; i++) check_expr(C, e->u.app.args[i], sc);
-    break;
-  case E_LAMBDA: check_def(C, e->u.lambda, sc); break;
-  case E_LET: {
-    Scope s = {sc, 0, 0, NULL};
-    for (int i = 0; i < e->u.let.n; i++) {
-      Def *w = e->u.let.defs[i];
-      if (w->pat) pat_scope(C, w->pat, &s);
-      else scope_add(&s, w->name);
-    }
-    check_defs(C, e->u.let.n, e->u.let.defs, &s);
-    check_expr(C, e->u.let.body, &s);
-    break;
-  }
-  case E_IF:
-    check_expr(C, e->u.cond.c, sc);
-    check_expr(C, e->u.cond.t, sc);
-    check_expr(C, e->u.cond.f, sc);
-    break;
-  case E_TUPLE: case E_LIST:
-    for (int i = 0; i < e->u.tuple.n; i++) check_expr(C, e->u.tuple.items[i], sc);
-    break;
-  case E_RANGE:
-    check_expr(C, e->u.range.from, sc);
-    if (e->u.range.then) check_expr(C, e->u.range.then, sc);
-    if (e->u.range.to) check_expr(C, e->u.range.to, sc);
-    break;
-  case E_BINOP:
-    check_expr(C, e->u.bin.a, sc);
-    check_expr(C, e->u.bin.b, sc);
-    break;
-  case E_NEG: check_expr(C, e->u.neg, sc); break;
-  case E_DEFBODY: check_def(C, e->u.def, sc); break;
-  default: break;
-  }
-}
-
 /* ---- running ---- */
 
 static void install_type(Interp *I, Item *it) {
@@ -268,7 +98,6 @@ static void refresh_values(Interp *I) {
 static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
                            const char *runname) {
   int runid = ++run_counter;
-  Check C = {I, items, n, 0};
   /* Duplicate definitions within one script are mistakes. */
   for (int i = 0; i < n; i++) {
     if (items[i]->kind != ITEM_DEF) continue;
@@ -281,15 +110,11 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
   }
   for (int i = 0; i < n; i++)
     if (items[i]->kind == ITEM_TYPE) install_type(I, items[i]);
-  for (int i = 0; i < n; i++) {
-    if (items[i]->kind == ITEM_DEF) {
-      Def *d = items[i]->def;
-      Scope top = {NULL, 0, 0, NULL};
-      check_def(&C, d, &top);
-    } else if (items[i]->kind == ITEM_EXPR) {
-      check_expr(&C, items[i]->expr, NULL);
-    }
-  }
+  for (int i = 0; i < n; i++)
+    if (items[i]->kind == ITEM_DEF && items[i]->def->name->con_arity >= 0)
+      qcs_error(items[i]->def->pos, "'%s' is a constructor; a function needs "
+                "another name", items[i]->def->name->name);
+  resolve_items(I, items, n);
   int redefined = 0;
   for (int i = 0; i < n; i++) {
     Item *it = items[i];
@@ -474,8 +299,7 @@ RunStatus interp_set_override(Interp *I, const char *name, const char *expr) {
     if (!ok) qcs_error(pos_none, "--set needs NAME=VALUE with a plain name, "
                        "not '%s'", name);
     Expr *e = parse_expression(I, src);
-    Check C = {I, NULL, 0, 0};
-    check_expr(&C, e, NULL);
+    resolve_expr(I, e);
     Sym *s = sym_intern(I, name, (int)strlen(name));
     if (s->con_arity >= 0)
       qcs_error(pos_none, "--set cannot replace the constructor %s", name);

@@ -8,8 +8,25 @@
  * call trace; an error abandons the current item but never the definitions
  * made before it.
  *
+ * A run goes: parse (defines nothing, see parse.h), install the type
+ * declarations' constructors, resolve and check every name (resolve.h;
+ * nothing has run yet if this fails), install the definitions, evaluate
+ * the expressions in order.
+ *
  * Memory: values, ASTs and source texts live in the garbage-collected heap
- * (Boehm GC); nothing handed out here needs freeing by the caller. */
+ * (Boehm GC); nothing handed out here needs freeing by the caller.
+ *
+ * Failure modes: every entry point that runs code catches the language's
+ * errors itself (error.h), reports them, undoes the half-forced thunks and
+ * returns RUN_ERROR; none returns with an error frame or a cleanup left
+ * behind. Only running out of memory in the collector, or the prelude
+ * failing to load (exit 2), ends the process.
+ *
+ * Threads: an Interp is used by one thread, the one whose stack it was
+ * given (interp_set_stack). Two Interps must not evaluate at the same time
+ * either: values come from one batch shared by the process (val_cell in
+ * value.h). Only interp_request_interrupt may be called from elsewhere (a
+ * signal handler, another thread). */
 #ifndef QCS_INTERP_H
 #define QCS_INTERP_H
 

@@ -5,7 +5,10 @@
  * starts a line). Token texts point into the source, which the caller keeps
  * alive; the token array is allocated in the GC heap. Lexical errors
  * (unterminated string or comment, stray bytes, NUL, out-of-range numbers)
- * are raised with qcs_error at their position. */
+ * are raised with qcs_error at their position (an unterminated comment
+ * with qcs_error_incomplete, so the REPL reads on; a string must end on
+ * its line). The lexer keeps no state between calls and touches no
+ * Interp. */
 #ifndef QCS_LEX_H
 #define QCS_LEX_H
 

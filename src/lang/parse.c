@@ -4,7 +4,7 @@
 #include <gc.h>
 #include <string.h>
 
-#include "lang/eval.h"
+#include "lang/limits.h"
 
 #define LAYOUT_MAX 256
 
@@ -986,12 +986,14 @@ static Def *binding(Parser *P, int toplevel, int *is_expr, Expr **ex) {
   Def *d = GC_MALLOC(sizeof *d);
   d->pos = pos;
   Expr *head = lhs->kind == E_APP ? lhs->u.app.fn : lhs;
-  if (head->kind == E_VAR &&
-      !(head->u.var->con_arity >= 0 && !toplevel)) {
+  if (head->kind == E_VAR) {
+    /* `C x = e` with C capitalised: a function C, unless C is a
+       constructor when the program runs (a pattern binding in where/let,
+       an error at the top level). The parser registers nothing, so that is
+       settled after parsing (interp.c, settle_defs). */
     Sym *name = head->u.var;
-    if (name->con_arity >= 0)
-      qcs_error(head->pos, "'%s' is a constructor; a function needs another "
-                "name", name->name);
+    if (!toplevel && is_upper(name) && peek(P) == T_BAR)
+      d->guard_pos = pos_here(P);
     int n = lhs->kind == E_APP ? lhs->u.app.n : 0;
     Pat **pats = GC_MALLOC(sizeof(Pat *) * (size_t)(n + 1));
     Vec vars = {0};
@@ -1130,12 +1132,8 @@ static Item *type_decl(Parser *P, Pos pos) {
   it->ncons = cons.n;
   it->cons = GC_MALLOC(sizeof(ConDecl) * (size_t)cons.n);
   for (int i = 0; i < cons.n; i++) it->cons[i] = *(ConDecl *)cons.items[i];
-  /* Constructors are known from here on, so later patterns can use them. */
-  for (int i = 0; i < it->ncons; i++) {
-    Sym *s = it->cons[i].name;
-    s->con_arity = it->cons[i].arity;
-    s->con_type = it->type;
-  }
+  /* Registered when the items are installed (interp.c), not here: parsing
+     changes no definition, so a text that fails to parse leaves none. */
   return it;
 }
 

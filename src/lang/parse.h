@@ -6,7 +6,20 @@
  * bindings of a `where` or `let` block line up in one column. Errors are
  * raised with qcs_error (qcs_error_incomplete when the text ends too
  * soon, so the REPL can ask for another line). Everything is allocated in
- * the GC heap. */
+ * the GC heap.
+ *
+ * State: parsing defines nothing. The only change it makes to the Interp
+ * is interning names (sym_intern adds a Sym with no value, which is not a
+ * definition: the checker, completion and :browse look at values and
+ * constructors, not at the table's size). It reads the stack limit for
+ * its nesting check (limits.h). Type declarations come back as ITEM_TYPE
+ * items; their constructors are installed when the items run (interp.c),
+ * so a text that fails to parse, or is only parsed (fuzz_parse), leaves
+ * the interpreter as it found it. Whether a where/let binding `C x = e` is
+ * a function C or a pattern binding depends on whether C is a constructor
+ * then, so it is settled by resolve.c, not here.
+ *
+ * Threads: one parse at a time per Interp (sym_intern is not locked). */
 #ifndef QCS_PARSE_H
 #define QCS_PARSE_H
 

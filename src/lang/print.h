@@ -1,7 +1,12 @@
 /* print.h: values printed in the language's own syntax, so that what the
  * REPL shows can be typed back: Reals in the shortest decimal that reads
  * back to the same double, tuples, lists, strings with escapes, and
- * constructor trees as applications with parentheses where needed. */
+ * constructor trees as applications with parentheses where needed.
+ *
+ * Printing forces what it prints, so it can raise any evaluation error
+ * (and the limits: max-list for a long list, max-memory for show's text);
+ * output written before the error stays written. Same thread rules as the
+ * evaluator. */
 #ifndef QCS_PRINT_H
 #define QCS_PRINT_H
 

@@ -5,7 +5,18 @@
  * something forces it. Forcing overwrites the thunk in place with its
  * weak-head normal form, so each thunk runs at most once (call by need).
  * All values live in the Boehm GC heap: no ownership to track, cycles
- * (a list defined in terms of itself) are fine. */
+ * (a list defined in terms of itself) are fine.
+ *
+ * Environments: an Env frame is made per clause applied (its pattern
+ * variables, then its where bindings) and per let, and only there (eval.c);
+ * resolve.c predicts each variable's frame and slot from the same rules,
+ * so the two must change together (see resolve.h). Frames only grow while
+ * being filled, before anything reads them by slot.
+ *
+ * The Interp here is the whole state of one interpreter: the symbol table
+ * (globals, constructors, signatures), the limits, the call trace and the
+ * stack of thunks being forced. It is used by one thread at a time; only
+ * qcs_interrupted (a global, not a field) is written from elsewhere. */
 #ifndef QCS_VALUE_H
 #define QCS_VALUE_H
 

@@ -112,6 +112,18 @@ static void test_parser(void) {
   CHECK("parse: comparisons do not chain", n < 0);
   n = parse("f (a, a) = a", MODE_REPL, &it);
   CHECK("parse: repeated pattern variable", n < 0);
+  /* Parsing defines nothing: a type's constructors are installed when the
+     items run (interp.c), so a text that fails to parse, or one only
+     parsed (fuzz/fuzz_parse.c), leaves the interpreter as it was. */
+  n = parse(":: Parsed = Zorkon Real | Zorkoff;\nf Zorkoff = 1\n", MODE_SCRIPT,
+            &it);
+  CHECK("parse: a type declaration registers no constructor",
+        n == 2 && sym_intern(I, "Zorkon", 6)->con_arity < 0 &&
+            sym_intern(I, "Zorkoff", 7)->con_arity < 0);
+  n = parse("f = a where Zorkon a = Zorkon 1", MODE_SCRIPT, &it);
+  CHECK("parse: a capitalised local binding is left for the checker",
+        n == 1 && it[0]->def->clauses[0]->nwhere == 1 &&
+            !it[0]->def->clauses[0]->where[0]->pat);
 }
 
 /* Evaluates text and returns its printed value, or "error: MSG". */
