@@ -7,17 +7,17 @@ void report_render(FILE *out, const RenderReport *r, const char *path) {
           r->width, r->height, r->spp, r->spp == 1 ? "" : "s", r->seconds,
           r->threads, r->threads == 1 ? "" : "s");
   fprintf(out, "  rays: %ld primary, %ld shadow (%.2f M rays/s)\n", r->primary,
-          r->shadow, r->seconds > 0 ? rays / r->seconds / 1e6 : 0.0);
+          r->shadow, r->seconds > 0 ? (double)rays / r->seconds / 1e6 : 0.0);
   if (r->evals || r->segments)
     fprintf(out, "  density: %ld evaluations, %ld segments, %ld polishing "
             "steps; %.2f steps per ray (most in one ray: %ld)\n",
             r->evals, r->segments, r->steps,
-            rays ? (double)(r->segments + r->steps) / rays : 0.0,
+            rays ? (double)(r->segments + r->steps) / (double)rays : 0.0,
             r->max_ray_work);
   if (r->rounded_hits)
     fprintf(out, "  rays hitting a rounded surface: %ld, %.1f density "
             "evaluations each\n", r->rounded_hits,
-            (double)r->rounded_hit_evals / r->rounded_hits);
+            (double)r->rounded_hit_evals / (double)r->rounded_hits);
   if (r->soft_solves)
     fprintf(out, "  soft objects: %ld polynomial solves\n", r->soft_solves);
   if (r->tol_in_force > r->tol && r->coord_scale > 1e3)

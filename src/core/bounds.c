@@ -235,7 +235,7 @@ static csg_tape *bound(const dt_tape *tp, double level, int kind, int *flagp) {
     case E_PLANE:
       e = csg_builder_plane(b, tp->leaves[tp->code[i].arg].n, nd[i].offset);
       break;
-    case E_OP: e = csg_builder_op(b, nd[i].csgop); break;
+    case E_OP: e = csg_builder_op(b, (csg_op)nd[i].csgop); break;
     }
     if (e) goto done;
   }

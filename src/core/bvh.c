@@ -114,7 +114,7 @@ int bvh_build(bvh *b, const bvh_item *items, int n, int leaf_max, int split) {
   }
   for (int j = 0; j < n; j++) {
     b->idx[j] = j;
-    for (int i = 0; i < 3; i++) cen[(size_t)i * n + j] = items[j].c[i];
+    for (int i = 0; i < 3; i++) cen[(size_t)i * (size_t)n + (size_t)j] = items[j].c[i];
   }
   b->n = n;
   b->nnodes = 1;

@@ -500,7 +500,7 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
       } else if (c == 0 || !live) {
         fold_leaf(&f, in, 1, c, buf);
       } else {
-        int a = pp->gsnip[g->snip0 + live], b = pp->gsnip[g->snip0 + live + 1];
+        int a = pp->gsnip[(unsigned)g->snip0 + live], b = pp->gsnip[(unsigned)g->snip0 + live + 1];
         f.start[f.sp] = f.n;
         f.isc[f.sp++] = 0;
         memcpy(buf + f.n, pp->gcode + a, (size_t)(b - a) * sizeof *buf);

@@ -361,7 +361,7 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
       int from = sg.depth - 1 < s->nlv - 1 ? sg.depth - 1 : s->nlv - 1;
       int to = sg.depth < s->nlv ? sg.depth : s->nlv;
       dt_prune_rl(from ? &lv[from] : t, s->rl, sg.a, sg.b,
-                  s->lvbuf + (size_t)to * s->ncode, &lv[to]);
+                  s->lvbuf + (size_t)to * (size_t)s->ncode, &lv[to]);
       vp = &lv[to];
     }
     int nc = vp->ncode;

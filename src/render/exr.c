@@ -99,7 +99,7 @@ static int bind_encode(exr_encode_pipeline_t *enc, const Chan *ch, int nch,
     if (!m) return -1;
     c->user_bytes_per_element = 4;
     c->user_data_type = EXR_PIXEL_FLOAT;
-    c->user_pixel_stride = (int32_t)(m->comps * sizeof(float));
+    c->user_pixel_stride = (int32_t)((size_t)m->comps * sizeof(float));
     c->user_line_stride = c->user_pixel_stride * im->width;
     c->encode_from_ptr = (const uint8_t *)(m->base + (size_t)m->comps *
                                            img_index(im, 0, y) + m->offset);

@@ -185,7 +185,7 @@ int img_write_ppm(const Image *im, FILE *f, const char *path, char *err,
   for (int y = 0; ok && y < im->height; y++) {
     const float *p = im->rgba + 4 * img_index(im, 0, y);
     for (size_t x = 0; x < w; x++)
-      for (int c = 0; c < 3; c++) row[3 * x + c] = img_srgb8(p[4 * x + c]);
+      for (size_t c = 0; c < 3; c++) row[3 * x + c] = img_srgb8(p[4 * x + c]);
     ok = fwrite(row, 1, 3 * w, f) == 3 * w;
   }
   free(row);
@@ -207,7 +207,7 @@ int img_compare(const Image *a, const Image *b, double *rms,
   for (size_t i = 0; i < np; i++) {
     double worst = 0;
     for (int c = 0; c < 3; c++) {
-      float x = a->rgba[4 * i + c], y = b->rgba[4 * i + c];
+      float x = a->rgba[4 * i + (size_t)c], y = b->rgba[4 * i + (size_t)c];
       if (x == y || (isnan(x) && isnan(y))) continue;
       double d = fabs((double)x - (double)y);
       if (isnan(d)) d = INFINITY;

@@ -327,7 +327,7 @@ typedef struct Tracer {
 static double now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + ts.tv_nsec * 1e-9;
+  return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
 static int add_prim(Tracer *T, int node, const double *colour) {
@@ -705,11 +705,11 @@ static void render_tile(Worker *W, int tile) {
           }
         }
       size_t k = img_index(im, x, y);
-      for (int i = 0; i < 3; i++) im->rgba[4 * k + i] = (float)(sum[i] / (g * g));
+      for (int i = 0; i < 3; i++) im->rgba[4 * k + (size_t)i] = (float)(sum[i] / (g * g));
       im->rgba[4 * k + 3] = 1;
       if (im->z) im->z[k] = (float)zmin;
       if (im->n)
-        for (int i = 0; i < 3; i++) im->n[3 * k + i] = (float)nrm0[i];
+        for (int i = 0; i < 3; i++) im->n[3 * k + (size_t)i] = (float)nrm0[i];
       if (im->cost) im->cost[k] = (float)(ray_work(W->c) - work0);
     }
 }

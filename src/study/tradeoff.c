@@ -74,7 +74,7 @@ static int sample_hits(const Scene *s, const RenderSettings *rs, double tol,
       int n = ray_spans(s, s->root, cam.eye, d, 0, INFINITY, c, &sp);
       double hit = NAN;
       if (n > 0 && sp[0].t0 > 0) hit = sp[0].t0;
-      z[(size_t)y * rs->width + x] = hit;
+      z[(size_t)y * (size_t)rs->width + (size_t)x] = hit;
     }
   if (c->failed) {
     ray_ctx_free(c);
