@@ -101,13 +101,32 @@ static void dt_check(Compile *C, int err, Pos pos) {
   if (err) qcs_error(pos, "%s", dt_strerror(err));
 }
 
+/* A constructor of a tree being compiled, forced, with its kind, its
+   position and its arguments (NULL unless it is a constructor). */
+typedef struct Node {
+  Value *v;
+  ConKind k;
+  Pos pos;
+  Value **a;
+} Node;
+
+static Node node_of(Compile *C, Value *v) {
+  eval_check(C->I, C->pos);
+  Node n;
+  n.v = force(C->I, v);
+  n.k = con_kind(n.v);
+  n.pos = vpos(C, n.v);
+  n.a = n.v->kind == V_CON ? n.v->u.con.args : NULL;
+  return n;
+}
+
 /* Emits the density tree v in postfix order into C->db. */
 static void emit_density(Compile *C, Value *v, double r) {
-  eval_check(C->I, C->pos);
-  v = force(C->I, v);
-  ConKind k = con_kind(v);
-  Pos pos = vpos(C, v);
-  Value **a = v->kind == V_CON ? v->u.con.args : NULL;
+  Node N = node_of(C, v);
+  ConKind k = N.k;
+  Pos pos = N.pos;
+  Value **a = N.a;
+  v = N.v;
   dt_op op;
   switch (k) {
   case K_SUM: op = DT_SUM; break;
@@ -218,11 +237,10 @@ static int set_node(Compile *C, ScKind kind, Pos pos, int a, int b) {
 
 /* A density tree with no radius: the sharp polyhedron it describes. */
 static int compile_sharp(Compile *C, Value *v) {
-  eval_check(C->I, C->pos);
-  v = force(C->I, v);
-  ConKind k = con_kind(v);
-  Pos pos = vpos(C, v);
-  Value **a = v->kind == V_CON ? v->u.con.args : NULL;
+  Node N = node_of(C, v);
+  ConKind k = N.k;
+  Pos pos = N.pos;
+  Value **a = N.a;
   switch (k) {
   case K_SUM: case K_DUNION: case K_UNION:
     return set_node(C, SC_UNION, pos, compile_sharp(C, a[0]),
@@ -243,7 +261,7 @@ static int compile_sharp(Compile *C, Value *v) {
     return add(C, &h, pos);
   }
   default:
-    return compile_obj(C, v);
+    return compile_obj(C, N.v);
   }
 }
 
@@ -491,11 +509,10 @@ static int compile_rounded(Compile *C, Value *tree, double r, Pos pos) {
 }
 
 static int compile_obj(Compile *C, Value *v) {
-  eval_check(C->I, C->pos);
-  v = force(C->I, v);
-  ConKind k = con_kind(v);
-  Pos pos = vpos(C, v);
-  Value **a = v->kind == V_CON ? v->u.con.args : NULL;
+  Node N = node_of(C, v);
+  ConKind k = N.k;
+  Pos pos = N.pos;
+  Value **a = N.a;
   switch (k) {
   case K_UNION:
     return set_node(C, SC_UNION, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
@@ -504,11 +521,11 @@ static int compile_obj(Compile *C, Value *v) {
   case K_SETDIFF:
     return set_node(C, SC_DIFF, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
   case K_HALFSPACE:
-    return compile_sharp(C, v);
+    return compile_sharp(C, N.v);
   case K_ROUNDED:
     return compile_rounded(C, a[1], get_radius(C, a[0], pos), pos);
   case K_SOFT:
-    return compile_soft(C, v, pos);
+    return compile_soft(C, N.v, pos);
   case K_EMPTY:
     return add_node(C, SC_EMPTY, pos);
   case K_ALL:
@@ -527,8 +544,8 @@ static int compile_obj(Compile *C, Value *v) {
     return i;
   }
   default:
-    if (is_density_kind(k)) return compile_rounded(C, v, 0, pos);
-    not_a(C, v, "a scene object (Union, Intersection, SetDifference, "
+    if (is_density_kind(k)) return compile_rounded(C, N.v, 0, pos);
+    not_a(C, N.v, "a scene object (Union, Intersection, SetDifference, "
           "Rounded, Halfspace, SoftObject, or a density tree)");
   }
 }

@@ -82,14 +82,7 @@ static _Noreturn void unknown_name(Interp *I, Sym *s, Env *env, Pos pos) {
       int d = edit_distance(s->name, e->names[i]->name);
       if (d < bestd) bestd = d, best = e->names[i]->name;
     }
-  for (size_t h = 0; h < I->symcap; h++)
-    for (Sym *g = I->symtab[h]; g; g = g->next)
-      if ((g->global || g->con_arity >= 0) && g->name[0] != '%') {
-        int d = edit_distance(s->name, g->name);
-        if (d < bestd) bestd = d, best = g->name;
-      }
-  if (best) qcs_error(pos, "unknown name '%s' (did you mean '%s'?)", s->name, best);
-  qcs_error(pos, "unknown name '%s'", s->name);
+  resolve_unknown_name(I, s, best, bestd, pos);
 }
 
 Value *eval_con_value(Interp *I, Sym *s) {

@@ -138,7 +138,11 @@ static _Noreturn void unknown(Resolver *R, Sym *s, Scope *sc, Pos pos) {
       int d = edit_distance(s->name, R->items[i]->def->name->name);
       if (d < bestd) bestd = d, best = R->items[i]->def->name->name;
     }
-  Interp *I = R->I;
+  resolve_unknown_name(R->I, s, best, bestd, pos);
+}
+
+void resolve_unknown_name(Interp *I, Sym *s, const char *best, int bestd,
+                          Pos pos) {
   for (size_t h = 0; h < I->symcap; h++)
     for (Sym *g = I->symtab[h]; g; g = g->next)
       if ((g->global || g->con_arity >= 0) && g->name[0] != '%') {

@@ -56,4 +56,11 @@ void resolve_items(Interp *I, Item **items, int n);
 /* Check and resolve one expression at the top level (qcs --set). */
 void resolve_expr(Interp *I, Expr *e);
 
+/* The error for an unknown name at pos: "did you mean" the closest of
+   best (a local candidate the caller found at distance bestd, or NULL)
+   and every global name. Also the evaluator's, for a name it cannot find
+   at run time. */
+_Noreturn void resolve_unknown_name(Interp *I, Sym *s, const char *best,
+                                    int bestd, Pos pos);
+
 #endif
