@@ -179,7 +179,7 @@ typedef struct {
   const dt_ray_leaf *rl;  /* the leaves along this ray */
   dt_instr *lvbuf;        /* nlv code buffers of ncode instructions, then */
   int nlv, ncode;         /* one scratch buffer for deeper segments */
-  int first;          /* stop at the first crossing after first_after; 2:
+  int first;          /* lg_mode: stop at the first crossing after first_after; 2:
                          any point of its bracket will do (polish) */
   double first_after;
   double *grad;       /* if not NULL: the gradient at that crossing */
@@ -442,11 +442,10 @@ static void ray_leaves_hull(const dt_tape *t, const double o[3],
 }
 
 /* Search the sorted, disjoint intervals iv[0..n) (pairs of doubles). */
-static int run(const dt_tape *t, const double o[3], const double d[3],
-               const double *iv, int n, double tol, lg_root *out, int maxout,
-               lg_stats *stats, const lg_hook *hook, int first,
-               double first_after, int bounded_iv, double *grad) {
-  if (n <= 0 || maxout <= 0) return 0;
+static int run(const lg_query *q, const double *iv, int n, int bounded_iv) {
+  const dt_tape *t = q->tape;
+  const double *o = q->o, *d = q->d;
+  if (n <= 0 || q->maxout <= 0) return 0;
   dt_instr local[LG_LEVEL_CODE], *buf = local;
   dt_ray_leaf lrl[LG_LOCAL_LEAVES], *rl = lrl;
   int nc = t->ncode > 0 ? t->ncode : 1;
@@ -476,8 +475,9 @@ static int run(const dt_tape *t, const double o[3], const double d[3],
     dt_ray_leaves(t, o, d, rl);
   else
     ray_leaves_hull(t, o, d, rl, &hlo, &hhi);
-  search s = {o, d, tol > 0 ? tol : DBL_MIN, out, 0, maxout, stats, hook,
-              rl, buf + nc, nlv, nc, first, first_after, grad};
+  search s = {o, d, q->tol > 0 ? q->tol : DBL_MIN, q->out, 0, q->maxout,
+              q->stats, q->hook, rl, buf + nc, nlv, nc, (int)q->mode, q->t0,
+              q->grad};
   for (int i = 0; i < n; i++) {
     double a = iv[2 * i], b = iv[2 * i + 1];
     if (hlo > a) a = hlo;
@@ -497,15 +497,15 @@ int lg_roots(const dt_tape *t, const double o[3], const double d[3],
              double t0, double t1, double tol, lg_root *out, int maxout,
              lg_stats *stats) {
   double iv[2] = {t0, t1};
-  return run(t, o, d, iv, t0 <= t1, tol, out, maxout, stats, NULL, 0, 0, 0,
-             NULL);
+  lg_query q = {t, o, d, t0, t1, tol, out, maxout, stats, NULL, LG_ALL, NULL};
+  return run(&q, iv, t0 <= t1, 0);
 }
 
-static int spans_run(const dt_tape *t, const double o[3], const double d[3],
-                     double t0, double t1, const csg_span *spans, int nspans,
-                     double tol, lg_root *out, int maxout, lg_stats *stats,
-                     const lg_hook *hook, int first, int bounded_iv,
-                     double *grad) {
+/* Search the given sorted spans, each widened by tol (plus a few ulps) and
+   clipped to [q->t0, q->t1]; widened neighbours are merged. */
+static int spans_run(const lg_query *q, const csg_span *spans, int nspans,
+                     int bounded_iv) {
+  const double tol = q->tol, t0 = q->t0, t1 = q->t1;
   double local[2 * 64], *iv = local;
   if (nspans > 64) {
     iv = malloc((size_t)nspans * 2 * sizeof *iv);
@@ -525,8 +525,7 @@ static int spans_run(const dt_tape *t, const double o[3], const double d[3],
     iv[2 * n + 1] = b;
     n++;
   }
-  int r = run(t, o, d, iv, n, tol, out, maxout, stats, hook, first, t0,
-              bounded_iv, grad);
+  int r = n > 0 ? run(q, iv, n, bounded_iv) : 0;
   if (iv != local) free(iv);
   return r;
 }
@@ -535,16 +534,15 @@ int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
                    double t0, double t1, const csg_span *spans, int nspans,
                    double tol, lg_root *out, int maxout, lg_stats *stats,
                    const lg_hook *hook) {
-  return spans_run(t, o, d, t0, t1, spans, nspans, tol, out, maxout, stats,
-                   hook, 0, 0, NULL);
+  lg_query q = {t, o, d, t0, t1, tol, out, maxout, stats, hook, LG_ALL, NULL};
+  return spans_run(&q, spans, nspans, 0);
 }
 
 /* Figure 7 (c): search where outer and not inner. */
-static int bounded(const dt_tape *t, const csg_tape *outer,
-                   const csg_tape *inner, const double o[3], const double d[3],
-                   double t0, double t1, double tol, lg_root *out, int maxout,
-                   lg_stats *stats, const lg_hook *hook, int first,
-                   double *grad) {
+int lg_search_bounded(const lg_query *q, const csg_tape *outer,
+                      const csg_tape *inner) {
+  const double *o = q->o, *d = q->d;
+  const double t0 = q->t0, t1 = q->t1, tol = q->tol;
   int no = outer->nleaves + 1, ni = inner ? inner->nleaves + 1 : 0;
   int nsc = csg_scratch_spans(outer);
   if (inner && csg_scratch_spans(inner) > nsc) nsc = csg_scratch_spans(inner);
@@ -576,8 +574,7 @@ static int bounded(const dt_tape *t, const csg_tape *outer,
       }
       m = w;
       int k = csg_spans_diff(os, n, is, m, ds);
-      r = spans_run(t, o, d, t0, t1, ds, k, tol, out, maxout, stats, hook,
-                    first, 1, grad);
+      r = spans_run(q, ds, k, 1);
     }
   }
   if (mem != local) free(mem);
@@ -589,8 +586,8 @@ int lg_roots_bounded(const dt_tape *t, const csg_tape *outer,
                      const double d[3], double t0, double t1, double tol,
                      lg_root *out, int maxout, lg_stats *stats,
                      const lg_hook *hook) {
-  return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, hook,
-                 0, NULL);
+  lg_query q = {t, o, d, t0, t1, tol, out, maxout, stats, hook, LG_ALL, NULL};
+  return lg_search_bounded(&q, outer, inner);
 }
 
 int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
@@ -598,6 +595,7 @@ int lg_first_bounded(const dt_tape *t, const csg_tape *outer,
                      const double d[3], double t0, double t1, double tol,
                      lg_root *out, int maxout, lg_stats *stats, int any,
                      double grad[3]) {
-  return bounded(t, outer, inner, o, d, t0, t1, tol, out, maxout, stats, NULL,
-                 any ? 2 : 1, grad);
+  lg_query q = {t, o, d, t0, t1, tol, out, maxout, stats, NULL,
+                any ? LG_ANY : LG_FIRST, grad};
+  return lg_search_bounded(&q, outer, inner);
 }

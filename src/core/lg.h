@@ -125,6 +125,38 @@ typedef struct lg_hook {
   void *ctx;
 } lg_hook;
 
+/* What a search reports (lg_query.mode). */
+typedef enum {
+  LG_ALL = 0,    /* every crossing, in order (the probes, CSG spans) */
+  LG_FIRST = 1,  /* up to the first crossing after t0 (a primary ray) */
+  LG_ANY = 2     /* whether there is a crossing after t0 (a shadow ray) */
+} lg_mode;
+
+/* One search along o + t d: the tape, where to look ([t0, t1]; t1 may be
+ * infinite), how finely (tol > 0 in units of t), where to put the roots
+ * (out, at most maxout), the counters (stats, may be NULL), a trace hook
+ * (may be NULL), what to report (mode) and, for LG_FIRST and LG_ANY, grad
+ * (may be NULL): see lg_first_bounded. */
+typedef struct lg_query {
+  const dt_tape *tape;
+  const double *o, *d;
+  double t0, t1, tol;
+  lg_root *out;
+  int maxout;
+  lg_stats *stats;
+  const lg_hook *hook;
+  lg_mode mode;
+  double *grad;
+} lg_query;
+
+/* Figure 7: the search of q where the outer bound and not the inner one
+ * is (inner may be NULL), each span widened by tol (plus a few ulps), as
+ * lg_roots_bounded (LG_ALL) and lg_first_bounded (LG_FIRST, LG_ANY) say.
+ * Returns the count, or -1 if out of memory. The functions below are this
+ * with their arguments named in a query. */
+int lg_search_bounded(const lg_query *q, const csg_tape *outer,
+                      const csg_tape *inner);
+
 /* Figure 9: every 0.5 crossing in [t0, t1] (clipped to where any filter
  * is touched, so infinite ends are fine), ascending, at most maxout of
  * them (the search stops at maxout, so maxout = 1 gives the first hit).

@@ -472,9 +472,10 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
     lg_root roots[8];
     double tol = ray_dist_tol(c, o, d);
     long unsplit = c->stats.lg.overflows;
-    int nr = lg_first_bounded(n->tape, n->outer, n->inner, o, d, t0, t1, tol,
-                              roots, 8, &c->stats.lg, any,
-                              any ? NULL : h->grad);
+    lg_query q = {.tape = n->tape, .o = o, .d = d, .t0 = t0, .t1 = t1,
+                  .tol = tol, .out = roots, .maxout = 8, .stats = &c->stats.lg,
+                  .mode = any ? LG_ANY : LG_FIRST, .grad = any ? NULL : h->grad};
+    int nr = lg_search_bounded(&q, n->outer, n->inner);
     if (c->stats.lg.overflows != unsplit && c->unresolved_node < 0)
       c->unresolved_node = node;
     if (nr < 0) c->failed = 1;

@@ -139,9 +139,11 @@ static int rounded_spans(const ScNode *n, int id, const double o[3],
                          csg_span *out) {
   lg_root roots[MAX_LEAF_ROOTS];
   long unsplit = c->stats.lg.overflows;
-  int nr = lg_roots_bounded(n->tape, n->outer, n->inner, o, d, t0, t1,
-                            ray_dist_tol(c, o, d), roots, MAX_LEAF_ROOTS,
-                            &c->stats.lg, c->hook);
+  lg_query q = {.tape = n->tape, .o = o, .d = d, .t0 = t0, .t1 = t1,
+                .tol = ray_dist_tol(c, o, d), .out = roots,
+                .maxout = MAX_LEAF_ROOTS, .stats = &c->stats.lg,
+                .hook = c->hook, .mode = LG_ALL};
+  int nr = lg_search_bounded(&q, n->outer, n->inner);
   if (c->stats.lg.overflows != unsplit) c->unresolved_node = id;
   if (nr < 0) return -1;
   double p[3] = {o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2]};
