@@ -96,6 +96,12 @@ if ! wait_count '^qcs> ' 1; then
   for c in $TMUX_CHECKS; do echo "skip $c: the REPL showed no prompt"; done
   exit 0
 fi
+if [ "$(pane | grep -c '^qcs [0-9.]*: type an expression or a definition; :help for help')" -eq 1 ]; then
+  ok repl-banner
+else fail repl-banner "no one-line banner on the terminal"; fi
+out=$(echo '1' | HOME=$tmp $lim "$QCS" 2>&1)
+if [ "$out" = 1 ]; then ok pipe-no-banner
+else fail pipe-no-banner "a pipe got '$out'"; fi
 
 s0=$(symbols)
 if enter 'rounded, 6 leaves, box \(0, 0, 0\) \.\. \(1, 1, 1\)' 'Rounded 0.1 UnitCube'; then

@@ -1021,6 +1021,12 @@ static int run_terminal(Repl *R) {
   repl_install_sigint();
   set_handler(SIGWINCH, on_sigwinch);
   set_handler(SIGCONT, on_sigcont);
+  /* One line, on a terminal only (run_terminal runs only on one). */
+  if (isatty(STDOUT_FILENO)) {
+    printf("qcs %s: type an expression or a definition; :help for help, "
+           ":quit to leave\n", interp_version());
+    fflush(stdout);
+  }
 
   while (!R->quit) {
     int more = R->in_block || R->pending.len > 0;
