@@ -148,6 +148,10 @@ static int drawer_init(Drawer *d, FILE *out, PreviewMode m, int cols,
   d->out = out;
   d->cols = cols;
   d->rows = rows;
+  /* chafa draws on the caller's thread: the render's workers have the
+     cores, and glib's thread pool (uninstrumented, synchronised by futexes
+     ThreadSanitizer cannot see) stays out of make tsan's way. */
+  chafa_set_n_threads(1);
   d->cfg = chafa_canvas_config_new();
   d->ti = term_info();
   if (!d->cfg || !d->ti) return -1;

@@ -25,6 +25,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,9 +51,14 @@ static char file_breaks[] = " \t\n\"'";
 
 /* ---- signals ---- */
 
-static volatile sig_atomic_t got_sigint, got_sigwinch, got_sigcont;
-static volatile sig_atomic_t at_prompt;   /* waiting for a key */
-static volatile sig_atomic_t sigint_count; /* Ctrl-Cs during one entry */
+/* Set by the handlers, which run on whichever thread the kernel picks (the
+   interpreter's, the collector's, main's), and read by the prompt loop on
+   the interpreter's thread: lock-free atomics, so that both a handler may
+   store to them and another thread may read them without a data race. */
+_Static_assert(ATOMIC_INT_LOCK_FREE == 2, "signal flags must be lock-free");
+static atomic_int got_sigint, got_sigwinch, got_sigcont;
+static atomic_int at_prompt;    /* waiting for a key */
+static atomic_int sigint_count; /* Ctrl-Cs during one entry */
 static int stderr_is_tty; /* set before the handler is installed */
 static int wake_pipe[2] = {-1, -1}; /* handlers -> prompt loop */
 
