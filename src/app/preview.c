@@ -59,7 +59,7 @@ PreviewMode preview_resolve(PreviewMode m, int fd) {
 static double now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + ts.tv_nsec * 1e-9;
+  return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
 void preview_geometry(PreviewMode m, int out_fd, int cols, int rows,
@@ -129,7 +129,7 @@ static unsigned char *to_rgba8(const Image *im) {
     float k = a > 0 ? 1 / a : 0;
     /* Background pixels may carry alpha 0 with colour: show them as is. */
     if (a <= 0) k = 1;
-    for (int c = 0; c < 3; c++) px[4 * i + c] = img_srgb8(p[c] * k);
+    for (size_t c = 0; c < 3; c++) px[4 * i + c] = img_srgb8(p[c] * k);
     px[4 * i + 3] = 255;
   }
   return px;

@@ -277,8 +277,7 @@ Value *interp_eval_expr(Interp *I, const char *name, const char *text) {
   src->name = nm;
   src->text = tx;
   Expr *e = parse_expression(I, src);
-  Check C = {I, NULL, 0, 0};
-  check_expr(&C, e, NULL);
+  resolve_expr(I, e);
   return eval(I, e, NULL);
 }
 
