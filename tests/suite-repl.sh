@@ -215,7 +215,8 @@ if keys_then '^qcs-exit-status=0$' C-d; then ok repl-ctrl-d
 else fail repl-ctrl-d "$(why 'Ctrl-D did not leave with status 0')"; fi
 
 missing=""
-for want in '1 + 2' 'f x = x * 2' 'g x =' 'x + 1' 'myLongName = 7' 'f 21' ':set max-steps 200000' 'deep 0'; do
+deep=${QCS_TSAN:-deep 0}; [ -n "${QCS_TSAN:-}" ] && deep=':set max-steps 0'
+for want in '1 + 2' 'f x = x * 2' 'g x =' 'x + 1' 'myLongName = 7' 'f 21' ':set max-steps 200000' "$deep"; do
   grep -qxF "$want" "$home/.qcs_history" 2>/dev/null || missing="$missing '$want'"
 done
 if [ -z "$missing" ]; then ok repl-history-file
