@@ -20,13 +20,17 @@ OPT     ?= -O2
 
 # Debian packages the build and the tests need.
 DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
-            libmpfr-dev libgmp-dev tmux clang hugs
+            libmpfr-dev libgmp-dev tmux clang hugs libchafa-dev libglib2.0-dev
 PC_PKGS  := readline bdw-gc libpng OpenEXR
 
 WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
           -Wmissing-prototypes -Wno-unused-parameter
 PKG_CFLAGS = $(shell pkg-config --cflags $(PC_PKGS) 2>/dev/null)
 PKG_LIBS   = $(shell pkg-config --libs $(PC_PKGS) 2>/dev/null)
+# The front end alone draws pictures in the terminal (libchafa).
+APP_PC     := chafa
+APP_CFLAGS = $(shell pkg-config --cflags $(APP_PC) 2>/dev/null)
+APP_LIBS   = $(shell pkg-config --libs $(APP_PC) 2>/dev/null)
 CFLAGS  ?= $(OPT) -g
 ALL_CFLAGS = -std=c11 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -DGC_THREADS \
              $(WARN) $(CFLAGS) $(PKG_CFLAGS) -MMD -MP -Isrc -I$(BUILD)
@@ -64,7 +68,9 @@ BIN ?= qcs
 all: $(BIN)
 
 $(BIN): $(APP_OBJS) $(LAYER_LIBS) $(BUILD)/layers.ok
-	$(CC) $(ALL_CFLAGS) -o $@ $(APP_OBJS) $(LAYER_LIBS) $(LIBS)
+	$(CC) $(ALL_CFLAGS) -o $@ $(APP_OBJS) $(LAYER_LIBS) $(LIBS) $(APP_LIBS)
+
+$(APP_OBJS): ALL_CFLAGS += $(APP_CFLAGS)
 
 # One static library per layer.
 $(BUILD)/libqcs%.a: $$(call layer_objs,%)

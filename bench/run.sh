@@ -249,6 +249,41 @@ RATIOS=$(
 echo
 echo "$RATIOS"
 
+# Pictures at the prompt (issue 13): qcs --show draws figure12 coarse to
+# fine in 100 x 32 cells; --timings says when the scene was ready (after
+# process start, the prelude and the script), then the first and the full
+# picture. Medians of PV_REPS runs for symbols and for sixels (drawn to a
+# file: the encoding is timed, not the terminal).
+PV_REPS=${PV_REPS:-7}
+pv_run() {  # pv_run MODE -> "FIRST FULL PIXELS" (first counted from start)
+  "$QCS" --show --preview "$1" --cells 100x32 --timings --threads "$THREADS" \
+    examples/figure12.qcs 2>&1 >/dev/null | awk '/scene ready/ {
+      for (i = 1; i <= NF; i++) {
+        if ($i == "ready") r = $(i + 1)
+        if ($i == "picture" && $(i - 1) == "first") f = $(i + 1)
+        if ($i == "full") u = $(i + 1)
+      }
+      printf "%.4f %.4f %s\n", r + f, r + u, $2 }'
+}
+declare -A PV_FIRST PV_FULL PV_PIX
+for m in symbols sixel; do
+  : > "$OUT/preview-$m.txt"
+  for i in $(seq "$PV_REPS"); do pv_run $m >> "$OUT/preview-$m.txt"; done
+  PV_FIRST[$m]=$(awk '{ print $1 }' "$OUT/preview-$m.txt" | median)
+  PV_FULL[$m]=$(awk '{ print $2 }' "$OUT/preview-$m.txt" | median)
+  PV_PIX[$m]=$(awk 'NR == 1 { print $3 }' "$OUT/preview-$m.txt")
+done
+PREVIEW=$(
+  echo "| figure12 at the prompt, 100 x 32 cells | pixels | first picture | full picture |"
+  echo "|---|---|---|---|"
+  for m in symbols sixel; do
+    echo "| $m | ${PV_PIX[$m]:--} | ${PV_FIRST[$m]:--} s | ${PV_FULL[$m]:--} s |"
+  done
+)
+echo
+echo "pictures at the prompt (from process start; medians of $PV_REPS):"
+echo "$PREVIEW" | tail -n +3 | sed 's/^| //; s/ |$//; s/ | /: /; s/ | / /g'
+
 # Issue 7's targets.
 verdict() { if [ "$1" = "-" ] || [ -z "$1" ]; then echo "not measured"; elif awk "BEGIN { exit !($2) }"; then echo "met"; else echo "NOT met"; fi; }
 ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "-" && a != "" && a + 0 >= b) }'; }
@@ -278,6 +313,10 @@ TARGETS=$(
   echo "| soft-cloud T(100000) / T(100) at most 4 | $GROWTH | $T4d |"
   echo "| exact Wyvill field N = 100 at least 100x faster than POV-Ray's isosurface | $ISO_RATIO | $T5 |"
   echo "| figure12 at most 12 density evaluations per rounded hit | ${E12:--} | $T6 |"
+  for m in symbols sixel; do
+    echo "| figure12's first picture at the prompt ($m) within 0.05 s | ${PV_FIRST[$m]:--} s | $(verdict "${PV_FIRST[$m]:-}" "${PV_FIRST[$m]:-0} <= 0.05") |"
+    echo "| figure12's full picture at the prompt ($m) within 0.3 s | ${PV_FULL[$m]:--} s | $(verdict "${PV_FULL[$m]:-}" "${PV_FULL[$m]:-0} <= 0.3") |"
+  done
 )
 echo
 echo "issue 7 targets:"
@@ -341,9 +380,17 @@ EOF
   echo "$RATIOS"
   echo '```'
   echo
-  echo "## Issue 7 targets"
+  echo "## Targets (issues 7 and 13)"
   echo
   echo "$TARGETS"
+  echo
+  echo "## Pictures at the prompt"
+  echo
+  echo "\`qcs --show --preview MODE --cells 100x32 --timings examples/figure12.qcs\`,"
+  echo "drawn to a file (the encoding is timed, not a terminal); times from"
+  echo "process start, medians of $PV_REPS runs."
+  echo
+  echo "$PREVIEW"
   if [ -f bench/callgrind.csv ]; then
     echo
     echo "## Callgrind instruction counts (150x95, 1 thread)"

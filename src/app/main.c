@@ -5,6 +5,7 @@
  *   qcs -e EXPR          evaluate EXPR (prelude loaded), print it, exit
  *   qcs tradeoff FILE    error against run time over root tolerances
  *   qcs convolution      the quasi-convolution against the true one
+ *   qcs --show FILE...   draw what the scripts render in the terminal
  *
  * The interpreter runs on a thread of its own with a large stack, so that
  * deep (non-tail) recursion in user programs is limited by a clear
@@ -20,8 +21,12 @@
 #include "bind/bind.h"
 #include "lang/interp.h"
 #include "bind/render_lang.h"
+#include "app/preview.h"
 #include "app/repl.h"
+#include "bind/report.h"
 #include "study/tradeoff.h"
+
+#include <time.h>
 
 #define STACK_SIZE ((size_t)512 << 20) /* reserved, touched only as used */
 #define STACK_USE ((size_t)256 << 20)  /* ~350000 nested calls: max-stack */
@@ -43,7 +48,51 @@ typedef struct Options {
   RenderOverrides render;
   int tradeoff;            /* qcs tradeoff: files[0] is the script */
   TradeoffOptions topt;
+  int show;                /* --show: renders are drawn in the terminal */
+  PreviewMode preview;     /* --preview MODE (default auto) */
+  int cells_w, cells_h;    /* --cells CxR (0: from the terminal) */
+  int timings;             /* --timings: when the pictures came */
+  double t_start;
 } Options;
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* --show: a render of the scripts is drawn progressively in the terminal
+   instead of being written. */
+static int show_capture(void *ctx, const Scene *s, const RenderSettings *rs,
+                        const char *path, char *err, size_t errlen) {
+  Options *o = ctx;
+  PreviewMode m = preview_resolve(o->preview, STDOUT_FILENO);
+  char line[512];
+  report_scene(line, sizeof line, s, path);
+  printf("%s\n", line);
+  fflush(stdout);
+  if (m == PREVIEW_OFF) {
+    snprintf(err, errlen, "--show: standard output is not a terminal (give "
+             "--preview symbols, sixel, kitty or iterm to draw anyway)");
+    return -1;
+  }
+  double t0 = now();
+  PreviewOptions po = {m, o->cells_w, o->cells_h, STDOUT_FILENO,
+                       isatty(STDIN_FILENO) ? STDIN_FILENO : -1,
+                       &qcs_interrupted};
+  PreviewResult res;
+  if (preview_show(stdout, s, rs, &po, &res, err, errlen)) return -1;
+  if (res.rungs && !res.stopped && res.rep.primary > 0 && res.rep.hits == 0)
+    printf("nothing hit: 0 of %ld primary rays met a surface\n",
+           res.rep.primary);
+  fflush(stdout);
+  if (o->timings)
+    fprintf(stderr, "%s: %dx%d pixels, %d picture%s; scene ready %.4f s after "
+            "start, first picture %.4f s later, full %.4f s later\n", path,
+            res.width, res.height, res.rungs, res.rungs == 1 ? "" : "s",
+            t0 - o->t_start, res.t_first, res.t_full);
+  return 0;
+}
 
 static void usage(FILE *out) {
   fprintf(out,
@@ -65,6 +114,12 @@ static void usage(FILE *out) {
           "  --tolerance T       root tolerance, a distance (default 1e-9)\n"
           "  --cost              add the root-finder cost channel to an EXR\n"
           "  --float             EXR colour as 32-bit floats (default half)\n"
+          "  --show              draw what the scripts render in the terminal,\n"
+          "                      coarse first, instead of writing files\n"
+          "  --preview MODE      how: auto (default), kitty, iterm, sixel,\n"
+          "                      symbols (auto draws nothing to a pipe)\n"
+          "  --cells CxR         the picture's size in character cells\n"
+          "  --timings           say when the first and the full picture came\n"
           "\n"
           "limits (an evaluation or render that passes one stops with an error;\n"
           "in the REPL, :set lists and changes them):\n"
@@ -116,6 +171,10 @@ static void *run(void *arg) {
     o->status = tradeoff_file(I, o->files[0], &o->topt);
     return NULL;
   }
+  if (o->show) {
+    o->render.capture = show_capture;
+    o->render.capture_ctx = o;
+  }
   for (int i = 0; i < o->nfiles; i++)
     if (interp_run_file(I, o->files[i]) != RUN_OK) {
       o->status = 1;
@@ -126,13 +185,14 @@ static void *run(void *arg) {
       o->status = 1;
       return NULL;
     }
-  /* -o with scripts that render nothing: render their `scene`. */
-  if (o->render.output && o->render.renders == 0 &&
-      render_lang_scene(I, o->render.output) != RUN_OK) {
+  /* -o or --show with scripts that render nothing: their `scene`. */
+  if ((o->render.output || o->show) && o->render.renders == 0 &&
+      render_lang_scene(I, o->render.output ? o->render.output : "scene") !=
+          RUN_OK) {
     o->status = 1;
     return NULL;
   }
-  if (o->nfiles == 0 && o->nexprs == 0) o->status = repl_run(I);
+  if (o->nfiles == 0 && o->nexprs == 0 && !o->show) o->status = repl_run(I);
   return NULL;
 }
 
@@ -196,6 +256,8 @@ static int tradeoff_args(int argc, char **argv, Options *o) {
 
 int main(int argc, char **argv) {
   static Options o;
+  o.t_start = now();
+  o.preview = PREVIEW_AUTO;
   o.max_spp = QCS_DEFAULT_MAX_SPP;
   o.max_pixels = QCS_DEFAULT_MAX_PIXELS;
   o.files = calloc((size_t)argc + 1, sizeof(char *));
@@ -319,6 +381,30 @@ int main(int argc, char **argv) {
       i++;
     } else if (!strcmp(a, "--cost")) {
       o.render.cost = 1;
+    } else if (!strcmp(a, "--show")) {
+      o.show = 1;
+    } else if (!strcmp(a, "--timings")) {
+      o.timings = 1;
+    } else if (!strcmp(a, "--preview")) {
+      if (i + 1 >= argc || preview_mode_parse(argv[i + 1], &o.preview) ||
+          o.preview == PREVIEW_OFF) {
+        fprintf(stderr, "qcs: error: --preview needs auto, kitty, iterm, "
+                "sixel or symbols\n");
+        return 1;
+      }
+      i++;
+    } else if (!strcmp(a, "--cells")) {
+      int w, h;
+      char c;
+      if (i + 1 >= argc || sscanf(argv[i + 1], "%dx%d%c", &w, &h, &c) != 2 ||
+          w < 1 || h < 1 || w > PREVIEW_MAX_COLS || h > PREVIEW_MAX_ROWS) {
+        fprintf(stderr, "qcs: error: --cells needs COLUMNSxROWS, at most "
+                "%dx%d\n", PREVIEW_MAX_COLS, PREVIEW_MAX_ROWS);
+        return 1;
+      }
+      o.cells_w = w;
+      o.cells_h = h;
+      i++;
     } else if (!strcmp(a, "--float")) {
       o.render.float_pixels = 1;
     } else if (a[0] == '-' && a[1]) {

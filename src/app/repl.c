@@ -13,15 +13,24 @@
  * collector has threads too: blocking signals in this thread and waiting
  * in pselect() would miss them). */
 #include "app/repl.h"
+
+#include "app/preview.h"
+#include "bind/compile.h"
+#include "bind/render_lang.h"
+#include "bind/report.h"
+#include "lang/eval.h"
+#include "lang/print.h"
 #include "study/tradeoff.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/select.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <readline/history.h>
@@ -42,9 +51,14 @@ static char file_breaks[] = " \t\n\"'";
 
 /* ---- signals ---- */
 
-static volatile sig_atomic_t got_sigint, got_sigwinch, got_sigcont;
-static volatile sig_atomic_t at_prompt;   /* waiting for a key */
-static volatile sig_atomic_t sigint_count; /* Ctrl-Cs during one entry */
+/* Set by the handlers, which run on whichever thread the kernel picks (the
+   interpreter's, the collector's, main's), and read by the prompt loop on
+   the interpreter's thread: lock-free atomics, so that both a handler may
+   store to them and another thread may read them without a data race. */
+_Static_assert(ATOMIC_INT_LOCK_FREE == 2, "signal flags must be lock-free");
+static atomic_int got_sigint, got_sigwinch, got_sigcont;
+static atomic_int at_prompt;    /* waiting for a key */
+static atomic_int sigint_count; /* Ctrl-Cs during one entry */
 static int stderr_is_tty; /* set before the handler is installed */
 static int wake_pipe[2] = {-1, -1}; /* handlers -> prompt loop */
 
@@ -160,6 +174,11 @@ typedef struct {
   char **files;      /* what :load ran, for :reload */
   size_t nfiles;
   char *histfile;    /* NULL: no history file */
+  /* Pictures at the prompt (:set preview, :set preview-size, :show). */
+  PreviewMode preview;   /* as set; resolved against stdout when used */
+  int preview_cols, preview_rows; /* 0: from the terminal */
+  int show_forced;       /* the entry is a :show: show it, or say why not */
+  const char *show_settings; /* :show ... with SETTINGS: their text */
 } Repl;
 
 static Interp *completion_interp; /* readline's callbacks take no user data */
@@ -219,6 +238,7 @@ static void cmd_browse(Repl *R, const char *arg, int bang);
 static void cmd_quit(Repl *R, const char *arg, int bang);
 static void cmd_tradeoff(Repl *R, const char *arg, int bang);
 static void cmd_set(Repl *R, const char *arg, int bang);
+static void cmd_show(Repl *R, const char *arg, int bang);
 
 /* Sorted by name; a command may be abbreviated to any unique prefix. */
 static const Command commands[] = {
@@ -229,8 +249,10 @@ static const Command commands[] = {
    "run a qcs file and remember it for :reload"},
   {"quit", ARG_NONE, 0, cmd_quit, ":quit", "leave qcs (so does Ctrl-D)"},
   {"reload", ARG_NONE, 0, cmd_reload, ":reload", "run the loaded files again"},
-  {"set", ARG_ANY, 0, cmd_set, ":set [LIMIT N]",
-   "list the resource limits, or change one (:set max-steps 1000000)"},
+  {"set", ARG_ANY, 0, cmd_set, ":set [NAME VALUE]",
+   "list the settings and limits, or change one (:set max-steps 1000000)"},
+  {"show", ARG_ANY, 0, cmd_show, ":show EXPR [with S]",
+   "draw a scene object as a picture (S: render settings, [Size 600 380])"},
   {"tradeoff", ARG_FILE, 0, cmd_tradeoff, ":tradeoff FILE",
    "error against run time over root tolerances (writes tradeoff.svg)"},
 };
@@ -267,8 +289,19 @@ static void cmd_help(Repl *R, const char *arg, int bang) {
 }
 
 /* :set lists the limits; :set NAME VALUE changes one. */
+static int set_preview(Repl *R, const char *name, const char *val);
+
 static void cmd_set(Repl *R, const char *arg, int bang) {
   if (!*arg) {
+    printf("preview       %-12s pictures of scene objects at the prompt "
+           "(off, auto, kitty, iterm, sixel, symbols)\n",
+           preview_mode_name(R->preview));
+    if (R->preview_cols || R->preview_rows)
+      printf("preview-size  %dx%-9d the picture's size in character cells\n",
+             R->preview_cols, R->preview_rows);
+    else
+      printf("preview-size  %-12s the picture's size in character cells\n",
+             "auto");
     interp_list_limits(R->I, stdout);
     fflush(stdout);
     return;
@@ -281,6 +314,10 @@ static void cmd_set(Repl *R, const char *arg, int bang) {
   memcpy(name, arg, n);
   name[n] = 0;
   char err[300];
+  if (!strcmp(name, "preview") || !strcmp(name, "preview-size")) {
+    if (set_preview(R, name, val)) R->had_error = 1;
+    return;
+  }
   if (!*val) {
     unsigned long long v;
     if (interp_limit_parse(name, "0", &v, err, sizeof err) &&
@@ -297,6 +334,182 @@ static void cmd_set(Repl *R, const char *arg, int bang) {
             strncmp(err, "unknown", 7) ? "" : "; :set alone lists the limits");
     R->had_error = 1;
   }
+}
+
+/* :set preview MODE, :set preview-size WxH | auto. 0, or -1 after an
+   error message. */
+static int set_preview(Repl *R, const char *name, const char *val) {
+  if (!strcmp(name, "preview")) {
+    PreviewMode m;
+    if (preview_mode_parse(val, &m)) {
+      fprintf(stderr, "error: :set preview needs off, auto, kitty, iterm, "
+              "sixel or symbols, not '%s'\n", val);
+      return -1;
+    }
+    R->preview = m;
+    return 0;
+  }
+  if (!strcmp(val, "auto")) {
+    R->preview_cols = R->preview_rows = 0;
+    return 0;
+  }
+  char *end;
+  long w = strtol(val, &end, 10), h = -1;
+  if (end != val && (*end == 'x' || *end == 'X')) {
+    const char *hs = end + 1;
+    h = strtol(hs, &end, 10);
+    if (end == hs) h = -1;
+  }
+  if (h < 1 || w < 1 || *skip_blanks(end)) {
+    fprintf(stderr, "error: :set preview-size needs COLUMNSxROWS (e.g. "
+            "80x25) or auto, not '%s'\n", val);
+    return -1;
+  }
+  if (w > PREVIEW_MAX_COLS || h > PREVIEW_MAX_ROWS) {
+    fprintf(stderr, "error: :set preview-size %ldx%ld is too large: at most "
+            "%dx%d character cells\n", w, h, PREVIEW_MAX_COLS,
+            PREVIEW_MAX_ROWS);
+    return -1;
+  }
+  R->preview_cols = (int)w;
+  R->preview_rows = (int)h;
+  return 0;
+}
+
+/* The last " with " of text outside brackets and strings, or NULL. */
+static const char *find_with(const char *text) {
+  const char *found = NULL;
+  int depth = 0, in_str = 0;
+  for (const char *p = text; *p; p++) {
+    if (in_str) {
+      if (*p == '\\' && p[1]) p++;
+      else if (*p == '"') in_str = 0;
+      continue;
+    }
+    if (*p == '"') in_str = 1;
+    else if (*p == '(' || *p == '[' || *p == '{') depth++;
+    else if ((*p == ')' || *p == ']' || *p == '}') && depth > 0) depth--;
+    else if (depth == 0 && !strncmp(p, "with", 4) && p > text &&
+             (p[-1] == ' ' || p[-1] == '\t') &&
+             (p[4] == ' ' || p[4] == '\t' || p[4] == '['))
+      found = p;
+  }
+  return found;
+}
+
+/* :show EXPR [with SETTINGS]: the value of EXPR as a picture, whatever
+   the preview setting (a pipe gets the summary and no picture). */
+static void cmd_show(Repl *R, const char *arg, int bang) {
+  if (!*arg) {
+    fputs("error: :show needs an expression (usage: :show EXPR [with "
+          "SETTINGS])\n", stderr);
+    R->had_error = 1;
+    return;
+  }
+  char *expr = strdup(arg), *settings = NULL;
+  if (!expr) return;
+  const char *w = find_with(expr);
+  if (w) {
+    settings = strdup(skip_blanks(w + 4));
+    expr[w - expr] = 0;
+  }
+  R->show_forced = 1;
+  R->show_settings = settings;
+  RunStatus st;
+  RUN_GUARDED(st, interp_run_string(R->I, SOURCE_NAME, expr, MODE_REPL));
+  if (st == RUN_INCOMPLETE) {
+    fputs("error: :show needs the whole expression on one line\n", stderr);
+    st = RUN_ERROR;
+  }
+  note_status(R, st);
+  R->show_forced = 0;
+  R->show_settings = NULL;
+  free(settings);
+  free(expr);
+}
+
+/* The terminal's input in non-canonical mode without echo while a picture
+   is drawn, so a key stops it at once (and stays unread for the prompt). */
+typedef struct { int fd, saved; struct termios t; } RawInput;
+
+static void raw_input_begin(RawInput *r, int fd) {
+  r->fd = fd;
+  r->saved = fd >= 0 && isatty(fd) && tcgetattr(fd, &r->t) == 0;
+  if (r->saved) {
+    struct termios t = r->t;
+    t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
+    t.c_cc[VMIN] = 1;
+    t.c_cc[VTIME] = 0;
+    tcsetattr(fd, TCSANOW, &t);
+  }
+}
+
+static void raw_input_end(RawInput *r) {
+  if (r->saved) tcsetattr(r->fd, TCSANOW, &r->t);
+}
+
+static void free_scene_cb(void *s) { scene_free(s); }
+
+/* The interpreter's show hook: a scene object (or a list of them) at the
+   prompt becomes a one-line summary and a picture. */
+static int repl_show(Interp *I, Value *v, Pos pos, void *ud) {
+  Repl *R = ud;
+  PreviewMode mode = preview_resolve(R->preview, STDOUT_FILENO);
+  if (mode == PREVIEW_OFF && !R->show_forced) return 0;
+  if (!compile_is_object(I, v)) {
+    if (!R->show_forced) return 0;
+    char buf[160];
+    val_brief(v, buf, sizeof buf);
+    qcs_error(pos, ":show draws scene objects (or lists of them), not %s: %s",
+              val_describe(v), buf);
+  }
+  Scene *s = compile_scene_any(I, v, pos);
+  ErrCleanup cu;
+  err_defer(&cu, free_scene_cb, s);
+  RenderSettings rs;
+  Value *sv = R->show_settings
+                  ? interp_eval_expr(I, "<:show settings>", R->show_settings)
+                  : NULL;
+  render_lang_settings(I, sv, pos, &rs);
+  char brief[200], line[512];
+  val_brief(v, brief, sizeof brief);
+  if (strlen(brief) > 40) { /* the head of a long tree: "Rounded 0.1 (...)" */
+    char *cut = brief + 36;
+    while (cut > brief && *cut != ' ') cut--;
+    strcpy(cut > brief ? cut : brief + 36, " ...");
+  }
+  report_scene(line, sizeof line, s, brief);
+  printf("%s\n", line);
+  fflush(stdout);
+  if (mode == PREVIEW_OFF) {
+    printf("(no picture: %s)\n", R->preview == PREVIEW_OFF
+                                    ? "preview is off; :set preview auto"
+                                    : "standard output is not a terminal");
+  } else {
+    PreviewOptions o = {mode, R->preview_cols, R->preview_rows,
+                        STDOUT_FILENO, R->interactive ? STDIN_FILENO : -1,
+                        &qcs_interrupted};
+    PreviewResult res;
+    char err[300];
+    RawInput raw;
+    raw_input_begin(&raw, o.input_fd);
+    int rc = preview_show(stdout, s, &rs, &o, &res, err, sizeof err);
+    raw_input_end(&raw);
+    if (atomic_load(&qcs_interrupted)) {
+      interp_clear_interrupt();
+      printf("(picture stopped)\n");
+    } else if (rc) {
+      fprintf(stderr, "error: %s\n", err);
+    } else if (res.rungs && !res.stopped && res.rep.primary > 0 &&
+               res.rep.hits == 0) {
+      printf("nothing hit: 0 of %ld primary rays met a surface\n",
+             res.rep.primary);
+    }
+  }
+  fflush(stdout);
+  err_release(&cu);
+  scene_free(s);
+  return 1;
 }
 
 static void remember_file(Repl *R, const char *path) {
@@ -814,6 +1027,12 @@ static int run_terminal(Repl *R) {
   repl_install_sigint();
   set_handler(SIGWINCH, on_sigwinch);
   set_handler(SIGCONT, on_sigcont);
+  /* One line, on a terminal only (run_terminal runs only on one). */
+  if (isatty(STDOUT_FILENO)) {
+    printf("qcs %s: type an expression or a definition; :help for help, "
+           ":quit to leave\n", interp_version());
+    fflush(stdout);
+  }
 
   while (!R->quit) {
     int more = R->in_block || R->pending.len > 0;
@@ -844,7 +1063,10 @@ int repl_run(Interp *I) {
   Repl R = {0};
   R.I = I;
   R.interactive = isatty(STDIN_FILENO);
+  R.preview = PREVIEW_AUTO;
+  interp_set_show(I, repl_show, &R);
   int status = R.interactive ? run_terminal(&R) : run_plain(&R);
+  interp_set_show(I, NULL, NULL);
   for (size_t i = 0; i < R.nfiles; i++) free(R.files[i]);
   free(R.files);
   free(R.pending.s);

@@ -568,3 +568,41 @@ Pos compile_node_pos(const Scene *s, int node) {
   return tag_pos(s->nodes[node].tag);
 }
 
+
+/* ---- pictures at the prompt ---- */
+
+static int object_kind(ConKind k) {
+  return k != K_NONE && k != K_KEY && k != K_QKEY;
+}
+
+int compile_is_object(Interp *I, Value *v) {
+  v = force(I, v);
+  if (v->kind == V_CON) return object_kind(con_kind(v));
+  if (v->kind != V_CONS) return 0;
+  /* a list of objects: every element (forced up to 1000 of them) */
+  int n = 0;
+  for (; v->kind == V_CONS && n < 1000; v = force(I, v->u.cons.tail), n++) {
+    Value *h = force(I, v->u.cons.head);
+    if (h->kind != V_CON || !object_kind(con_kind(h))) return 0;
+  }
+  return v->kind == V_NIL;
+}
+
+Scene *compile_scene_any(Interp *I, Value *obj, Pos pos) {
+  obj = force(I, obj);
+  if (obj->kind != V_CONS) return compile_scene(I, obj, pos);
+  Scene *s = scene_new();
+  if (!s) qcs_error(pos, "out of memory");
+  Compile C = {I, s, NULL, pos};
+  ErrCleanup cu;
+  err_defer(&cu, free_scene, s);
+  int root = -1;
+  for (Value *l = obj; l->kind == V_CONS; l = force(I, l->u.cons.tail)) {
+    int i = compile_obj(&C, l->u.cons.head);
+    root = root < 0 ? i : set_node(&C, SC_UNION, pos, root, i);
+  }
+  if (root < 0) root = add_node(&C, SC_EMPTY, pos);
+  s->root = root;
+  err_release(&cu);
+  return s;
+}

@@ -41,6 +41,13 @@ void compile_warn_once(Interp *I, Pos pos, const char *msg);
    that only touch do not count. */
 int compile_sum_overlaps(Interp *I, Value *tree, Pos pos);
 
+/* 1 if v (forced here) is a scene object or density tree, or a finite
+   list of them (at most 1000): what the REPL shows as a picture. */
+int compile_is_object(Interp *I, Value *v);
+
+/* compile_scene, also for a list of objects (their Union; [] is empty). */
+Scene *compile_scene_any(Interp *I, Value *obj, Pos pos);
+
 /* The source position of a scene node (pos_none if it has none). */
 Pos compile_node_pos(const Scene *s, int node);
 #endif

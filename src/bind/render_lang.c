@@ -60,7 +60,9 @@ void render_set_overrides(Interp *I, RenderOverrides *o) { I->host = o; }
 
 static Value *render_scene_item(Interp *I, void *ud) {
   Sym *s = sym_intern(I, "scene", 5);
-  return render_value(I, NULL, ud, s->global, s->def_pos);
+  Value *v = render_value(I, NULL, ud, s->global, s->def_pos);
+  RenderOverrides *ov = overrides_of(I);
+  return ov && ov->capture ? NULL : v; /* a captured render wrote nothing */
 }
 
 RunStatus render_lang_scene(Interp *I, const char *path) {
@@ -169,6 +171,13 @@ static void read_settings(Interp *I, Value *list, Pos pos, RenderSettings *rs,
                 "Threads, CostChannel, FloatPixels, Quiet)", buf);
     }
   }
+}
+
+void render_lang_settings(Interp *I, Value *settings, Pos pos,
+                          RenderSettings *rs) {
+  int quiet = 0, float_pixels = 0;
+  render_defaults(rs);
+  if (settings) read_settings(I, settings, pos, rs, &quiet, &float_pixels);
 }
 
 Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,

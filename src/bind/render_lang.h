@@ -33,6 +33,11 @@ typedef struct RenderOverrides {
 } RenderOverrides;
 
 void render_install(Interp *I);
+/* The conventions (render_defaults) with a settings list applied (NULL:
+   none); errors raised at pos. FloatPixels and Quiet are accepted and
+   mean nothing here. */
+void render_lang_settings(Interp *I, Value *settings, Pos pos,
+                          struct RenderSettings *rs);
 /* 0 if a file can be made at path (its folder exists and may be written
    in), else -1 with "cannot write PATH: REASON" in err, so that a bad
    output name is refused before a long render rather than after it. As

@@ -16,6 +16,11 @@
    tolerance in force. */
 void report_render(FILE *out, const RenderReport *rep, const char *path);
 
+/* One line about a compiled scene, for the picture at the prompt:
+   "WHAT: KIND, N leaves, box (x, y, z) .. (x, y, z)" (or "unbounded"),
+   where WHAT is the caller's short text (the value as printed, cut). */
+void report_scene(char *buf, size_t n, const Scene *s, const char *what);
+
 /* A RenderSettings progress callback that keeps one line updated on
    stderr ("rendering 42%, 1.3 s left") and clears it at the end; ud is
    unused. Meant for a terminal: callers set it only when stderr is one. */

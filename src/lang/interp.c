@@ -139,6 +139,9 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
     I->steps = 0;
     I->item_pos = items[i]->expr->pos;
     Value *v = eval(I, items[i]->expr, NULL);
+    if (mode == MODE_REPL && I->show &&
+        I->show(I, v, items[i]->expr->pos, I->show_ud))
+      continue;
     print_value(I, stdout, v);
     fputc('\n', stdout);
     fflush(stdout);
@@ -256,6 +259,26 @@ RunStatus interp_eval_print(Interp *I, const char *text) {
   report_error(I);
   unwind(I, nforcing);
   return RUN_ERROR;
+}
+
+void interp_set_show(Interp *I,
+                     int (*show)(Interp *I, struct Value *v, Pos pos, void *ud),
+                     void *ud) {
+  I->show = show;
+  I->show_ud = ud;
+}
+
+Value *interp_eval_expr(Interp *I, const char *name, const char *text) {
+  Src *src = GC_MALLOC(sizeof *src);
+  char *nm = GC_MALLOC_ATOMIC(strlen(name) + 1);
+  strcpy(nm, name);
+  char *tx = GC_MALLOC_ATOMIC(strlen(text) + 1);
+  strcpy(tx, text);
+  src->name = nm;
+  src->text = tx;
+  Expr *e = parse_expression(I, src);
+  resolve_expr(I, e);
+  return eval(I, e, NULL);
 }
 
 RunStatus interp_run_item(Interp *I, Pos pos,

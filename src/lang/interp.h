@@ -82,6 +82,19 @@ RunStatus interp_run_item(Interp *I, Pos pos,
    is then ignored. */
 RunStatus interp_set_override(Interp *I, const char *name, const char *expr);
 
+/* Show values instead of printing them: show(I, v, pos, ud) is called for
+   each value of a MODE_REPL entry and returns 1 if it showed it (the REPL's
+   pictures of scene objects); NULL: print everything. */
+struct Value;
+void interp_set_show(Interp *I,
+                     int (*show)(Interp *I, struct Value *v, Pos pos, void *ud),
+                     void *ud);
+
+/* Parse, check and evaluate text as one expression, inside an item that is
+   already running (a show hook, a host's item): errors are raised, not
+   reported. name names the source in positions. */
+struct Value *interp_eval_expr(Interp *I, const char *name, const char *text);
+
 /* Name completion: calls emit for every global name (prelude, builtins and
    user definitions) that begins with prefix. */
 void interp_complete(Interp *I, const char *prefix,

@@ -137,6 +137,11 @@ struct Interp {
   int ntrace;                /* entries in use (may exceed TRACE_MAX) */
   Forcing *forcing;
   int nforcing, capforcing;
+  /* Set by a front end that can show values (the REPL's pictures): called
+     with each value of a REPL entry, it returns 1 if it showed the value,
+     which is then not printed. */
+  int (*show)(Interp *I, Value *v, Pos pos, void *ud);
+  void *show_ud;
   void *host;                /* state of the layer that installed its
                                 built-ins (bind/): opaque here */
   Pos warned[64];            /* warnings already given (said once each) */

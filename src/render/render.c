@@ -593,6 +593,7 @@ typedef struct Worker {
   Tracer *T;
   RayCtx *c;
   long primary, shadow, max_work;
+  long hits;                  /* primary rays that met a surface */
   long rounded_hits, rounded_hit_evals;
 } Worker;
 
@@ -612,6 +613,7 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
     nrm[0] = nrm[1] = nrm[2] = 0;
     return;
   }
+  W->hits++;
   if (T->s->nodes[h.id].kind == SC_ROUNDED) {
     W->rounded_hits++;
     W->rounded_hit_evals += c->stats.lg.evals - evals0;
@@ -877,6 +879,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   for (int i = 0; i < nthreads; i++) {
     Worker *W = &workers[i];
     rep->primary += W->primary;
+    rep->hits += W->hits;
     rep->shadow += W->shadow;
     rep->evals += W->c->stats.lg.evals;
     rep->segments += W->c->stats.lg.segments;

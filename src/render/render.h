@@ -84,6 +84,7 @@ typedef struct RenderReport {
   int width, height, spp, threads;
   double seconds;            /* wall time of the render */
   long primary, shadow;      /* rays */
+  long hits;                 /* primary rays that met a surface */
   long evals;                /* density evaluations */
   long segments, steps;      /* root-search segments, regula falsi steps */
   long soft_solves;          /* soft-object polynomial solves */
