@@ -160,6 +160,20 @@ done
 if cmp -s "$g/deep1.png" "$g/deep4.png"; then ok gen/deep-csg-100k-same-image
 else fail gen/deep-csg-100k-same-image "1 and 4 threads made different pictures"; fi
 
+# A CSG tree 10^6 nodes deep (built by the strict foldl, so the only deep
+# walk is the scene compiler's), on 4 threads under a max-stack of 128M:
+# refused with the named limit at the scene's definition, never a signal.
+# Which frame crosses the limit, the compiler's or a thunk's it forces, and
+# so the column, follows the compiler's frame sizes: the line is checked.
+cat >"$g/deep6.qcs" <<'DEEP'
+cube k = Intersection UnitCube (Halfspace ((0, 0, -1), k / 1000000))
+scene = foldl (\acc k -> Intersection (Union (cube k) acc) UnitCube) UnitCube [1 .. 1000000]
+DEEP
+run deep6 "$g" --threads 4 --max-stack 128M --size 16x12 -o deep6.png deep6.qcs
+if [ "$st" -eq 1 ] && head -1 "$tmp/err" | grep -qE '^deep6\.qcs:2:[0-9]+: error: recursion too deep: nested calls use more than 128M of stack; .*\(limit max-stack' &&
+   [ ! -e "$g/deep6.png" ]; then ok gen/deep-csg-million
+else fail gen/deep-csg-million "status $st: $(head -c 300 "$tmp/err")"; fi
+
 # A file that does not exist.
 run missing "$g" no-such-file.qcs
 want 'qcs: error: cannot read no-such-file.qcs: No such file or directory\n'
