@@ -2,6 +2,17 @@
 #include "lang/error.h"
 
 #include <gc.h>
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define QCS_ASAN 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) && !defined(QCS_ASAN)
+#define QCS_ASAN 1
+#endif
+#ifdef QCS_ASAN
+#include <sanitizer/asan_interface.h>
+#endif
 #include <pthread.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -56,6 +67,17 @@ static _Noreturn void err_throw(void) {
   }
   run_cleanups(f->cleanups);
   err_top = f->prev;
+#ifdef QCS_ASAN
+  /* The frames between here and the handler's die with the jump. ASan
+     clears their redzones itself only for stacks below a size it trusts;
+     the interpreter's is 256M, so after a deep recursion ends in an error
+     ("recursion too deep") stale redzones would make later, shallower
+     calls look like overflows. Clear them here: the handler's ErrFrame
+     lies in its frame, above every frame the jump discards. */
+  char here;
+  if ((char *)f > &here)
+    __asan_unpoison_memory_region(&here, (size_t)((char *)f - &here));
+#endif
   longjmp(f->jb, 1);
 }
 
