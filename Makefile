@@ -20,7 +20,8 @@ OPT     ?= -O2
 
 # Debian packages the build and the tests need.
 DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
-            libmpfr-dev libgmp-dev tmux clang hugs libchafa-dev libglib2.0-dev
+            libmpfr-dev libgmp-dev tmux clang hugs libchafa-dev libglib2.0-dev \
+            libmicrohttpd-dev
 PC_PKGS  := readline bdw-gc libpng OpenEXR
 
 WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
@@ -28,7 +29,7 @@ WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
 PKG_CFLAGS = $(shell pkg-config --cflags $(PC_PKGS) 2>/dev/null)
 PKG_LIBS   = $(shell pkg-config --libs $(PC_PKGS) 2>/dev/null)
 # The front end alone draws pictures in the terminal (libchafa).
-APP_PC     := chafa
+APP_PC     := chafa libmicrohttpd
 APP_CFLAGS = $(shell pkg-config --cflags $(APP_PC) 2>/dev/null)
 APP_LIBS   = $(shell pkg-config --libs $(APP_PC) 2>/dev/null)
 CFLAGS  ?= $(OPT) -g
@@ -94,6 +95,13 @@ $(OBJS): ALL_CFLAGS += -Wconversion
 $(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -c -o $@ $<
+
+# The viewer's page (HTML, CSS, JavaScript), embedded as the prelude is.
+$(BUILD)/view_page.inc: src/app/view_page.html tools/embed.sh
+	@mkdir -p $(BUILD)
+	sh tools/embed.sh qcs_view_page src/app/view_page.html < $< > $@.tmp && mv $@.tmp $@
+
+$(BUILD)/app/view.o: $(BUILD)/view_page.inc
 
 # The prelude is qcs source, embedded in the binary as a C string.
 $(BUILD)/prelude.inc: stdlib/prelude.qcs tools/embed.sh
