@@ -145,7 +145,20 @@ demo: deps
 	@echo "pictures: gallery/figure12.png and gallery/figure12.exr"
 
 
-test: deps
+# The viewer's tests drive a real browser (tests/suite-view.sh).
+TEST_DEB_PKGS := chromium
+.PHONY: test-deps
+test-deps:
+	@dpkg-query -W -f='$${Status}' $(TEST_DEB_PKGS) 2>/dev/null | grep -q 'ok installed' || \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "installing: $(TEST_DEB_PKGS)"; \
+	    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $(TEST_DEB_PKGS) >/dev/null || \
+	      echo "note: apt-get could not install $(TEST_DEB_PKGS): the browser tests are skipped"; \
+	  else \
+	    echo "note: $(TEST_DEB_PKGS) is not installed: the browser tests are skipped"; \
+	  fi
+
+test: deps test-deps
 	@$(MAKE) -s $(BIN) units
 	@sh tests/run-all.sh
 
