@@ -203,6 +203,7 @@ bench: deps
 	    echo "note: povray is not installed (run 'sudo apt-get install povray' or make bench as root): the POV-Ray half is skipped"; \
 	  fi
 	@QCS=./$(BIN) bash bench/run.sh $(BENCH_ARGS)
+	@python3 bench/view_bench.py ./$(BIN) examples/figure12.qcs
 
 # Instruction counts per scene under callgrind (150x95, one thread): bench/callgrind.csv.
 bench-callgrind: deps

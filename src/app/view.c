@@ -1240,3 +1240,37 @@ int view_scene(Interp *src_I, Scene *s, const RenderSettings *rs,
   view_finish(&v, d, &rt);
   return 0;
 }
+
+/* ---- :view EXPR ---- */
+
+static Value *view_item(Interp *I, void *ud) {
+  char text[4200];
+  snprintf(text, sizeof text, "render \"view.png\" (%s)", (const char *)ud);
+  interp_eval_expr(I, "<view>", text);
+  return NULL;
+}
+
+int view_expr(Interp *I, const char *expr, const ViewOptions *o) {
+  if (strlen(expr) > 4000) {
+    fprintf(stderr, "error: :view: the expression is too long\n");
+    return -1;
+  }
+  RenderOverrides *old = render_get_overrides(I), ov;
+  Capture cap = {0};
+  if (old) ov = *old;
+  else memset(&ov, 0, sizeof ov);
+  ov.output = NULL;
+  ov.capture = capture;
+  ov.capture_ctx = &cap;
+  ov.keep = 1;
+  ov.kept = NULL;
+  render_set_overrides(I, &ov);
+  Pos none = {0};
+  RunStatus st = interp_run_item(I, none, view_item, (void *)expr);
+  render_set_overrides(I, old);
+  if (st != RUN_OK || !ov.kept || !cap.got) {
+    scene_free(ov.kept);
+    return -1;
+  }
+  return view_scene(I, ov.kept, &cap.rs, o);
+}

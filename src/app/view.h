@@ -57,4 +57,8 @@ int view_file(const char *file, const ViewOptions *o);
 struct RenderSettings;
 int view_scene(Interp *src_I, Scene *s, const struct RenderSettings *rs,
                const ViewOptions *o);
+
+/* Evaluate expr (a scene object) in I as the prompt would and serve it
+   with view_scene; -1 (the error reported) if it is not a scene. */
+int view_expr(Interp *I, const char *expr, const ViewOptions *o);
 #endif
