@@ -1163,7 +1163,7 @@ int view_file(const char *file, const ViewOptions *o) {
   int gone = 0;
   while (!stop_flag) {
     struct pollfd pfd = {ino, POLLIN, 0};
-    poll(&pfd, 1, pending ? 10 : 200);
+    poll(&pfd, 1, pending > 0 ? 10 : 200);
     char buf[8192] __attribute__((aligned(__alignof__(struct inotify_event))));
     ssize_t n;
     while ((n = read(ino, buf, sizeof buf)) > 0) {
@@ -1178,7 +1178,7 @@ int view_file(const char *file, const ViewOptions *o) {
       }
     }
     /* The editor's dance is over once the name has been quiet 30 ms. */
-    if (pending && now() - pending > 0.03) {
+    if (pending > 0 && now() - pending > 0.03) {
       pending = 0;
       struct stat st;
       if (stat(v.file, &st) != 0) {
