@@ -20,7 +20,8 @@ OPT     ?= -O2
 
 # Debian packages the build and the tests need.
 DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
-            libmpfr-dev libgmp-dev tmux clang hugs libchafa-dev libglib2.0-dev
+            libmpfr-dev libgmp-dev tmux clang hugs libchafa-dev libglib2.0-dev \
+            libmicrohttpd-dev
 PC_PKGS  := readline bdw-gc libpng OpenEXR
 
 WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
@@ -28,7 +29,7 @@ WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
 PKG_CFLAGS = $(shell pkg-config --cflags $(PC_PKGS) 2>/dev/null)
 PKG_LIBS   = $(shell pkg-config --libs $(PC_PKGS) 2>/dev/null)
 # The front end alone draws pictures in the terminal (libchafa).
-APP_PC     := chafa
+APP_PC     := chafa libmicrohttpd
 APP_CFLAGS = $(shell pkg-config --cflags $(APP_PC) 2>/dev/null)
 APP_LIBS   = $(shell pkg-config --libs $(APP_PC) 2>/dev/null)
 CFLAGS  ?= $(OPT) -g
@@ -95,6 +96,13 @@ $(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -c -o $@ $<
 
+# The viewer's page (HTML, CSS, JavaScript), embedded as the prelude is.
+$(BUILD)/view_page.inc: src/app/view_page.html tools/embed.sh
+	@mkdir -p $(BUILD)
+	sh tools/embed.sh qcs_view_page src/app/view_page.html < $< > $@.tmp && mv $@.tmp $@
+
+$(BUILD)/app/view.o: $(BUILD)/view_page.inc
+
 # The prelude is qcs source, embedded in the binary as a C string.
 $(BUILD)/prelude.inc: stdlib/prelude.qcs tools/embed.sh
 	@mkdir -p $(BUILD)
@@ -137,7 +145,20 @@ demo: deps
 	@echo "pictures: gallery/figure12.png and gallery/figure12.exr"
 
 
-test: deps
+# The viewer's tests drive a real browser (tests/suite-view.sh).
+TEST_DEB_PKGS := chromium
+.PHONY: test-deps
+test-deps:
+	@dpkg-query -W -f='$${Status}' $(TEST_DEB_PKGS) 2>/dev/null | grep -q 'ok installed' || \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "installing: $(TEST_DEB_PKGS)"; \
+	    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $(TEST_DEB_PKGS) >/dev/null || \
+	      echo "note: apt-get could not install $(TEST_DEB_PKGS): the browser tests are skipped"; \
+	  else \
+	    echo "note: $(TEST_DEB_PKGS) is not installed: the browser tests are skipped"; \
+	  fi
+
+test: deps test-deps
 	@$(MAKE) -s $(BIN) units
 	@sh tests/run-all.sh
 
@@ -182,6 +203,7 @@ bench: deps
 	    echo "note: povray is not installed (run 'sudo apt-get install povray' or make bench as root): the POV-Ray half is skipped"; \
 	  fi
 	@QCS=./$(BIN) bash bench/run.sh $(BENCH_ARGS)
+	@python3 bench/view_bench.py ./$(BIN) examples/figure12.qcs
 
 # Instruction counts per scene under callgrind (150x95, one thread): bench/callgrind.csv.
 bench-callgrind: deps

@@ -6,6 +6,7 @@
  *   qcs tradeoff FILE    error against run time over root tolerances
  *   qcs convolution      the quasi-convolution against the true one
  *   qcs --show FILE...   draw what the scripts render in the terminal
+ *   qcs view FILE        a live viewer in the browser (app/view.h)
  *
  * The interpreter runs on a thread of its own with a large stack, so that
  * deep (non-tail) recursion in user programs is limited by a clear
@@ -23,6 +24,7 @@
 #include "bind/render_lang.h"
 #include "app/preview.h"
 #include "app/repl.h"
+#include "app/view.h"
 #include "bind/report.h"
 #include "study/tradeoff.h"
 
@@ -53,6 +55,9 @@ typedef struct Options {
   int cells_w, cells_h;    /* --cells CxR (0: from the terminal) */
   int timings;             /* --timings: when the pictures came */
   double t_start;
+  int view;                /* qcs view: files[0] is followed */
+  ViewOptions vopt;
+  char *stack_base;        /* the interpreter thread's, for qcs view */
 } Options;
 
 static double now(void) {
@@ -101,6 +106,7 @@ static void usage(FILE *out) {
           "  qcs                 start the REPL\n"
           "  qcs FILE...         run scripts (top-level expressions are printed)\n"
           "  qcs -e EXPR         evaluate EXPR with the prelude loaded and print it\n"
+          "  qcs view FILE       a live view in the browser (qcs view --help)\n"
           "\n"
           "options:\n"
           "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
@@ -138,12 +144,11 @@ static void usage(FILE *out) {
           "The language is described in lang/ (lang/manual.md); `man qcs`.\n");
 }
 
-static void *run(void *arg) {
-  Options *o = arg;
+/* A new interpreter set up as the options say (stack, limits, --set);
+   NULL (the error reported) if an option is refused. */
+static Interp *configured_interp(Options *o) {
   Interp *I = bind_interp_new();
-  render_set_overrides(I, &o->render);
-  char probe;
-  interp_set_stack(I, &probe, o->stack_use);
+  interp_set_stack(I, o->stack_base, o->stack_use);
   interp_set_stack_reserved(I, o->stack_reserved);
   for (int i = 0; i < o->nlimits; i++) {
     char err[300];
@@ -151,7 +156,6 @@ static void *run(void *arg) {
         interp_set_limit(I, o->limit_names[i], o->limit_values[i], err,
                          sizeof err)) {
       fprintf(stderr, "qcs: error: --%s\n", err);
-      o->status = 1;
       return NULL;
     }
   }
@@ -162,11 +166,32 @@ static void *run(void *arg) {
     if (n >= sizeof name) n = sizeof name - 1;
     memcpy(name, o->sets[i], n);
     name[n] = 0;
-    if (interp_set_override(I, name, eq + 1) != RUN_OK) {
-      o->status = 1;
-      return NULL;
-    }
+    if (interp_set_override(I, name, eq + 1) != RUN_OK) return NULL;
   }
+  return I;
+}
+
+static Interp *view_interp(void *ud) {
+  Interp *I = configured_interp(ud);
+  return I ? I : bind_interp_new();
+}
+
+static void *run(void *arg) {
+  Options *o = arg;
+  char probe;
+  o->stack_base = &probe;
+  if (o->view) {
+    o->vopt.new_interp = view_interp;
+    o->vopt.ud = o;
+    o->status = view_file(o->files[0], &o->vopt);
+    return NULL;
+  }
+  Interp *I = configured_interp(o);
+  if (!I) {
+    o->status = 1;
+    return NULL;
+  }
+  render_set_overrides(I, &o->render);
   if (o->tradeoff) {
     o->status = tradeoff_file(I, o->files[0], &o->topt);
     return NULL;
@@ -254,6 +279,56 @@ static int tradeoff_args(int argc, char **argv, Options *o) {
   return 0;
 }
 
+static void view_usage(FILE *out) {
+  fputs("usage: qcs view [--listen ADDR:PORT] [--threads N] [--set NAME=VALUE] "
+        "FILE.qcs\n"
+        "\n"
+        "Serve a live view of what FILE renders (or its `scene`) in the "
+        "browser:\nopen the printed URL. The picture follows the file on "
+        "every save; drag to\norbit, shift-drag to pan, wheel to zoom, "
+        "click to probe a pixel. Listens on\n127.0.0.1 and a free port "
+        "unless --listen says otherwise. Ctrl-C stops it.\n", out);
+}
+
+/* qcs view's arguments into o; -1: exit 1, 1: exit 0, 0: run. */
+static int view_args(int argc, char **argv, Options *o) {
+  o->view = 1;
+  for (int i = 2; i < argc; i++) {
+    const char *a = argv[i];
+    char err[200], *end;
+    long n;
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      view_usage(stdout);
+      return 1;
+    } else if (!strcmp(a, "--listen") && i + 1 < argc) {
+      if (view_parse_listen(argv[i + 1], err, sizeof err)) {
+        fprintf(stderr, "qcs: error: view: %s\n", err);
+        return -1;
+      }
+      o->vopt.listen = argv[++i];
+    } else if (!strcmp(a, "--threads") && i + 1 < argc &&
+               (n = strtol(argv[i + 1], &end, 10)) >= 1 && n <= 256 && !*end) {
+      o->vopt.threads = (int)n;
+      i++;
+    } else if (!strcmp(a, "--set") && i + 1 < argc &&
+               strchr(argv[i + 1], '=') && o->nsets < 64) {
+      o->sets[o->nsets++] = argv[++i];
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "qcs: error: view: bad option or argument '%s'\n", a);
+      view_usage(stderr);
+      return -1;
+    } else {
+      o->files[o->nfiles++] = argv[i];
+    }
+  }
+  if (o->nfiles != 1) {
+    fprintf(stderr, "qcs: error: view needs one scene file\n");
+    view_usage(stderr);
+    return -1;
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static Options o;
   o.t_start = now();
@@ -273,6 +348,11 @@ int main(int argc, char **argv) {
   if (sub) {
     int rc = tradeoff_args(argc, argv, &o);
     if (rc) return rc < 0 ? 1 : 0;
+  }
+  if (argc > 1 && !strcmp(argv[1], "view")) {
+    int rc = view_args(argc, argv, &o);
+    if (rc) return rc < 0 ? 1 : 0;
+    sub = 1;
   }
   for (int i = 1; i < argc && !sub; i++) {
     const char *a = argv[i];

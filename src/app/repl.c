@@ -13,6 +13,7 @@
  * collector has threads too: blocking signals in this thread and waiting
  * in pselect() would miss them). */
 #include "app/repl.h"
+#include "app/view.h"
 
 #include "app/preview.h"
 #include "bind/compile.h"
@@ -239,6 +240,7 @@ static void cmd_quit(Repl *R, const char *arg, int bang);
 static void cmd_tradeoff(Repl *R, const char *arg, int bang);
 static void cmd_set(Repl *R, const char *arg, int bang);
 static void cmd_show(Repl *R, const char *arg, int bang);
+static void cmd_view(Repl *R, const char *arg, int bang);
 
 /* Sorted by name; a command may be abbreviated to any unique prefix. */
 static const Command commands[] = {
@@ -255,6 +257,8 @@ static const Command commands[] = {
    "draw a scene object as a picture (S: render settings, [Size 600 380])"},
   {"tradeoff", ARG_FILE, 0, cmd_tradeoff, ":tradeoff FILE",
    "error against run time over root tolerances (writes tradeoff.svg)"},
+  {"view", ARG_ANY, 0, cmd_view, ":view [EXPR]",
+   "serve EXPR (default scene) in the browser until Enter (qcs view)"},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 
@@ -399,6 +403,12 @@ static const char *find_with(const char *text) {
 
 /* :show EXPR [with SETTINGS]: the value of EXPR as a picture, whatever
    the preview setting (a pipe gets the summary and no picture). */
+/* :view [EXPR]: the browser viewer (app/view.h) for EXPR or `scene`. */
+static void cmd_view(Repl *R, const char *arg, int bang) {
+  ViewOptions vo = {0};
+  if (view_expr(R->I, *arg ? arg : "scene", &vo)) R->had_error = 1;
+}
+
 static void cmd_show(Repl *R, const char *arg, int bang) {
   if (!*arg) {
     fputs("error: :show needs an expression (usage: :show EXPR [with "

@@ -213,7 +213,12 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
   if (ov && ov->capture) {
     Scene *cs = compile_scene(I, obj, pos);
     int rc = ov->capture(ov->capture_ctx, cs, &rs, path, err, sizeof err);
-    scene_free(cs);
+    if (ov->keep && !rc) {
+      scene_free(ov->kept);
+      ov->kept = cs;
+    } else {
+      scene_free(cs);
+    }
     if (rc) qcs_error(pos, "%s", err);
     return val_str(path);
   }

@@ -30,6 +30,11 @@ typedef struct RenderOverrides {
   RenderCapture capture;  /* non-NULL: renders call this instead (qcs
                              tradeoff); nothing is written */
   void *capture_ctx;
+  int keep;             /* with capture: keep the scene captured last in
+                           kept (the previous one is freed); the caller
+                           owns kept and frees it with scene_free (qcs
+                           view) */
+  struct Scene *kept;
 } RenderOverrides;
 
 void render_install(Interp *I);

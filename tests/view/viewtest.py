@@ -1,0 +1,392 @@
+#!/usr/bin/env python3
+"""viewtest.py: qcs view driven in headless Chromium (Chrome DevTools
+Protocol over a minimal websocket client, standard library only), plus a
+load test with hostile clients. Prints "ok NAME", "FAIL NAME: why" or
+"skip NAME: why" lines. Loopback only; every loop is bounded.
+
+usage: viewtest.py QCS WORKDIR [--load-only] [--screenshot FILE]"""
+import base64, http.client, json, os, random, re, shutil, socket, struct
+import subprocess, sys, tempfile, threading, time, zlib
+
+QCS = os.path.abspath(sys.argv[1])
+WORK = sys.argv[2]
+LOAD_ONLY = "--load-only" in sys.argv
+SHOT = sys.argv[sys.argv.index("--screenshot") + 1] if "--screenshot" in sys.argv else None
+results = []
+
+
+def report(name, ok, why=""):
+    line = ("ok %s" % name) if ok else ("FAIL %s: %s" % (name, why))
+    print(line, flush=True)
+    results.append(ok)
+
+
+# ---- PNG decoding (8-bit RGB/RGBA, not interlaced) ----
+def png_pixels(data):
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, idat, w = 8, b"", 0
+    while pos < len(data):
+        n, = struct.unpack(">I", data[pos:pos + 4])
+        typ, body = data[pos + 4:pos + 8], data[pos + 8:pos + 8 + n]
+        if typ == b"IHDR":
+            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
+            assert depth == 8 and ctype in (2, 6)
+            nc = 3 if ctype == 2 else 4
+        elif typ == b"IDAT":
+            idat += body
+        pos += 12 + n
+    raw, stride, out, prev = zlib.decompress(idat), w * nc, [], bytearray(w * nc)
+    for y in range(h):
+        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - nc] if i >= nc else 0
+            b, c = prev[i], prev[i - nc] if i >= nc else 0
+            if f == 1: line[i] = (line[i] + a) & 255
+            elif f == 2: line[i] = (line[i] + b) & 255
+            elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        out.append(bytes(line[j] for j in range(stride) if nc == 3 or j % 4 != 3))
+        prev = line
+    return w, h, b"".join(out)
+
+
+# ---- a minimal websocket client for CDP ----
+class WS:
+    def __init__(self, url):
+        m = re.match(r"ws://([^/:]+):(\d+)(/.*)", url)
+        self.s = socket.create_connection((m.group(1), int(m.group(2))), timeout=20)
+        key = base64.b64encode(os.urandom(16)).decode()
+        self.s.sendall(("GET %s HTTP/1.1\r\nHost: %s:%s\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                        "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\n\r\n"
+                        % (m.group(3), m.group(1), m.group(2), key)).encode())
+        head = b""
+        while b"\r\n\r\n" not in head:
+            head += self.s.recv(1)
+        assert b" 101 " in head.split(b"\r\n")[0], head
+        self.buf, self.id, self.events = b"", 0, []
+
+    def _read(self, n):
+        while len(self.buf) < n:
+            d = self.s.recv(65536)
+            if not d: raise EOFError
+            self.buf += d
+        r, self.buf = self.buf[:n], self.buf[n:]
+        return r
+
+    def recv(self):
+        msg = b""
+        while True:
+            b0, b1 = self._read(2)
+            n = b1 & 127
+            if n == 126: n, = struct.unpack(">H", self._read(2))
+            elif n == 127: n, = struct.unpack(">Q", self._read(8))
+            msg += self._read(n)
+            if b0 & 0x80: return msg.decode()
+
+    def send(self, text):
+        data, mask = text.encode(), os.urandom(4)
+        n = len(data)
+        head = bytes([0x81]) + (bytes([0x80 | n]) if n < 126 else
+                                bytes([0x80 | 126]) + struct.pack(">H", n) if n < 65536 else
+                                bytes([0x80 | 127]) + struct.pack(">Q", n))
+        self.s.sendall(head + mask + bytes(b ^ mask[i % 4] for i, b in enumerate(data)))
+
+    def call(self, method, **params):
+        self.id += 1
+        self.send(json.dumps({"id": self.id, "method": method, "params": params}))
+        while True:
+            m = json.loads(self.recv())
+            if m.get("id") == self.id:
+                if "error" in m: raise RuntimeError(m["error"])
+                return m.get("result", {})
+
+    def js(self, expr):
+        r = self.call("Runtime.evaluate", expression=expr, returnByValue=True, awaitPromise=True)
+        return r.get("result", {}).get("value")
+
+
+def wait_for(pred, secs):
+    t0 = time.time()
+    while time.time() - t0 < secs:
+        v = pred()
+        if v: return v
+        time.sleep(0.02)
+    return None
+
+
+# ---- the server ----
+def start_view(scene):
+    out = open(os.path.join(WORK, "view.out"), "w")
+    p = subprocess.Popen([QCS, "view", "--threads", "2", scene], stdout=subprocess.PIPE,
+                         stderr=open(os.path.join(WORK, "view.err"), "w"), text=True)
+    url = None
+    t0 = time.time()
+    while time.time() - t0 < 10:
+        line = p.stdout.readline()
+        if not line: break
+        out.write(line)
+        m = re.search(r"(http://\S+)", line)
+        if m:
+            url = m.group(1)
+            break
+    threading.Thread(target=lambda: [out.write(l) for l in p.stdout], daemon=True).start()
+    return p, url
+
+
+def http_get(host, port, path, headers=None, method="GET", timeout=10):
+    c = http.client.HTTPConnection(host, port, timeout=timeout)
+    c.request(method, path, headers=headers or {})
+    r = c.getresponse()
+    body = r.read()
+    c.close()
+    return r.status, dict(r.getheaders()), body
+
+
+def qcs_eval(defs, expr):
+    r = subprocess.run([QCS, defs, "-e", expr], capture_output=True, text=True, timeout=30)
+    return r.stdout
+
+
+def nums(text):
+    return [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", text)]
+
+
+def close(a, b, rel=1e-12):
+    return len(a) == len(b) and all(abs(x - y) <= rel * max(1, abs(x), abs(y)) for x, y in zip(a, b))
+
+
+# ---- the browser tests ----
+def browser_tests(host, port, token, scene, defs):
+    chrome = shutil.which("chromium") or shutil.which("chromium-browser")
+    if not chrome:
+        print("skip view-browser: chromium is not installed")
+        return
+    prof = tempfile.mkdtemp(prefix="qcs-chrome-")
+    url = "http://%s:%d/?t=%s" % (host, port, token)
+    br = subprocess.Popen([chrome, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                           "--no-first-run", "--disable-background-networking", "--disable-component-update",
+                           "--disable-sync", "--force-color-profile=srgb", "--user-data-dir=" + prof,
+                           "--remote-debugging-port=0", "--window-size=1200,600", url],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        portfile = os.path.join(prof, "DevToolsActivePort")
+        if not wait_for(lambda: os.path.exists(portfile) and open(portfile).read().strip(), 20):
+            report("view-browser", False, "chromium did not start")
+            return
+        cport = int(open(portfile).read().split()[0])
+        pages = wait_for(lambda: [t for t in json.loads(http_get("127.0.0.1", cport, "/json/list")[2])
+                                  if t.get("type") == "page"], 10)
+        ws = WS(pages[0]["webSocketDebuggerUrl"])
+        ws.call("Runtime.enable")
+        state = lambda: ws.js("JSON.stringify(window.qcsView || null)")
+        qv = lambda: json.loads(state() or "null")
+        if not wait_for(lambda: (qv() or {}).get("lastStep") == 1, 15):
+            report("view-load", False, "no full picture within 15 s: %s" % state())
+            return
+        # the canvas against qcs -o at the same camera
+        ref = os.path.join(WORK, "ref.png")
+        subprocess.run([QCS, "-o", ref, scene], capture_output=True, timeout=60)
+        canvas_png = lambda: base64.b64decode(ws.js("document.getElementById('pic').toDataURL('image/png')").split(",")[1])
+        w1, h1, a = png_pixels(canvas_png())
+        w2, h2, b = png_pixels(open(ref, "rb").read())
+        diff = sum(1 for i in range(0, min(len(a), len(b)), 3) if a[i:i + 3] != b[i:i + 3])
+        report("view-load-identical", (w1, h1) == (w2, h2) and diff == 0,
+               "%dx%d vs %dx%d, %d pixels differ" % (w1, h1, w2, h2, diff))
+        if SHOT:
+            pass  # taken after the probe below, with the panel filled
+        # click to probe: pixel (150, 250) of the canvas
+        box = ws.js("JSON.stringify(document.getElementById('pic').getBoundingClientRect())")
+        box = json.loads(box)
+        def click(x, y):
+            for t in ("mousePressed", "mouseReleased"):
+                ws.call("Input.dispatchMouseEvent", type=t, x=box["x"] + x + 0.5, y=box["y"] + y + 0.5,
+                        button="left", clickCount=1)
+        click(150, 250)
+        pr = wait_for(lambda: (qv() or {}).get("probe"), 5)
+        if not pr or "hit" not in pr:
+            report("view-probe", False, "no probe answer: %s" % pr)
+        else:
+            hit = pr["hit"]
+            p = hit["point"]
+            pt = "(%r, %r, %r)" % tuple(p)
+            dens = nums(qcs_eval(defs, "Density r %s (Difference UnitCube box1)" % pt))
+            grad = nums(qcs_eval(defs, "Gradient r %s (Difference UnitCube box1)" % pt))
+            o = "(%r, %r, %r)" % tuple(pr["origin"])
+            d = "(%r, %r, %r)" % tuple(pr["dir"])
+            tr = qcs_eval(defs, "Trace (Shift (0, 0, 0) obj4) %s %s" % (o, d)).strip().splitlines()
+            roots_prompt = nums(tr[-1]) if tr else []
+            seg_lines = [l for l in tr if l.strip().startswith("[") and "rho-0.5" in l]
+            ok = (close([hit["density"]], dens) and close(hit["gradient"], grad)
+                  and len(seg_lines) == len(hit["segments"]) and hit["where"] and ":23:" in hit["where"])
+            troots = [s for s in roots_prompt]
+            report("view-probe-numbers", ok, "density %r vs %r, gradient %r vs %r, %d vs %d segments, where %r"
+                   % (hit["density"], dens, hit["gradient"], grad, len(hit["segments"]), len(seg_lines), hit["where"]))
+            report("view-probe-roots", close(sorted(troots)[:1], [hit["t"]], 1e-9),
+                   "page %r, prompt %r" % (hit["t"], troots))
+            panel = ws.js("document.getElementById('density').textContent")
+            report("view-probe-panel", panel is not None and abs(float(panel) - dens[0]) < 1e-12,
+                   "panel shows %r" % panel)
+        if SHOT:
+            r = ws.call("Page.captureScreenshot", format="png")
+            open(SHOT, "wb").write(base64.b64decode(r["data"]))
+        # orbit by a synthetic drag
+        before = canvas_png()
+        n0 = qv()["frames"]
+        ws.call("Input.dispatchMouseEvent", type="mousePressed", x=box["x"] + 300, y=box["y"] + 200, button="left", clickCount=1)
+        for i in range(1, 11):
+            ws.call("Input.dispatchMouseEvent", type="mouseMoved", x=box["x"] + 300 + 6 * i, y=box["y"] + 200 + 2 * i, button="left")
+        ws.call("Input.dispatchMouseEvent", type="mouseReleased", x=box["x"] + 360, y=box["y"] + 220, button="left", clickCount=1)
+        ok = wait_for(lambda: (qv() or {}).get("frames", 0) > n0 and qv()["lastStep"] == 1, 5)
+        cam = ws.js("document.getElementById('camtext').value")
+        report("view-orbit", bool(ok) and canvas_png() != before and cam.startswith("Camera ("),
+               "frames %s, camera %r" % (state(), cam))
+        # reset key: back to the scene's own camera, identical to qcs -o again
+        ws.call("Input.dispatchKeyEvent", type="keyDown", key="r", text="r")
+        ws.call("Input.dispatchKeyEvent", type="keyUp", key="r")
+        time.sleep(0.05)
+        wait_for(lambda: (qv() or {}).get("lastStep") == 1, 5)
+        time.sleep(0.2)
+        w1, h1, a = png_pixels(canvas_png())
+        report("view-reset-identical", a == b, "after r the picture differs from qcs -o")
+        # follow the file: an editor's save (write a temporary, rename over)
+        v0 = qv()["version"]
+        src = open(scene).read()
+        def save(text):
+            tmp = scene + ".swp"
+            open(tmp, "w").write(text)
+            os.rename(tmp, scene)
+        t0 = time.time()
+        save(src.replace("r    = 0.07;", "r    = 0.2;"))
+        ok = wait_for(lambda: (qv() or {}).get("version", 0) > v0 and qv()["lastStep"] == 1, 5)
+        dt = time.time() - t0
+        report("view-follow", bool(ok) and dt < 1.0, "new full picture after %.2f s" % dt)
+        print("# view: new full picture %.3f s after the save" % dt)
+        after_good = canvas_png()
+        # an error: the message and the last good picture
+        save(src.replace("r    = 0.07;", "r    = 0.07 +;"))
+        err = wait_for(lambda: (qv() or {}).get("error"), 5)
+        shown = ws.js("getComputedStyle(document.getElementById('err')).display")
+        report("view-error", bool(err) and re.search(r"figure12\.qcs:\d+:\d+: error:", err) is not None
+               and shown == "block" and canvas_png() == after_good, "error %r, shown %r" % (err, shown))
+        # deleted, then back
+        os.unlink(scene)
+        gone = wait_for(lambda: "gone" in ((qv() or {}).get("error") or ""), 5)
+        save(src)
+        back = wait_for(lambda: (qv() or {}).get("error") is None and qv()["lastStep"] == 1, 5)
+        report("view-delete", bool(gone) and bool(back), "gone %r, back %r" % (gone, back))
+        ws.s.close()
+    finally:
+        br.terminate()
+        try: br.wait(10)
+        except Exception: br.kill()
+        shutil.rmtree(prof, ignore_errors=True)
+
+
+# ---- the load test ----
+def load_test(host, port, token, total=10000, clients=50):
+    good_host = "%s:%d" % (host, port)
+    wrong = []
+    lock = threading.Lock()
+    count = [0]
+    def one(rng):
+        kind = rng.randrange(10)
+        t = token
+        cam = "eye=%g,%g,%g&at=2,0.5,0&up=0,1,0&fov=%g" % (rng.uniform(-5, 8), rng.uniform(0.5, 6), rng.uniform(-5, 8), rng.uniform(20, 60))
+        if kind == 0: path, hdr, want = "/state?t=" + t, {}, {200}
+        elif kind == 1: path, hdr, want = "/frame?t=%s&%s&step=16" % (t, cam), {}, {200, 409, 503}
+        elif kind == 2: path, hdr, want = "/probe?t=%s&%s&x=%d&y=%d" % (t, cam, rng.randrange(600), rng.randrange(380)), {}, {200}
+        elif kind == 3: path, hdr, want = "/state?t=" + "0" * 32, {}, {403}
+        elif kind == 4: path, hdr, want = "/state?t=" + t, {"Host": "evil.example:%d" % port}, {403}
+        elif kind == 5: path, hdr, want = "/frame?t=%s&eye=nan,1,1&at=0,0,0&up=0,1,0&fov=30" % t, {}, {400}
+        elif kind == 6: path, hdr, want = "/frame?t=%s&eye=1,1,1&at=0,0,0&up=0,1,0&fov=0" % t, {}, {400}
+        elif kind == 7: path, hdr, want = "/state?t=" + t, {"Origin": "http://evil.example"}, {403}
+        elif kind == 8: path, hdr, want = "/../../etc/passwd?t=" + t, {}, {404}
+        else:
+            # raw garbage, or a client that vanishes mid-request
+            try:
+                s = socket.create_connection((host, port), timeout=5)
+                s.sendall(rng.choice([b"GARBAGE\r\n\r\n", b"GET /frame?t=" + t.encode() + b"&own=1&step=16 HTTP/1.1\r\nHost: " + good_host.encode() + b"\r\n\r\n",
+                                      bytes(rng.randrange(256) for _ in range(200)), b"GET / HTTP/1.1\r\n" + b"X: " + b"a" * 100000]))
+                s.close()
+            except OSError:
+                pass
+            return
+        hdr.setdefault("Host", good_host)
+        for attempt in range(3):
+            try:
+                st, _, body = http_get(host, port, path, hdr, timeout=15)
+                break
+            except (ConnectionError, OSError) as e:
+                st, body = None, str(e)
+                time.sleep(0.05)
+        if st not in want:
+            with lock: wrong.append((path, hdr, st, body[:100]))
+        elif kind == 2 and st == 200:
+            j = json.loads(body)
+            if "roots" not in j or "dir" not in j:
+                with lock: wrong.append((path, "probe without roots"))
+    def client(i):
+        rng = random.Random(i)
+        while True:
+            with lock:
+                if count[0] >= total: return
+                count[0] += 1
+            one(rng)
+    t0 = time.time()
+    th = [threading.Thread(target=client, args=(i,)) for i in range(clients)]
+    for t in th: t.start()
+    for t in th: t.join(120)
+    dt = time.time() - t0
+    return wrong, dt
+
+
+def main():
+    os.makedirs(WORK, exist_ok=True)
+    here = os.path.dirname(os.path.abspath(__file__))
+    scene = os.path.join(WORK, "figure12.qcs")
+    shutil.copy(os.path.join(here, "..", "..", "examples", "figure12.qcs"), scene)
+    defs = os.path.join(WORK, "defs.qcs")
+    open(defs, "w").write("".join(l for l in open(scene) if not l.startswith("renderWith")))
+    p, url = start_view(scene)
+    if not url:
+        report("view-start", False, "no URL printed")
+        p.kill()
+        return
+    m = re.match(r"http://([\d.]+):(\d+)/\?t=(\w+)", url)
+    host, port, token = m.group(1), int(m.group(2)), m.group(3)
+    report("view-start", True)
+    try:
+        if not LOAD_ONLY:
+            browser_tests(host, port, token, scene, defs)
+        rss0 = int(open("/proc/%d/statm" % p.pid).read().split()[1]) * 4
+        # 100 clients at once: held open, then a normal request still served
+        socks = []
+        for i in range(100):
+            try: socks.append(socket.create_connection((host, port), timeout=5))
+            except OSError: pass
+        for s in socks: s.close()
+        def try_state():
+            try: return http_get(host, port, "/state?t=" + token, {"Host": "%s:%d" % (host, port)})[0]
+            except OSError: return None
+        st = wait_for(try_state, 5)
+        report("view-100-clients", st == 200 and p.poll() is None, "status %s after 100 connections" % st)
+        wrong, dt = load_test(host, port, token)
+        rss1 = int(open("/proc/%d/statm" % p.pid).read().split()[1]) * 4
+        alive = p.poll() is None
+        report("view-load-test", alive and not wrong, "alive %s, %d wrong answers, first %r" % (alive, len(wrong), wrong[:2]))
+        print("# view: 10000 requests from 50 clients in %.1f s; RSS %d kB before, %d kB after" % (dt, rss0, rss1))
+    finally:
+        p.send_signal(2)
+        try:
+            rc = p.wait(10)
+            report("view-stop", rc == 0, "exit status %s" % rc)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            report("view-stop", False, "did not stop on SIGINT within 10 s")
+
+
+main()
+sys.exit(0 if all(results) else 1)
