@@ -258,13 +258,19 @@ def browser_tests(host, port, token, scene, defs):
             tmp = scene + ".swp"
             open(tmp, "w").write(text)
             os.rename(tmp, scene)
+        png_before_save = canvas_png()
         t0 = time.time()
         save(src.replace("r    = 0.07;", "r    = 0.2;"))
-        ok = wait_for(lambda: (qv() or {}).get("version", 0) > v0 and qv()["lastStep"] == 1, 5)
+        # A test asserts the picture, not the speed: the latency budget (a
+        # first frame within 50 ms, the full one within 0.2 s) is measured
+        # by make bench (bench/view_bench.py); here the new full picture
+        # must come (10 s allows a sanitizer build) and differ from the old.
+        ok = wait_for(lambda: (qv() or {}).get("version", 0) > v0 and qv()["lastStep"] == 1, 10)
         dt = time.time() - t0
-        report("view-follow", bool(ok) and dt < 1.0, "new full picture after %.2f s" % dt)
-        print("# view: new full picture %.3f s after the save" % dt)
         after_good = canvas_png()
+        report("view-follow", bool(ok) and after_good != png_before_save,
+               "no new full picture %.2f s after the save, or the same one" % dt)
+        print("# view: new full picture %.3f s after the save" % dt)
         # an error: the message and the last good picture
         save(src.replace("r    = 0.07;", "r    = 0.07 +;"))
         err = wait_for(lambda: (qv() or {}).get("error"), 5)
