@@ -23,7 +23,11 @@ width() { # width NAME FILE: run FILE in $tmp, every line <= 80 columns
 width "teach: tour within 80 columns" examples/tour.qcs
 for f in examples/lessons/*.qcs; do
   [ -f "$f" ] || continue
+  rm -f "$tmp"/*.svg "$tmp"/*.png
   width "teach: lesson $(basename "$f" .qcs) within 80 columns" "$f"
+  n=$(ls "$tmp" | grep -c -E '\.(svg|png)$')
+  if [ "$n" -gt 0 ]; then echo "ok teach: lesson $(basename "$f" .qcs) draws ($n files)"
+  else echo "FAIL teach: lesson $(basename "$f" .qcs) wrote no picture"; fi
 done
 
 # :set digits at the prompt: numbers, a gradient's rounding-noise

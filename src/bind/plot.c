@@ -859,8 +859,12 @@ static Value *pl_slice(Interp *I, Value **args, Pos pos) {
   fputs("\"/>\n", s.f);
   char title[200], b1[40], b2[40];
   format_real_digits(b1, r, 6);
-  snprintf(title, sizeof title, "Density over a plane (r = %s): eq. (2) "
-           "combined, Figures 4 and 8", b1);
+  if (r > 0)
+    snprintf(title, sizeof title, "Density over a plane (r = %s): eq. (2) "
+             "combined, Figures 4 and 8", b1);
+  else
+    snprintf(title, sizeof title, "Density over a plane (each plane's own "
+             "radius): Figures 4 and 8");
   svg_axes(&s, title, "a (centre + a u + b v)", "b");
   svg_end_data(&s);
   /* colour bar */
