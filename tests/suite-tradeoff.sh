@@ -40,3 +40,8 @@ awk -F'|' '/^\| 1e-/ && $6 !~ /ref/ {
 # the evaluation count rises as the tolerance tightens, end to end
 awk -F'|' '/^\| 1e-0[2]/ {a = $4 + 0} /^\| 1e-12/ {b = $4 + 0}
   END { if (b > a) print "ok tradeoff-evals-rise"; else print "FAIL tradeoff-evals-rise: " a " then " b }' "$tmp/out"
+# a scene the tolerance cannot change (sharp and soft only) says so
+if "$QCS" tradeoff --size 30x20 --repeats 1 -o "$tmp/m.svg" examples/mould.qcs \
+     >"$tmp/out2" 2>"$tmp/err2" && grep -q 'no Rounded object' "$tmp/out2"; then
+  echo "ok tradeoff-says-tolerance-unused"
+else echo "FAIL tradeoff-says-tolerance-unused: $(head -c 200 "$tmp/err2")"; fi

@@ -252,7 +252,7 @@ static const Command commands[] = {
   {"quit", ARG_NONE, 0, cmd_quit, ":quit", "leave qcs (so does Ctrl-D)"},
   {"reload", ARG_NONE, 0, cmd_reload, ":reload", "run the loaded files again"},
   {"set", ARG_ANY, 0, cmd_set, ":set [NAME VALUE]",
-   "list the settings and limits, or change one (:set max-steps 1000000)"},
+   "list the settings and limits, or change one (:set digits 6)"},
   {"show", ARG_ANY, 0, cmd_show, ":show EXPR [with S]",
    "draw a scene object as a picture (S: render settings, [Size 600 380])"},
   {"tradeoff", ARG_FILE, 0, cmd_tradeoff, ":tradeoff FILE",
@@ -306,6 +306,8 @@ static void cmd_set(Repl *R, const char *arg, int bang) {
     else
       printf("preview-size  %-12s the picture's size in character cells\n",
              "auto");
+    printf("digits        %-12d significant digits of printed Reals "
+           "(0: shortest that reads back)\n", R->I->digits);
     interp_list_limits(R->I, stdout);
     fflush(stdout);
     return;
@@ -320,6 +322,18 @@ static void cmd_set(Repl *R, const char *arg, int bang) {
   char err[300];
   if (!strcmp(name, "preview") || !strcmp(name, "preview-size")) {
     if (set_preview(R, name, val)) R->had_error = 1;
+    return;
+  }
+  if (!strcmp(name, "digits")) { /* printing, not a limit: Reals, probes */
+    char *end;
+    long d = strtol(val, &end, 10);
+    if (!*val || *end || d < 0 || d > 17) {
+      fprintf(stderr, "error: :set digits needs 0 (shortest that reads "
+              "back) to 17, not '%s'\n", val);
+      R->had_error = 1;
+    } else {
+      R->I->digits = (int)d;
+    }
     return;
   }
   if (!*val) {

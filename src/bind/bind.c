@@ -1,11 +1,13 @@
 /* bind.c: the whole language. See bind.h. */
 #include "bind/bind.h"
 
+#include "bind/plot.h"
 #include "bind/probes.h"
 #include "bind/render_lang.h"
 
 void bind_install(Interp *I) {
   probes_install(I);
+  plot_install(I);
   render_install(I);
 }
 

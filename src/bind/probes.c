@@ -5,7 +5,9 @@
  * returns, also when an error unwinds (the ScopedScene handler below). */
 #include "bind/probes.h"
 
+#include <float.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/bounds.h"
@@ -42,10 +44,34 @@ static Value *pr_density(Interp *I, Value **args, Pos pos) {
   return val_num(rho);
 }
 
-/* Gradient r p tree: Section 2.4. */
+/* Is v (forced) a SoftObject? */
+static int is_soft(Interp *I, Value *v) {
+  v = force(I, v);
+  return v->kind == V_CON && v->u.con.con &&
+         !strcmp(v->u.con.con->name, "SoftObject");
+}
+
+/* The gradient of Field p soft: eq. (1) differentiated, summed. */
+static Value *soft_gradient(Interp *I, Value *obj, const double p[3],
+                            Pos pos) {
+  Scene *s = compile_scene(I, obj, pos);
+  double g[3] = {0, 0, 0};
+  for (int i = 0; i < s->n; i++)
+    if (s->nodes[i].kind == SC_SOFT) {
+      double gi[3];
+      soft_field_grad(s->nodes[i].soft, p, gi);
+      for (int k = 0; k < 3; k++) g[k] += gi[k];
+    }
+  scene_free(s);
+  return val_tuple3(g[0], g[1], g[2]);
+}
+
+/* Gradient r p tree: Section 2.4; for a soft object (r unused) the
+   gradient of its field. */
 static Value *pr_gradient(Interp *I, Value **args, Pos pos) {
   double r = get_radius(I, args[0], pos), p[3], g[3];
   get_point(I, args[1], pos, "the point", p);
+  if (is_soft(I, args[2])) return soft_gradient(I, args[2], p, pos);
   dt_tape *t = compile_density_tape(I, args[2], r, pos);
   dt_density_grad(t, p, g);
   dt_tape_free(t);
@@ -194,7 +220,8 @@ static Value *roots_list(Interp *I, const Scene *s, const double o[3],
   return list;
 }
 
-static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook) {
+static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook,
+                        const soft_hook *shook) {
   double o[3], d[3];
   get_point(I, args[1], pos, "the ray origin", o);
   get_dir(I, args[2], pos, d);
@@ -205,6 +232,7 @@ static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook) {
     qcs_error(pos, "out of memory");
   }
   c->hook = hook;
+  c->soft_hook = shook;
   /* The scene and the context must not leak if an error unwinds. */
   ErrCleanup cu_scene, cu_ctx;
   err_defer(&cu_scene, free_scene, s);
@@ -226,42 +254,212 @@ static Value *ray_probe(Interp *I, Value **args, Pos pos, const lg_hook *hook) {
 
 /* Roots obj o d: every t >= 0 where o + t d crosses obj's surface. */
 static Value *pr_roots(Interp *I, Value **args, Pos pos) {
-  return ray_probe(I, args, pos, NULL);
+  return ray_probe(I, args, pos, NULL, NULL);
 }
 
-static const char *const decisions[] = {
-    [LG_SEG_EXCLUDED] = "range misses 0.5",
-    [LG_SEG_FLAT] = "flat (L = 0)",
-    [LG_SEG_NO_ROOT] = "eq.6 false: <= 1 root; no sign change",
-    [LG_SEG_ROOT] = "eq.6 false: <= 1 root; sign change -> polish (Newton/bisection)",
-    [LG_SEG_SPLIT] = "eq.6 true: may hold 2 roots -> split",
-    [LG_SEG_TINY] = "shorter than tolerance",
+/* ---- Trace: the root search as a table within 80 columns ---- */
+
+/* What Trace collects while the ray is traced, printed afterwards so that
+   the columns can be sized to what they hold. */
+typedef struct TraceLog {
+  lg_trace_event *lg;
+  soft_trace_event *soft;
+  size_t nlg, caplg, nsoft, capsoft;
+  int oom;
+} TraceLog;
+
+static void trace_lg(void *ctx, const lg_trace_event *ev) {
+  TraceLog *t = ctx;
+  if (t->nlg == t->caplg) {
+    size_t cap = t->caplg ? 2 * t->caplg : 64;
+    lg_trace_event *n = realloc(t->lg, cap * sizeof *n);
+    if (!n) { t->oom = 1; return; }
+    t->lg = n;
+    t->caplg = cap;
+  }
+  t->lg[t->nlg++] = *ev;
+}
+
+static void trace_soft(void *ctx, const soft_trace_event *ev) {
+  TraceLog *t = ctx;
+  if (t->nsoft == t->capsoft) {
+    size_t cap = t->capsoft ? 2 * t->capsoft : 64;
+    soft_trace_event *n = realloc(t->soft, cap * sizeof *n);
+    if (!n) { t->oom = 1; return; }
+    t->soft = n;
+    t->capsoft = cap;
+  }
+  t->soft[t->nsoft++] = *ev;
+}
+
+static void free_trace_log(void *p) {
+  TraceLog *t = p;
+  free(t->lg);
+  free(t->soft);
+}
+
+/* x to the digits of a table cell, 0 when |x| <= tol. */
+static void cell_tol(char *buf, double x, int digits, double tol) {
+  if (isfinite(x) && fabs(x) <= tol) x = 0;
+  if (isinf(x)) strcpy(buf, x > 0 ? "inf" : "-inf");
+  else format_real_digits(buf, x, digits);
+}
+
+/* x to the digits of the table, a value within rounding of 0 beside the
+   scale of its column (8 ulps of it) shown as 0. */
+#define CELL 32
+static void cell(char *buf, double x, int digits, double scale) {
+  cell_tol(buf, x, digits, 8 * DBL_EPSILON * scale);
+}
+
+/* A table: rows of n cells, column headers, widths from the cells; cells
+   right-aligned except the last (text). */
+static void print_table(FILE *out, int n, const char *const *head,
+                        char (*cells)[CELL], size_t rows) {
+  int w[16] = {0};
+  for (int j = 0; j < n; j++) w[j] = (int)strlen(head[j]);
+  for (size_t i = 0; i < rows; i++)
+    for (int j = 0; j < n; j++) {
+      int l = (int)strlen(cells[i * (size_t)n + (size_t)j]);
+      if (l > w[j]) w[j] = l;
+    }
+  for (size_t i = 0; i <= rows; i++) {
+    for (int j = 0; j < n; j++) {
+      const char *c = i == 0 ? head[j] : cells[(i - 1) * (size_t)n + (size_t)j];
+      if (j == n - 1) fprintf(out, " %s", c);
+      else fprintf(out, "%*s%s", j ? 1 : 0, "", c),
+           fprintf(out, "%*s", w[j] - (int)strlen(c), "");
+    }
+    fputc('\n', out);
+  }
+}
+
+/* The numbers of a Trace: the digits setting, else 4 significant. */
+static int trace_digits(const Interp *I) { return I->digits ? I->digits : 4; }
+
+static const char *const lg_decisions[] = {
+    [LG_SEG_EXCLUDED] = "miss",  [LG_SEG_FLAT] = "flat",
+    [LG_SEG_NO_ROOT] = "none",   [LG_SEG_ROOT] = "root",
+    [LG_SEG_SPLIT] = "split",    [LG_SEG_TINY] = "tiny",
 };
 
-static void trace_event(void *ctx, const lg_trace_event *ev) {
-  FILE *out = ctx;
-  char a[32], b[32], L[32], G[32];
-  format_real(a, ev->t0);
-  format_real(b, ev->t1);
-  snprintf(L, sizeof L, "%.4g", ev->L);
-  snprintf(G, sizeof G, "%.4g", ev->G);
-  fprintf(out, "  %*s[%s, %s]  rho-0.5 at the ends: %.3g, %.3g  L = %s  G = %s  "
-          "eq.6: %.4g vs %.4g  %s  (%d instr)%s\n",
-          2 * (ev->depth < 20 ? ev->depth : 20), "", a, b, ev->f0, ev->f1, L, G,
-          ev->lhs, ev->t1 - ev->t0,
-          ev->decision >= 0 && ev->decision <= LG_SEG_TINY
-              ? decisions[ev->decision] : "?",
-          ev->ncode, ev->nroots ? "  -> root" : "");
+static void print_lg_trace(FILE *out, const TraceLog *t, int digits) {
+  fprintf(out,
+          "Rounded objects: the search of Figure 9, one segment a line, "
+          "depth first.\n"
+          " d: depth of splitting  t0, t1: the segment of o + t d\n"
+          " f0, f1: density - 0.5 at its ends  L >= |rho'|, G >= |rho''| "
+          "on it (3.4.1)\n"
+          " A+B: eq. (6); A+B > t1 - t0 proves at most one root  "
+          "ops: tape size there\n"
+          " split: may hold 2 roots  root: 1 root, polished  none: no "
+          "sign change\n"
+          " miss: range misses 0.5  flat: L = 0  tiny: below the "
+          "tolerance\n");
+  static const char *const head[] = {"d", "t0", "t1", "f0", "f1", "L",
+                                     "G", "A+B", "ops", "decision"};
+  char (*cells)[CELL] = calloc(t->nlg * 10 + 1, CELL);
+  if (!cells) return;
+  for (size_t i = 0; i < t->nlg; i++) {
+    const lg_trace_event *e = &t->lg[i];
+    char (*c)[CELL] = cells + i * 10;
+    double ts = fmax(fabs(e->t0), fabs(e->t1));
+    snprintf(c[0], CELL, "%d", e->depth);
+    cell(c[1], e->t0, digits, ts);
+    cell(c[2], e->t1, digits, ts);
+    cell(c[3], e->f0, digits, 1);
+    cell(c[4], e->f1, digits, 1);
+    cell(c[5], e->L, digits, 0);
+    cell(c[6], e->G, digits, 0);
+    cell(c[7], e->lhs, digits, 0);
+    snprintf(c[8], CELL, "%d", e->ncode);
+    snprintf(c[9], CELL, "%s%s",
+             e->decision >= 0 && e->decision <= LG_SEG_TINY
+                 ? lg_decisions[e->decision] : "?",
+             e->nroots && e->decision == LG_SEG_TINY ? " -> root" : "");
+  }
+  print_table(out, 10, head, cells, t->nlg);
+  free(cells);
+}
+
+static const char *const soft_decisions[] = {
+    [SOFT_IV_EMPTY] = "no key: 0",   [SOFT_IV_BOUND] = "range",
+    [SOFT_IV_COEFF] = "coeff",       [SOFT_IV_QUICK] = "solve: bound",
+    [SOFT_IV_LAGUERRE] = "solve: Laguerre",
+    [SOFT_IV_CASCADE] = "solve: cascade",
+};
+
+static void print_soft_trace(FILE *out, const TraceLog *t, int digits) {
+  fprintf(out,
+          "Soft objects: Wyvill and Trotman's intervals between key bounds, "
+          "in order.\n"
+          " t0, t1: the interval  keys: keys acting on it  field in "
+          "[lo, hi] there\n"
+          " range: [lo, hi] stays on one side of magic  coeff: the sextic's "
+          "constant\n"
+          " term outweighs the rest  solve: eq. (4) solved (bound: by its "
+          "range;\n"
+          " Laguerre: verified by signs; cascade: by derivatives)  "
+          "roots: crossings\n");
+  static const char *const head[] = {"t0", "t1", "keys", "lo", "hi",
+                                     "decision", "roots"};
+  size_t rows = 0;
+  for (size_t i = 0; i < t->nsoft; i++)
+    rows += t->soft[i].nroots > 1 ? (size_t)t->soft[i].nroots : 1;
+  char (*cells)[CELL] = calloc(rows * 7 + 1, CELL);
+  if (!cells) return;
+  size_t r = 0;
+  for (size_t i = 0; i < t->nsoft; i++) {
+    const soft_trace_event *e = &t->soft[i];
+    char (*c)[CELL] = cells + r * 7;
+    double ts = fmax(fabs(e->t0), fabs(e->t1));
+    cell(c[0], e->t0, digits, ts);
+    cell(c[1], e->t1, digits, ts);
+    snprintf(c[2], CELL, "%d", e->nkeys);
+    if (e->decision == SOFT_IV_EMPTY) {
+      strcpy(c[3], "0");
+      strcpy(c[4], "0");
+    } else {
+      double fs = fmax(fabs(e->flo), fabs(e->fhi));
+      /* soft.c widens the range by 1e-12 sum |w| against rounding */
+      cell_tol(c[3], e->flo, digits, 1e-11 * fs);
+      cell_tol(c[4], e->fhi, digits, 1e-11 * fs);
+    }
+    strcpy(c[5], e->decision >= 0 && e->decision <= SOFT_IV_CASCADE
+                     ? soft_decisions[e->decision] : "?");
+    if (e->nroots == 0) strcpy(c[6], "-");
+    for (int k = 0; k < e->nroots; k++) {
+      char (*ck)[CELL] = cells + (r + (size_t)k) * 7;
+      cell(ck[6], e->roots[k], digits, 0);
+    }
+    r += e->nroots > 1 ? (size_t)e->nroots : 1;
+  }
+  print_table(out, 7, head, cells, rows);
+  free(cells);
 }
 
 /* Trace obj o d: Roots, printing the root search of every rounded leaf
-   the ray meets (segments, L, G, the eq. (6) decision, roots). */
+   (Figure 9) and soft object (Wyvill and Trotman) the ray meets. */
 static Value *pr_trace(Interp *I, Value **args, Pos pos) {
-  lg_hook hook = {trace_event, stdout};
-  printf("Trace: segments of the guaranteed root search (Figure 9), "
-         "indented by depth\n");
-  Value *v = ray_probe(I, args, pos, &hook);
+  TraceLog log = {0};
+  ErrCleanup cu;
+  err_defer(&cu, free_trace_log, &log);
+  lg_hook hook = {trace_lg, &log};
+  soft_hook shook = {trace_soft, &log};
+  Value *v = ray_probe(I, args, pos, &hook, &shook);
+  int digits = trace_digits(I);
+  printf("Trace: the root search along o + t d; the value is Roots' list\n"
+         "(numbers to %d significant digits: :set digits N for more)\n",
+         digits);
+  if (log.oom) printf("(out of memory: the trace is incomplete)\n");
+  if (log.nlg) print_lg_trace(stdout, &log, digits);
+  if (log.nsoft) print_soft_trace(stdout, &log, digits);
+  if (!log.nlg && !log.nsoft)
+    printf("No rounded or soft object's bound is met: nothing to search "
+           "(sharp faces are\nsolved directly).\n");
   fflush(stdout);
+  err_release(&cu);
+  free_trace_log(&log);
   return v;
 }
 
@@ -289,7 +487,7 @@ static Value *pr_lg(Interp *I, Value **args, Pos pos) {
   X("Density", 3, pr_density,                                                \
     "Density r p tree: the density of the tree smoothed with radius r at p") \
   X("Gradient", 3, pr_gradient,                                              \
-    "Gradient r p tree: the density's gradient at p")                        \
+    "Gradient r p tree: the density's (or soft field's) gradient at p")                      \
   X("PointInObject", 2, pr_inside,                                           \
     "PointInObject p obj: is p inside the object?")                          \
   X("Displacement", 2, pr_displacement,                                      \

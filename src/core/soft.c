@@ -408,6 +408,14 @@ static void interval_poly(const soft_obj *o, const key_event *act, int nact,
 int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
                double t0, double t1, double *out, int maxout,
                soft_scratch *scratch, soft_stats *stats) {
+  return soft_roots_traced(obj, o, d, t0, t1, out, maxout, scratch, stats,
+                           NULL);
+}
+
+int soft_roots_traced(const soft_obj *obj, const double o[3],
+                      const double d[3], double t0, double t1, double *out,
+                      int maxout, soft_scratch *scratch, soft_stats *stats,
+                      const soft_hook *hook) {
   soft_stats dummy;
   if (!stats) { memset(&dummy, 0, sizeof dummy); stats = &dummy; }
   stats->rays++;
@@ -500,12 +508,31 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
         if (fabs(c[0]) > s1 * (1 + 1e-12) + 1e-300 && (c[0] > 0) == state)
           settled = 1;  /* |p(v) - p(0)| < |p(0)| on [-1, 1] */
       }
+      soft_trace_event ev;
+      if (hook) {
+        ev.t0 = cur / len;
+        ev.t1 = tnext / len;
+        ev.flo = flo;
+        ev.fhi = fhi;
+        ev.nkeys = na;
+        ev.nroots = 0;
+        ev.decision = (fhi <= obj->magic && state == 0) ||
+                              (flo > obj->magic && state == 1)
+                          ? SOFT_IV_BOUND : SOFT_IV_COEFF;
+      }
       if (settled) {
         stats->skipped++;
+        if (hook) hook->fn(hook->ctx, &ev);
       } else {
         int sb = poly_eval(c, 6, 1.0, NULL) > 0;
         double v[POLY_MAX_DEG];
+        poly_stats before = stats->poly;
         int nv = poly_crossings(c, 6, -1.0, 1.0, state, sb, 0, v, &stats->poly);
+        if (hook)
+          ev.decision = stats->poly.fallbacks > before.fallbacks
+                            ? SOFT_IV_CASCADE
+                        : stats->poly.laguerre > before.laguerre
+                            ? SOFT_IV_LAGUERRE : SOFT_IV_QUICK;
         for (int j = 0; j < nv; j++) {
           double t = tm + h * v[j];
           /* A root on the boundary with the two neighbouring sextics
@@ -518,8 +545,10 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
             continue;
           }
           if (nout < maxout) out[nout++] = t / len;
+          if (hook) ev.roots[ev.nroots++] = t / len;
           last_from = iv;
         }
+        if (hook) hook->fn(hook->ctx, &ev);
         state = sb;
         prev_h = h;
         if (nout >= maxout) break;
@@ -531,6 +560,12 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
          sign of a sextic whose value there is rounding noise when magic
          is tiny: the field vanishes at a key's bound), the exit is at its
          end: crossings must alternate. */
+      if (hook) {
+        soft_trace_event ev = {cur / len, tnext / len, NAN, NAN, 0,
+                               SOFT_IV_EMPTY, 0, {0}};
+        if (state == 1 && iv > 0) ev.roots[ev.nroots++] = cur / len;
+        hook->fn(hook->ctx, &ev);
+      }
       if (state == 1 && iv > 0) {
         if (nout < maxout) out[nout++] = cur / len;
         last_from = iv;

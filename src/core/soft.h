@@ -98,4 +98,36 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
                double t0, double t1, double *out, int maxout,
                soft_scratch *scratch, soft_stats *stats);
 
+/* Trace of soft_roots_traced: one event per interval between consecutive
+ * key-bound events along the ray (the paper's step 1), saying how it was
+ * decided (step 2). */
+enum {
+  SOFT_IV_EMPTY,     /* no key acts: the field is 0 < magic */
+  SOFT_IV_BOUND,     /* the field's range [flo, fhi] stays on one side */
+  SOFT_IV_COEFF,     /* the sextic's constant term outweighs the others */
+  SOFT_IV_QUICK,     /* solved: settled by the polynomial's range bound */
+  SOFT_IV_LAGUERRE,  /* solved: Laguerre's method, verified by signs */
+  SOFT_IV_CASCADE    /* solved: the derivative cascade (Laguerre rejected) */
+};
+
+typedef struct soft_trace_event {
+  double t0, t1;     /* the interval, in units of t */
+  double flo, fhi;   /* bounds on the field over it (NAN for EMPTY) */
+  int nkeys;         /* keys acting on it */
+  int decision;      /* SOFT_IV_* */
+  int nroots;        /* crossings it reported, at roots[] (units of t) */
+  double roots[POLY_MAX_DEG];
+} soft_trace_event;
+
+typedef struct soft_hook {
+  void (*fn)(void *ctx, const soft_trace_event *ev);
+  void *ctx;
+} soft_hook;
+
+/* soft_roots, calling hook (may be NULL) once per interval. */
+int soft_roots_traced(const soft_obj *obj, const double o[3],
+                      const double d[3], double t0, double t1, double *out,
+                      int maxout, soft_scratch *scratch, soft_stats *stats,
+                      const soft_hook *hook);
+
 #endif

@@ -78,6 +78,18 @@ static Value *bi_not(Interp *I, Value **args, Pos pos) {
 static Value *bi_show(Interp *I, Value **args, Pos pos) {
   return val_str(show_value(I, force(I, args[0])));
 }
+/* showReal digits x: x rounded to digits significant digits (1..17), as
+   :set digits prints it; digits 0 is the shortest form that reads back. */
+static Value *bi_showReal(Interp *I, Value **args, Pos pos) {
+  double n = ARGNUM(0, "the digits of showReal");
+  double x = ARGNUM(1, "the number of showReal");
+  if (!(n >= 0 && n <= 17) || n != floor(n))
+    qcs_error(pos, "showReal needs a whole number of digits from 0 to 17, "
+              "not %g", n);
+  char buf[40];
+  format_real_digits(buf, x, (int)n);
+  return val_str(GC_STRDUP(buf));
+}
 /* error msg: said where the user's code called it, even when that was
    through the prelude (Scale's "factors > 0"); the text is the user's
    own, shown as it is. */

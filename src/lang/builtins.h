@@ -40,6 +40,8 @@
   X("isInfinite", 1, bi_isInfinite, "isInfinite x")                          \
   X("not", 1, bi_not, "not b")                                               \
   X("show", 1, bi_show, "show v: v printed as a String")                     \
+  X("showReal", 2, bi_showReal,                                              \
+    "showReal digits x: x to that many significant digits (0: shortest)")     \
   X("error", 1, bi_error, "error msg: stop with an error")                   \
   X("seq", 2, bi_seq, "seq a b: evaluate a, then give b")                    \
   X("dot", 2, bi_dot, "dot u v: scalar product of 3-vectors")                \

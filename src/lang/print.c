@@ -2,6 +2,7 @@
 #define _GNU_SOURCE /* fopencookie */
 #include "lang/print.h"
 
+#include <float.h>
 #include <gc.h>
 #include <math.h>
 #include <stdio.h>
@@ -10,7 +11,11 @@
 
 #include "lang/eval.h"
 
-void format_real(char *buf, double x) {
+static void layout_real(char *buf, const char *tmp);
+
+void format_real(char *buf, double x) { format_real_digits(buf, x, 0); }
+
+void format_real_digits(char *buf, double x, int digits) {
   if (isnan(x)) {
     strcpy(buf, "NaN");
     return;
@@ -23,13 +28,24 @@ void format_real(char *buf, double x) {
     strcpy(buf, signbit(x) ? "-0" : "0");
     return;
   }
-  /* The fewest significant digits that read back as x ... */
+  /* The fewest significant digits that read back as x (or, with digits
+     set, x rounded to that many: a value within rounding of a round
+     number shows as that number) ... */
   char tmp[40];
-  int prec;
-  for (prec = 1; prec <= 17; prec++) {
-    snprintf(tmp, sizeof tmp, "%.*e", prec - 1, x);
-    if (strtod(tmp, NULL) == x) break;
+  if (digits > 0) {
+    snprintf(tmp, sizeof tmp, "%.*e", (digits > 17 ? 17 : digits) - 1, x);
+  } else {
+    int prec;
+    for (prec = 1; prec <= 17; prec++) {
+      snprintf(tmp, sizeof tmp, "%.*e", prec - 1, x);
+      if (strtod(tmp, NULL) == x) break;
+    }
   }
+  layout_real(buf, tmp);
+}
+
+/* tmp ("-d.ddde+NN") laid out as JavaScript does, trailing zeros gone. */
+static void layout_real(char *buf, const char *tmp) {
   /* ... laid out as JavaScript does: plain for 1e-6 <= |x| < 1e21,
      otherwise with an exponent ("1e-12", "1.5e300"). */
   char digits[20];
@@ -171,7 +187,7 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
   }
   switch (v->kind) {
   case V_NUM:
-    format_real(buf, v->u.num);
+    format_real_digits(buf, v->u.num, I->digits);
     fputs(buf, out);
     break;
   case V_BOOL:
@@ -180,14 +196,30 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
   case V_STR:
     print_str(out, v->u.str);
     break;
-  case V_TUPLE:
+  case V_TUPLE: {
+    /* With digits set, a coordinate within rounding of 0 beside larger
+       ones (a gradient's 2e-31 beside 7.5) shows as 0. */
+    double scale = -1;
+    if (I->digits > 0) {
+      scale = 0;
+      for (int i = 0; i < v->u.tup.n && scale >= 0; i++) {
+        Value *x = force(I, v->u.tup.items[i]);
+        if (x->kind != V_NUM || !isfinite(x->u.num)) scale = -1;
+        else if (fabs(x->u.num) > scale) scale = fabs(x->u.num);
+      }
+    }
     fputc('(', out);
     for (int i = 0; i < v->u.tup.n; i++) {
       if (i) fputs(", ", out);
-      print_rec(I, out, v->u.tup.items[i], 0);
+      Value *x = v->u.tup.items[i];
+      if (scale > 0 && fabs(force(I, x)->u.num) <= 8 * DBL_EPSILON * scale)
+        fputs("0", out);
+      else
+        print_rec(I, out, x, 0);
     }
     fputc(')', out);
     break;
+  }
   case V_NIL:
   case V_CONS:
     fputc('[', out);

@@ -25,4 +25,8 @@ void print_brief(FILE *out, Value *v, int depth);
 /* The shortest decimal form of x that reads back as x ("0.1", "1e-12",
    "3"); buf needs 32 bytes. */
 void format_real(char *buf, double x);
+/* As format_real with digits <= 0; else x rounded to that many significant
+   digits (at most 17), trailing zeros dropped ("1" for 1.000000000000001
+   at 15 digits). The REPL's :set digits N and showReal use it. */
+void format_real_digits(char *buf, double x, int digits);
 #endif

@@ -131,6 +131,8 @@ struct Interp {
   unsigned long long max_list; /* max-list: elements of one list */
   unsigned long long max_pixels; /* max-pixels: of one rendered image */
   int max_spp;               /* max-spp: samples per pixel of a render */
+  int digits;                /* :set digits: significant digits of printed
+                                Reals; 0 = the shortest that reads back */
   Pos item_pos;              /* the top-level item being run, for errors
                                 found where no position is at hand */
   TraceEntry trace[TRACE_MAX];

@@ -155,6 +155,41 @@ int img_write(const Image *im, const char *path, const ImgWriteOptions *opt,
   return rc;
 }
 
+int img_write_bytes(const char *path, const void *data, size_t len,
+                    char *err, size_t errlen) {
+  char *tmp = NULL;
+  int fd = open_temp(path, &tmp);
+  if (fd < 0) {
+    snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+    return -1;
+  }
+  int rc = 0;
+  const char *p = data;
+  while (len > 0) {
+    ssize_t w = write(fd, p, len);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      rc = -1;
+      break;
+    }
+    p += w;
+    len -= (size_t)w;
+  }
+  if (rc == 0 && fsync(fd) != 0 && errno != EINVAL) rc = -1;
+  if (rc != 0) snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+  if (close(fd) != 0 && rc == 0) {
+    snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+    rc = -1;
+  }
+  if (rc == 0 && rename(tmp, path) != 0) {
+    snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+    rc = -1;
+  }
+  if (rc != 0) unlink(tmp);
+  free(tmp);
+  return rc;
+}
+
 /* ---- sRGB ---------------------------------------------------------------- */
 
 unsigned char img_srgb8(float v) {

@@ -75,6 +75,11 @@ static inline size_t img_index(const Image *im, int x, int y) {
  * before a long render. */
 int img_format(const char *path, char *err, size_t errlen);
 
+/* Write len bytes (an SVG, a report) to path atomically, as img_write
+   writes an image: whole or not at all. 0, or -1 with err set. */
+int img_write_bytes(const char *path, const void *data, size_t len,
+                    char *err, size_t errlen);
+
 /* Write im to path in the format of its extension, atomically (see above).
  * 0, or -1 with a message like "cannot write out.png: Permission denied". */
 int img_write(const Image *im, const char *path, const ImgWriteOptions *opt,

@@ -168,8 +168,8 @@ static int soft_spans(const ScNode *n, int id, const double o[3],
                       const double d[3], double t0, double t1, RayCtx *c,
                       csg_span *out) {
   double t[MAX_LEAF_ROOTS];
-  int nr = soft_roots(n->soft, o, d, t0, t1, t, MAX_LEAF_ROOTS, c->soft,
-                      &c->stats.soft);
+  int nr = soft_roots_traced(n->soft, o, d, t0, t1, t, MAX_LEAF_ROOTS,
+                             c->soft, &c->stats.soft, c->soft_hook);
   if (nr < 0) return -1;
   /* The state before the first crossing, sampled halfway to it; a
      crossing reported at t0 itself (the origin on the surface, or within

@@ -64,6 +64,7 @@ typedef struct RayCtx {
   size_t cap_frames;
   RayStats stats;
   const lg_hook *hook; /* optional trace of every root search segment */
+  const soft_hook *soft_hook; /* optional trace of every soft interval */
   int failed;          /* a query ran out of memory (sticky; ray_spans
                           sets it, and so may the caller's own queries) */
   int unresolved_node; /* a rounded node whose search left segments unsplit

@@ -1,0 +1,91 @@
+#!/bin/sh
+# suite-teach.sh: what a student reads. No line of the tour's or a
+# lesson's output is wider than 80 columns; :set digits N rounds what the
+# REPL prints (piped, so no terminal is needed); every lesson runs and
+# writes the pictures it names. Prints "ok NAME" or "FAIL NAME: why".
+QCS=${QCS:-./qcs}
+top=$(pwd)
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+
+width() { # width NAME FILE: run FILE in $tmp, every line <= 80 columns
+  (cd "$tmp" && timeout 120 "$top/$QCS" "$top/$2" > out 2> err < /dev/null)
+  st=$?
+  wide=$(awk 'length($0) > 80 { print NR ": " length($0) }' "$tmp/out" "$tmp/err" | head -3 | tr '\n' ' ')
+  if [ $st -ne 0 ]; then
+    echo "FAIL $1: status $st: $(head -c 300 "$tmp/err" | tr '\n' ' ')"
+  elif [ -n "$wide" ]; then
+    echo "FAIL $1: lines wider than 80 columns (line: width) $wide"
+  else
+    echo "ok $1"
+  fi
+}
+
+width "teach: tour within 80 columns" examples/tour.qcs
+for f in examples/lessons/*.qcs; do
+  [ -f "$f" ] || continue
+  rm -f "$tmp"/*.svg "$tmp"/*.png
+  width "teach: lesson $(basename "$f" .qcs) within 80 columns" "$f"
+  n=$(ls "$tmp" | grep -c -E '\.(svg|png)$')
+  if [ "$n" -gt 0 ]; then echo "ok teach: lesson $(basename "$f" .qcs) draws ($n files)"
+  else echo "FAIL teach: lesson $(basename "$f" .qcs) wrote no picture"; fi
+done
+
+# :set digits at the prompt: numbers, a gradient's rounding-noise
+# coordinate, Trace's table, and back to the shortest form.
+out=$(printf '%s\n' ':set digits 6' '1/3' '1.000000000000001' \
+  'Gradient 0.1 (0.5, 0.5, 0.95) UnitCube' ':set digits 0' '1/3' \
+  ':set digits 18' | "$QCS" 2>&1)
+want='0.333333
+1
+(0, 0, -5.625)
+0.3333333333333333
+error: :set digits needs 0 (shortest that reads back) to 17, not '"'18'"
+if [ "$out" = "$want" ]; then echo "ok teach: :set digits"
+else echo "FAIL teach: :set digits: got $(printf '%s' "$out" | tr '\n' '|')"; fi
+
+# plotRay's curve is Density (or Field) at the plotted t, and its roots
+# are Roots: read the data-* attributes back and check them in qcs.
+curve_check() { # curve_check NAME OBJ O D CLASS PROBE
+  name=$1 obj=$2 o=$3 d=$4 cls=$5 probe=$6
+  (cd "$tmp" && "$top/$QCS" -e "plotRay \"ray.svg\" ($obj) $o $d" > /dev/null 2> err) ||
+    { echo "FAIL teach: $name: plotRay failed: $(head -c 200 "$tmp/err")"; return; }
+  line=$(grep "class=\"$cls\"" "$tmp/ray.svg")
+  xs=$(printf '%s' "$line" | sed 's/.*data-x="\([^"]*\)".*/\1/' | tr ' ' ',')
+  ys=$(printf '%s' "$line" | sed 's/.*data-y="\([^"]*\)".*/\1/' | tr ' ' ',')
+  rs=$(grep -o 'class="root"[^>]*data-t="[^"]*"' "$tmp/ray.svg" | sed 's/.*data-t="\([^"]*\)"/\1/' | tr '\n' ',' | sed 's/,$//')
+  cat > "$tmp/check.qcs" <<QCS
+obj = $obj;
+at t = (ox + t * dx, oy + t * dy, oz + t * dz)
+  where (ox, oy, oz) = $o;
+        (dx, dy, dz) = $d;
+ts = [$xs];
+ys = [$ys];
+bad = [t \\\\ (t, y) <- zip ts ys, abs ($probe (at t) - y) > 1e-12];
+(length ts, length bad)
+[$rs] == Roots obj $o $d
+QCS
+  got=$("$top/$QCS" "$tmp/check.qcs" 2>&1 | tr '\n' ' ')
+  if [ "$got" = "(401, 0) True " ]; then echo "ok teach: $name"
+  else echo "FAIL teach: $name: got $got"; fi
+}
+curve_check "plotRay curve is Density, its roots are Roots" \
+  "Rounded 0.1 UnitCube" "(-1, 0.95, 0.5)" "(1, 0, 0)" density \
+  "(\\p -> Density 0.1 p UnitCube)"
+curve_check "plotRay curve of a soft object is Field, its roots are Roots" \
+  "SoftObject 0.5 [Key (0, 0, 0) 1 1, Key (0.8, 0, 0) 1 1]" "(-2, 0.1, 0)" \
+  "(1, 0, 0)" field "(\\p -> Field p obj)"
+
+# Every plot writes its file, and a failed write leaves nothing behind.
+(cd "$tmp" && "$top/$QCS" -e 'plotDisplacement "d.svg"' \
+  -e 'plotField "c.svg" (SoftObject 0.5 [Key (0, 0, 0) 1 1]) (-2, 0, 0) (1, 0, 0)' \
+  -e 'plotSlice "s.png" 0.1 UnitCube ((0.5, 0.5, 0.5), (0.8, 0, 0), (0, 0.8, 0))' \
+  > out 2> err)
+if [ -s "$tmp/d.svg" ] && [ -s "$tmp/c.svg" ] && [ -s "$tmp/s.png" ] && [ -s "$tmp/s.svg" ] &&
+   grep -q '</svg>' "$tmp/d.svg" && grep -q '</svg>' "$tmp/c.svg" && grep -q '</svg>' "$tmp/s.svg"
+then echo "ok teach: plotDisplacement, plotField, plotSlice write their files"
+else echo "FAIL teach: plots: $(ls "$tmp" | tr '\n' ' ') $(head -c 200 "$tmp/err")"; fi
+if "$QCS" -e 'plotDisplacement "/nonexistent-dir/d.svg"' > /dev/null 2> "$tmp/err"; then
+  echo "FAIL teach: plot into a missing folder succeeded"
+elif grep -q 'cannot write /nonexistent-dir/d.svg' "$tmp/err"; then
+  echo "ok teach: plot into a missing folder is an error naming the file"
+else echo "FAIL teach: plot error: $(head -c 200 "$tmp/err")"; fi
