@@ -218,7 +218,8 @@ def browser_tests(host, port, token, scene, defs):
             d = "(%r, %r, %r)" % tuple(pr["dir"])
             tr = qcs_eval(defs, "Trace (Shift (0, 0, 0) obj4) %s %s" % (o, d)).strip().splitlines()
             roots_prompt = nums(tr[-1]) if tr else []
-            seg_lines = [l for l in tr if l.strip().startswith("[") and "rho-0.5" in l]
+            # the Trace table's rows: depth, t0, t1, ..., decision
+            seg_lines = [l for l in tr if re.match(r"^\s*\d+\s+\S+\s+\S+\s.*\b(split|root|none|miss|flat|tiny)\s*$", l)]
             ok = (close([hit["density"]], dens) and close(hit["gradient"], grad)
                   and len(seg_lines) == len(hit["segments"]) and hit["where"] and ":23:" in hit["where"])
             troots = [s for s in roots_prompt]
