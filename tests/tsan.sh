@@ -2,7 +2,7 @@
 # tsan.sh (make tsan): the threaded parts of qcs under ThreadSanitizer.
 # QCS and QCS_UNIT_DIR name a -fsanitize=thread build (build-tsan). Runs
 # the render and fast-path unit tests, every rendering example on 4
-# threads, and the REPL and preview suites; prints "ok NAME" / "FAIL NAME: why" lines
+# threads, the REPL, preview and viewer suites (the viewer: libmicrohttpd threads, the render thread, 10,000 requests from 50 clients); prints "ok NAME" / "FAIL NAME: why" lines
 # and a closing "N passed, N failed". halt_on_error=1: the first report
 # ends the program with status 66, which is a failure here.
 cd "$(dirname "$0")/.." || exit 1
@@ -24,7 +24,7 @@ for f in examples/*.qcs; do
      ! grep -q ThreadSanitizer "$tmp/$n.err"; then echo "ok tsan/example-$n" >>"$log"
   else echo "FAIL tsan/example-$n: $(grep -m3 -E 'ThreadSanitizer|error' "$tmp/$n.err" | tr '\n' ' ')" >>"$log"; fi
 done
-for s in tests/suite-repl.sh tests/suite-preview.sh; do QCS_TSAN=1 sh "$s" 2>&1 | sed 's/^\(ok\|FAIL\|skip\) /\1 tsan\//' >>"$log"; done
+for s in tests/suite-repl.sh tests/suite-preview.sh tests/suite-view.sh; do QCS_TSAN=1 sh "$s" 2>&1 | sed 's/^\(ok\|FAIL\|skip\) /\1 tsan\//' >>"$log"; done
 
 grep -E '^(FAIL|skip) ' "$log"
 passed=$(grep -c '^ok ' "$log"); failed=$(grep -c '^FAIL ' "$log")
