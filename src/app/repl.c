@@ -221,7 +221,7 @@ static void note_status(Repl *R, RunStatus st) {
 
 /* ---- commands ---- */
 
-typedef enum { ARG_NONE, ARG_FILE, ARG_ANY } ArgKind;
+typedef enum { ARG_NONE, ARG_FILE, ARG_ANY, ARG_NAME } ArgKind;
 
 typedef struct {
   const char *name;
@@ -239,12 +239,19 @@ static void cmd_quit(Repl *R, const char *arg, int bang);
 static void cmd_tradeoff(Repl *R, const char *arg, int bang);
 static void cmd_set(Repl *R, const char *arg, int bang);
 static void cmd_show(Repl *R, const char *arg, int bang);
+static void cmd_type(Repl *R, const char *arg, int bang);
+static void cmd_info(Repl *R, const char *arg, int bang);
+static void cmd_doc(Repl *R, const char *arg, int bang);
 
 /* Sorted by name; a command may be abbreviated to any unique prefix. */
 static const Command commands[] = {
   {"browse", ARG_NONE, 1, cmd_browse, ":browse[!]",
    "list your definitions (! adds the prelude and built-ins)"},
+  {"doc", ARG_NAME, 0, cmd_doc, ":doc NAME",
+   "what NAME does, in one line, and an example"},
   {"help", ARG_NONE, 0, cmd_help, ":help", "this text"},
+  {"info", ARG_NAME, 0, cmd_info, ":info NAME",
+   "kind, arity, where defined, signature, doc (also :i)"},
   {"load", ARG_FILE, 0, cmd_load, ":load FILE",
    "run a qcs file and remember it for :reload"},
   {"quit", ARG_NONE, 0, cmd_quit, ":quit", "leave qcs (so does Ctrl-D)"},
@@ -255,6 +262,8 @@ static const Command commands[] = {
    "draw a scene object as a picture (S: render settings, [Size 600 380])"},
   {"tradeoff", ARG_FILE, 0, cmd_tradeoff, ":tradeoff FILE",
    "error against run time over root tolerances (writes tradeoff.svg)"},
+  {"type", ARG_ANY, 0, cmd_type, ":type EXPR",
+   "what kind of value EXPR is (also :t); a scene object is summarised"},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 
@@ -584,6 +593,48 @@ static void cmd_browse(Repl *R, const char *arg, int bang) {
 
 static void cmd_quit(Repl *R, const char *arg, int bang) { R->quit = 1; }
 
+static void cmd_info(Repl *R, const char *arg, int bang) {
+  if (interp_info(R->I, stdout, arg)) R->had_error = 1;
+  fflush(stdout);
+}
+
+static void cmd_doc(Repl *R, const char *arg, int bang) {
+  if (interp_doc(R->I, stdout, arg)) R->had_error = 1;
+  fflush(stdout);
+}
+
+/* :type EXPR runs as an item, so that an error in EXPR is reported as
+   one; the value is described, not printed. */
+static Value *type_item(Interp *I, void *ud) {
+  const char *text = ud;
+  Value *v = interp_eval_expr(I, SOURCE_NAME, text);
+  char desc[400];
+  interp_describe(I, v, desc, sizeof desc);
+  const char *t = skip_blanks(text);
+  const char *sig = interp_signature(I, t);
+  if (sig) printf("%s :: %s\n", t, sig);
+  printf("%s\n", desc);
+  if (compile_is_object(I, v)) { /* a scene object: what it compiles to */
+    Scene *s = compile_scene_any(I, v, pos_none);
+    char line[512];
+    report_scene(line, sizeof line, s, "a scene object");
+    scene_free(s);
+    printf("%s\n", line);
+  }
+  return NULL;
+}
+
+static void cmd_type(Repl *R, const char *arg, int bang) {
+  if (!*arg) {
+    fputs("error: :type needs an expression (usage: :type EXPR)\n", stderr);
+    R->had_error = 1;
+    return;
+  }
+  RunStatus st;
+  RUN_GUARDED(st, interp_run_item(R->I, pos_none, type_item, (void *)arg));
+  note_status(R, st);
+}
+
 static void unknown_command(Repl *R, const char *word) {
   const char *best = NULL;
   int best_d = 3; /* suggest only close names (lang/error.h's distance) */
@@ -640,6 +691,8 @@ static void run_command(Repl *R, const char *line) {
   int bang = n > 0 && word[n - 1] == '!';
   if (bang) word[n - 1] = '\0';
   if (strcmp(word, "?") == 0) strcpy(word, "help");
+  if (strcmp(word, "t") == 0) strcpy(word, "type"); /* as in GHCi */
+  if (strcmp(word, "i") == 0) strcpy(word, "info");
 
   /* the argument, without surrounding blanks */
   const char *arg = skip_blanks(end);
@@ -662,6 +715,10 @@ static void run_command(Repl *R, const char *line) {
     R->had_error = 1;
   } else if (c->arg == ARG_NONE && alen > 0) {
     fprintf(stderr, "error: ':%s' takes no argument (usage: %s)\n", c->name,
+            c->usage);
+    R->had_error = 1;
+  } else if (c->arg == ARG_NAME && (alen == 0 || strpbrk(argcopy, " \t"))) {
+    fprintf(stderr, "error: ':%s' needs one name (usage: %s)\n", c->name,
             c->usage);
     R->had_error = 1;
   } else if (c->arg == ARG_FILE && alen == 0) {

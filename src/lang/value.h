@@ -47,6 +47,12 @@ struct Sym {
   const char *sig;     /* type signature text */
   Pos def_pos;         /* where it was defined (for "already defined") */
   const char *def_file;/* which run defined it */
+  const char *doc;     /* one line for :doc and :info ("// doc:" above the
+                          definition, or a built-in's table entry) */
+  const char *example; /* an expression showing it ("// e.g."), or NULL */
+  int builtin;         /* a built-in (written in C) */
+  int shadow_warned;   /* a user definition that shadows a built-in or a
+                          prelude name has been warned about */
 };
 
 typedef enum {

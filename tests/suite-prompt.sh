@@ -1,0 +1,92 @@
+#!/bin/sh
+# suite-prompt.sh: seeing what you model at the prompt (issue 13): :type,
+# :info, :doc, the docs and examples of every built-in and prelude
+# function, shadowing warnings, continuation lines, :reload and renders,
+# errors at the user's line. Piped stdin (the plain loop) for most checks;
+# the ...> prompt through tmux. One line per check: "ok NAME", "FAIL NAME:
+# why" or "skip NAME: why".
+#   QCS  the binary under test (default ./qcs), run from the project root
+cd "$(dirname "$0")/.." || exit 1
+QCS=${QCS:-./qcs}
+case $QCS in /*) ;; *) QCS=$PWD/$QCS ;; esac
+if [ ! -x "$QCS" ]; then
+  echo "FAIL prompt: no binary at $QCS"
+  exit 1
+fi
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 1' INT TERM
+ok() { echo "ok $1"; }
+fail() { printf 'FAIL %s: %s\n' "$1" "$(printf '%s' "$2" | tr '\n' '|' | cut -c1-300)"; }
+if command -v timeout >/dev/null 2>&1; then lim="timeout 60"; else lim=""; fi
+# q: $QCS on piped stdin (given as arguments, one line each), clean HOME,
+# in $tmp; stdout in $tmp/out, stderr in $tmp/err, status in $rc
+q() { printf '%s\n' "$@" >"$tmp/in"; (cd "$tmp" && HOME=$tmp $lim "$QCS" <in >out 2>err); rc=$?; }
+# expect NAME FILE PATTERN...: every (grep -E) pattern is a line of FILE
+expect() {
+  name=$1 file=$2; shift 2
+  for p in "$@"; do
+    if ! grep -Eq -- "$p" "$tmp/$file"; then
+      fail "$name" "no line '$p' in $file: $(cat "$tmp/out" "$tmp/err")"
+      return 1
+    fi
+  done
+  ok "$name"
+}
+
+# ---- :type ----
+q ':type 1 + 2' ':t "a"' ':t (1, 2, 3)' ':t [1, 2]' ':t Shift' ':t Shift (1, 0, 0)' \
+  ':t Rounded' ':t Rounded 0.1 UnitCube' ':t sqrt'
+expect type-kinds out '^a Real$' '^a String$' '^a 3-tuple$' \
+  '^a list whose first element is a Real$' '^Shift :: Vector a -> a$' \
+  '^a function of 2 arguments \(Shift\)$' \
+  '^a function of 1 more argument \(Shift given 1 of 2\)$' \
+  '^the constructor Rounded of SceneObject: a function of 2 arguments$' \
+  '^a SceneObject, made by the constructor Rounded$' \
+  '^a scene object: rounded, 6 leaves, box \(0, 0, 0\) \.\. \(1, 1, 1\)$' \
+  '^a built-in function of 1 argument \(sqrt\)$'
+q ':t nosuchname' '1 + 1'
+if [ "$rc" = 1 ] && grep -q "unknown name 'nosuchname'" "$tmp/err" && [ "$(cat "$tmp/out")" = 2 ]
+then ok type-error; else fail type-error "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi
+
+# ---- :info and :doc ----
+q ':info Shift' ':i sqrt' ':i Rounded' ':i UnitCube' 'f x = x * 2' ':i f' ':i lenght'
+expect info-kinds out '^Shift  -- prelude function, 2 arguments, defined at <prelude>:[0-9]+$' \
+  '^  Shift v obj: ' '^  e\.g\. Shift ' \
+  '^sqrt  -- built-in, 1 argument$' '^  sqrt x: square root$' '^  e\.g\. sqrt 16$' \
+  '^Rounded  -- constructor of SceneObject, 2 arguments, defined at <prelude>:' \
+  '^UnitCube  -- prelude value, defined at' \
+  '^f  -- your definition, 1 argument, defined at the prompt$' &&
+expect info-unknown err "'lenght' is not defined \(did you mean 'length'\?\)"
+printf '// doc: twice x: x added to itself\n// e.g. twice 4\ntwice :: Real -> Real;\ntwice x = x + x;\n' >"$tmp/lib.qcs"
+q ':load lib.qcs' ':doc twice' ':doc map'
+expect doc-user-file out '^twice :: Real -> Real$' '^twice x: x added to itself$' '^e\.g\. twice 4$' \
+  '^map f xs: f applied to every element$'
+
+# Every built-in and prelude function has a doc and an example, and the
+# examples run without an error (renders write into $tmp).
+q ':browse!'
+names=$(grep -v -- '-- constructor' "$tmp/out" | awk '{print $1}')
+n=$(printf '%s\n' $names | wc -l)
+set --
+for nm in $names; do set -- "$@" ":doc $nm"; done
+q "$@"
+undoc=$(grep 'has no doc' "$tmp/out")
+neg=$(grep -c '^e\.g\. ' "$tmp/out")
+if [ -z "$undoc" ] && [ "$neg" -eq "$n" ] && [ "$n" -gt 100 ]; then ok doc-every-name
+else fail doc-every-name "$n names, $neg examples: $undoc"; fi
+grep '^e\.g\. ' "$tmp/out" | sed 's/^e\.g\. //' >"$tmp/examples"
+(cd "$tmp" && HOME=$tmp $lim "$QCS" <examples >out 2>err); rc=$?
+if [ "$rc" = 0 ] && ! grep -q 'error' "$tmp/err"; then ok doc-examples-run
+else fail doc-examples-run "status $rc: $(grep -A2 error "$tmp/err" | head -5)"; fi
+
+# ---- shadowing ----
+q 'map f xs = 42' 'map f xs = 43' 'map 1 2' ':browse'
+nwarn=$(grep -c 'warning: map shadows the prelude' "$tmp/err")
+if [ "$rc" = 0 ] && [ "$nwarn" = 1 ] && grep -q '^43$' "$tmp/out" &&
+   grep -q "^map  -- yours, shadows the prelude's map" "$tmp/out"
+then ok shadow-warn-once; else fail shadow-warn-once "status $rc, $nwarn warnings: $(cat "$tmp/out" "$tmp/err")"; fi
+q 'sqrt x = x' 'sqrt 9' 'length [1, 2]'
+if [ "$rc" = 0 ] && grep -q 'warning: sqrt shadows the built-in sqrt' "$tmp/err" &&
+   [ "$(cat "$tmp/out")" = "$(printf '9\n2')" ]
+then ok shadow-builtin; else fail shadow-builtin "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi
