@@ -90,3 +90,13 @@ q 'sqrt x = x' 'sqrt 9' 'length [1, 2]'
 if [ "$rc" = 0 ] && grep -q 'warning: sqrt shadows the built-in sqrt' "$tmp/err" &&
    [ "$(cat "$tmp/out")" = "$(printf '9\n2')" ]
 then ok shadow-builtin; else fail shadow-builtin "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi
+
+# ---- continuation lines (piped: the definition is joined before it runs) ----
+q 'f x = y' '  where' '    y = x + 1' 'f 1' \
+  'g x' '  | x < 0 = 0' '  | otherwise = x' 'g 5' 'g (-1)' \
+  'h x = x' '  + 1' 'h 1' 'k x = x * w where' '  w = 3' 'k 2'
+if [ "$rc" = 0 ] && [ ! -s "$tmp/err" ] && [ "$(cat "$tmp/out")" = "$(printf '2\n5\n0\n2\n6')" ]
+then ok continuation-pipe; else fail continuation-pipe "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi
+q 'let y = 1 in y' '  + 1'
+if [ "$rc" = 1 ] && [ "$(cat "$tmp/out")" = 1 ]; then ok continuation-not-expression
+else fail continuation-not-expression "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi

@@ -166,6 +166,8 @@ typedef struct {
   Interp *I;
   int interactive;   /* stdin is a terminal */
   Buf pending;       /* the unfinished entry, lines joined by '\n' */
+  Buf last;          /* the last entry run, if it was a definition: an
+                        indented line after it continues it (layout) */
   int in_block;      /* between ":{" and ":}" */
   long block_line;   /* input line of the ":{", for messages */
   long line_no;      /* input lines read so far */
@@ -738,12 +740,78 @@ static void reset_entry(Repl *R) {
   R->in_block = 0;
 }
 
+/* Does text start with a definition, "name args = ..." or "name args |"
+   (a '=' or '|' outside brackets and strings, not part of an operator)? */
+static int looks_like_definition(const char *text) {
+  const char *p = skip_blanks(text);
+  if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || *p == '_'))
+    return 0;
+  static const char *const keywords[] = {"let", "if", "case", NULL};
+  for (int k = 0; keywords[k]; k++) {
+    size_t n = strlen(keywords[k]);
+    if (!strncmp(p, keywords[k], n) &&
+        !strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                "0123456789_'", p[n] ? p[n] : 'a'))
+      return 0;
+  }
+  int depth = 0, in_str = 0;
+  for (; *p; p++) {
+    if (in_str) {
+      if (*p == '\\' && p[1]) p++;
+      else if (*p == '"') in_str = 0;
+      continue;
+    }
+    if (*p == '"') in_str = 1;
+    else if (*p == '(' || *p == '[') depth++;
+    else if ((*p == ')' || *p == ']') && depth > 0) depth--;
+    else if (*p == '/' && p[1] == '/') { /* a comment, to the end of its line */
+      while (p[1] && p[1] != '\n') p++;
+    }
+    else if (depth == 0 && (*p == '=' || *p == '|')) {
+      char a = p[1], b = p[-1];
+      if (*p == '=' && (a == '=' || b == '=' || b == '<' || b == '>' ||
+                        b == '/' || b == '!'))
+        continue;
+      if (*p == '|' && (a == '|' || b == '|')) continue;
+      return 1;
+    }
+  }
+  return 0;
+}
+
+/* "g x (a, b)": one line of names, numbers and brackets, which an
+   error (unknown name g) may have met because guards follow. */
+static int looks_like_head(const char *text) {
+  const char *p = skip_blanks(text);
+  if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || *p == '_'))
+    return 0;
+  for (; *p; p++)
+    if (!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                "0123456789_' \t()[],:.", *p))
+      return 0;
+  return 1;
+}
+
+/* A line that continues the definition before it, as the layout rule
+   has it: indented, or starting with '|', '=' or "where". */
+static int continues_definition(const char *line) {
+  const char *p = skip_blanks(line);
+  if (!*p || (p[0] == '/' && p[1] == '/')) return 0;
+  return p != line || *p == '|' || *p == '=' ||
+         (!strncmp(p, "where", 5) &&
+          (p[5] == 0 || p[5] == ' ' || p[5] == '\t'));
+}
+
 /* Give the pending text to the interpreter; keep it if it is unfinished. */
 static void submit(Repl *R, RunMode mode) {
   RunStatus st;
   RUN_GUARDED(st, interp_run_string(R->I, SOURCE_NAME, R->pending.s, mode));
   if (st == RUN_INCOMPLETE) return;
   note_status(R, st);
+  buf_clear(&R->last);
+  if (mode == MODE_REPL && (looks_like_definition(R->pending.s) ||
+                            (st == RUN_ERROR && looks_like_head(R->pending.s))))
+    buf_add(&R->last, R->pending.s, R->pending.len);
   reset_entry(R);
 }
 
@@ -774,8 +842,18 @@ static void feed_line(Repl *R, const char *line) {
       return;
     }
     if (*skip_blanks(line) == ':') {
+      buf_clear(&R->last);
       run_command(R, line);
       return;
+    }
+    /* "f x = y" then "  where y = ...": the definition is run again with
+       the new line (a definition replaces the one before it) */
+    if ((R->last.len > 0 || *skip_blanks(line) == '|') &&
+        continues_definition(line)) {
+      if (R->last.len > 0) {
+        buf_add(&R->pending, R->last.s, R->last.len);
+        buf_add(&R->pending, "\n", 1);
+      }
     }
   } else {
     buf_add(&R->pending, "\n", 1);
@@ -842,15 +920,47 @@ static void feed_eof(Repl *R) {
 
 /* ---- plain loop: stdin is not a terminal ---- */
 
+/* Reads one line without its end; 0 at end of input. */
+static int plain_line(char **line, size_t *cap) {
+  ssize_t n = getline(line, cap, stdin);
+  if (n < 0) return 0;
+  while (n > 0 && ((*line)[n - 1] == '\n' || (*line)[n - 1] == '\r'))
+    (*line)[--n] = 0;
+  return 1;
+}
+
+/* Piped input can look ahead: lines that continue a definition (the
+   layout rule: indented, or starting with '|', '=' or where) join it
+   before it runs, so "f x = y" is not run without its "  where y = ...". */
 static int run_plain(Repl *R) {
-  char *line = NULL;
-  size_t cap = 0;
-  ssize_t n;
-  while (!R->quit && (n = getline(&line, &cap, stdin)) >= 0) {
-    while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r')) line[--n] = 0;
-    feed_line(R, line);
+  char *line = NULL, *next = NULL;
+  size_t cap = 0, ncap = 0;
+  int have = plain_line(&line, &cap);
+  Buf entry = {0};
+  while (!R->quit && have) {
+    buf_clear(&entry);
+    buf_add(&entry, line, strlen(line));
+    int joined = 0;
+    int have_next;
+    while ((have_next = plain_line(&next, &ncap)) != 0 &&
+           R->pending.len == 0 && !R->in_block &&
+           *skip_blanks(line) != ':' && continues_definition(next) &&
+           (looks_like_definition(entry.s) || looks_like_head(entry.s))) {
+      buf_add(&entry, "\n", 1);
+      buf_add(&entry, next, strlen(next));
+      joined++;
+    }
+    R->line_no += joined;
+    feed_line(R, entry.s);
+    char *t = line;
+    size_t tc = cap;
+    line = next, cap = ncap;
+    next = t, ncap = tc;
+    have = have_next;
   }
+  free(entry.s);
   free(line);
+  free(next);
   if (!R->quit) feed_eof(R);
   fflush(stdout);
   return R->had_error ? 1 : 0;
@@ -1127,5 +1237,6 @@ int repl_run(Interp *I) {
   for (size_t i = 0; i < R.nfiles; i++) free(R.files[i]);
   free(R.files);
   free(R.pending.s);
+  free(R.last.s);
   return status;
 }
