@@ -100,3 +100,26 @@ then ok continuation-pipe; else fail continuation-pipe "status $rc: $(cat "$tmp/
 q 'let y = 1 in y' '  + 1'
 if [ "$rc" = 1 ] && [ "$(cat "$tmp/out")" = 1 ]; then ok continuation-not-expression
 else fail continuation-not-expression "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi
+
+# ---- :reload leaves renders out; :reload! and reload-renders run them ----
+printf 'h x = x + 1\nrender "r.png" (Rounded 0.1 UnitCube)\nh 1\n' >"$tmp/r.qcs"
+rm -f "$tmp/r.png"
+printf ':load r.qcs\n' >"$tmp/in1"
+(cd "$tmp" && HOME=$tmp $lim "$QCS" <in1 >/dev/null 2>&1)
+if [ -f "$tmp/r.png" ]; then ok reload-load-renders; else fail reload-load-renders ":load did not write r.png"; fi
+rm -f "$tmp/r.png"
+# the render reports: one for :load, none for :reload
+q ':load r.qcs' ':reload' 'h 5'
+nrep=$(grep -c '^r\.png: 600x380' "$tmp/err")
+if [ "$rc" = 0 ] && [ "$nrep" = 1 ] && grep -q '^(1 render in r.qcs not run again; :reload! runs them)$' "$tmp/out" &&
+   [ "$(grep -c '^2$' "$tmp/out")" = 2 ] && grep -q '^6$' "$tmp/out"
+then ok reload-no-render; else fail reload-no-render "status $rc, $nrep renders: $(cat "$tmp/out" "$tmp/err")"; fi
+q ':load r.qcs' ':reload!' ':set reload-renders on' ':reload'
+nrep=$(grep -c '^r\.png: 600x380' "$tmp/err")
+if [ "$rc" = 0 ] && [ "$nrep" = 3 ]; then ok reload-bang-renders
+else fail reload-bang-renders "status $rc, $nrep renders, want 3: $(cat "$tmp/err")"; fi
+printf 'map f xs = 0\nmine = 7\n' >"$tmp/m.qcs"
+q ':load m.qcs' 'map (\x -> x) [1]' ':unload m.qcs' 'map (\x -> x) [1]' 'mine'
+if [ "$rc" = 1 ] && [ "$(cat "$tmp/out")" = "$(printf '0\nunloaded m.qcs: 2 definitions removed\n[1]')" ] &&
+   grep -q "unknown name 'mine'" "$tmp/err"
+then ok unload; else fail unload "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi

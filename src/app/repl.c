@@ -181,6 +181,7 @@ typedef struct {
   int preview_cols, preview_rows; /* 0: from the terminal */
   int show_forced;       /* the entry is a :show: show it, or say why not */
   const char *show_settings; /* :show ... with SETTINGS: their text */
+  int reload_renders;    /* :set reload-renders on: :reload renders too */
 } Repl;
 
 static Interp *completion_interp; /* readline's callbacks take no user data */
@@ -236,6 +237,7 @@ typedef struct {
 static void cmd_help(Repl *R, const char *arg, int bang);
 static void cmd_load(Repl *R, const char *arg, int bang);
 static void cmd_reload(Repl *R, const char *arg, int bang);
+static void cmd_unload(Repl *R, const char *arg, int bang);
 static void cmd_browse(Repl *R, const char *arg, int bang);
 static void cmd_quit(Repl *R, const char *arg, int bang);
 static void cmd_tradeoff(Repl *R, const char *arg, int bang);
@@ -257,7 +259,8 @@ static const Command commands[] = {
   {"load", ARG_FILE, 0, cmd_load, ":load FILE",
    "run a qcs file and remember it for :reload"},
   {"quit", ARG_NONE, 0, cmd_quit, ":quit", "leave qcs (so does Ctrl-D)"},
-  {"reload", ARG_NONE, 0, cmd_reload, ":reload", "run the loaded files again"},
+  {"reload", ARG_NONE, 1, cmd_reload, ":reload[!]",
+   "run the loaded files again, but not their renders (! renders too)"},
   {"set", ARG_ANY, 0, cmd_set, ":set [NAME VALUE]",
    "list the settings and limits, or change one (:set max-steps 1000000)"},
   {"show", ARG_ANY, 0, cmd_show, ":show EXPR [with S]",
@@ -266,6 +269,8 @@ static const Command commands[] = {
    "error against run time over root tolerances (writes tradeoff.svg)"},
   {"type", ARG_ANY, 0, cmd_type, ":type EXPR",
    "what kind of value EXPR is (also :t); a scene object is summarised"},
+  {"unload", ARG_FILE, 0, cmd_unload, ":unload FILE",
+   "forget a loaded file and the definitions it made"},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 
@@ -313,6 +318,8 @@ static void cmd_set(Repl *R, const char *arg, int bang) {
     else
       printf("preview-size  %-12s the picture's size in character cells\n",
              "auto");
+    printf("reload-renders %-11s whether :reload runs the files' renders "
+           "again (on, off)\n", R->reload_renders ? "on" : "off");
     interp_list_limits(R->I, stdout);
     fflush(stdout);
     return;
@@ -325,6 +332,16 @@ static void cmd_set(Repl *R, const char *arg, int bang) {
   memcpy(name, arg, n);
   name[n] = 0;
   char err[300];
+  if (!strcmp(name, "reload-renders")) {
+    if (!strcmp(val, "on") || !strcmp(val, "off")) {
+      R->reload_renders = !strcmp(val, "on");
+    } else {
+      fprintf(stderr, "error: :set reload-renders needs on or off, not "
+              "'%s'\n", val);
+      R->had_error = 1;
+    }
+    return;
+  }
   if (!strcmp(name, "preview") || !strcmp(name, "preview-size")) {
     if (set_preview(R, name, val)) R->had_error = 1;
     return;
@@ -574,18 +591,55 @@ static void cmd_tradeoff(Repl *R, const char *arg, int bang) {
   if (st) R->had_error = 1;
 }
 
+/* :reload runs the files' definitions and expressions again, but not
+   their renders (a file that renders at its end would redraw it on every
+   edit): those are counted and said. :reload! (or :set reload-renders
+   on) runs them too. */
 static void cmd_reload(Repl *R, const char *arg, int bang) {
   if (R->nfiles == 0) {
     fputs("error: no files to reload; use :load FILE first\n", stderr);
     R->had_error = 1;
     return;
   }
+  RenderOverrides *old = render_get_overrides(R->I);
+  RenderOverrides skip = old ? *old : (RenderOverrides){0};
+  skip.skip = !bang && !R->reload_renders;
   for (size_t i = 0; i < R->nfiles; i++) { /* all, as :load ran them */
     RunStatus st;
+    skip.skipped = 0;
+    render_set_overrides(R->I, &skip);
     RUN_GUARDED(st, interp_run_file(R->I, R->files[i]));
+    render_set_overrides(R->I, old);
+    if (old) old->renders = skip.renders;
     note_status(R, st);
     if (st == RUN_OK && R->interactive) printf("reloaded %s\n", R->files[i]);
+    if (skip.skipped)
+      printf("(%d render%s in %s not run again; :reload! runs them)\n",
+             skip.skipped, skip.skipped == 1 ? "" : "s", R->files[i]);
+    fflush(stdout);
   }
+}
+
+/* :unload FILE: forget a loaded file and the definitions it made. */
+static void cmd_unload(Repl *R, const char *arg, int bang) {
+  size_t i = 0;
+  while (i < R->nfiles && strcmp(R->files[i], arg)) i++;
+  if (i == R->nfiles) {
+    fprintf(stderr, "error: %s is not loaded (:unload takes a file as "
+            ":load was given it:", arg);
+    for (size_t k = 0; k < R->nfiles; k++) fprintf(stderr, " %s", R->files[k]);
+    fputs(R->nfiles ? ")\n" : " none is loaded)\n", stderr);
+    R->had_error = 1;
+    return;
+  }
+  int n = interp_unload(R->I, R->files[i]);
+  printf("unloaded %s: %d definition%s removed\n", R->files[i], n,
+         n == 1 ? "" : "s");
+  fflush(stdout);
+  free(R->files[i]);
+  memmove(R->files + i, R->files + i + 1,
+          (R->nfiles - i - 1) * sizeof *R->files);
+  R->nfiles--;
 }
 
 static void cmd_browse(Repl *R, const char *arg, int bang) {

@@ -189,6 +189,10 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
   int quiet = 0, float_pixels = 0;
   if (settings) read_settings(I, settings, pos, &rs, &quiet, &float_pixels);
   RenderOverrides *ov = overrides_of(I);
+  if (ov && ov->skip) {
+    ov->skipped++;
+    return val_str(path);
+  }
   if (ov) {
     if (ov->output) path = ov->output;
     if (ov->width) rs.width = ov->width, rs.height = ov->height;

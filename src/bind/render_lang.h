@@ -30,6 +30,10 @@ typedef struct RenderOverrides {
   RenderCapture capture;  /* non-NULL: renders call this instead (qcs
                              tradeoff); nothing is written */
   void *capture_ctx;
+  int skip;             /* renders do nothing but count themselves in
+                           skipped and give their file name (the REPL's
+                           :reload) */
+  int skipped;
 } RenderOverrides;
 
 void render_install(Interp *I);

@@ -456,6 +456,27 @@ void interp_browse(Interp *I, FILE *out, int all) {
   }
 }
 
+int interp_unload(Interp *I, const char *file) {
+  int n = 0;
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next) {
+      if (!s->user || s->overridden || s->con_arity >= 0 || !s->def_file ||
+          strcmp(s->def_file, file))
+        continue;
+      s->global = s->prelude_value;
+      s->def = s->prelude_def;
+      s->sig = s->prelude_sig;
+      s->doc = s->prelude_doc;
+      s->example = s->prelude_example;
+      s->def_pos = s->prelude_pos;
+      s->def_file = NULL;
+      s->user = 0;
+      n++;
+    }
+  if (n) refresh_values(I);
+  return n;
+}
+
 /* ---- :info, :doc, :type ---- */
 
 /* The symbol of a global or constructor called name, or NULL. */
@@ -687,7 +708,14 @@ Interp *interp_new(void (*install)(Interp *I)) {
     exit(2);
   }
   for (size_t h = 0; h < I->symcap; h++)
-    for (Sym *s = I->symtab[h]; s; s = s->next) s->prelude_value = s->global;
+    for (Sym *s = I->symtab[h]; s; s = s->next) {
+      s->prelude_value = s->global;
+      s->prelude_def = s->def;
+      s->prelude_sig = s->sig;
+      s->prelude_doc = s->doc;
+      s->prelude_example = s->example;
+      s->prelude_pos = s->def_pos;
+    }
   return I;
 }
 

@@ -173,6 +173,12 @@ const char *interp_version(void);
    example only. An unknown name: a message on stderr and -1. */
 int interp_info(Interp *I, FILE *out, const char *name);
 int interp_doc(Interp *I, FILE *out, const char *name);
+/* Forget the definitions that the run of file (a path as given to
+   interp_run_file) made: a name that shadowed a built-in or the prelude's
+   gets the original back; the others are undefined (code still using
+   them says "unknown name" when it runs). Type declarations' constructors
+   stay. Returns how many names were removed. */
+int interp_unload(Interp *I, const char *file);
 /* The signature written for name (name :: type), or NULL. */
 const char *interp_signature(Interp *I, const char *name);
 /* What can be known of a value's type, forcing it to weak-head normal

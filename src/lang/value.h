@@ -53,6 +53,10 @@ struct Sym {
   int builtin;         /* a built-in (written in C) */
   int shadow_warned;   /* a user definition that shadows a built-in or a
                           prelude name has been warned about */
+  /* As the prelude left them, for :unload of a file that shadowed it. */
+  Def *prelude_def;
+  const char *prelude_sig, *prelude_doc, *prelude_example;
+  Pos prelude_pos;
 };
 
 typedef enum {
