@@ -123,3 +123,21 @@ q ':load m.qcs' 'map (\x -> x) [1]' ':unload m.qcs' 'map (\x -> x) [1]' 'mine'
 if [ "$rc" = 1 ] && [ "$(cat "$tmp/out")" = "$(printf '0\nunloaded m.qcs: 2 definitions removed\n[1]')" ] &&
    grep -q "unknown name 'mine'" "$tmp/err"
 then ok unload; else fail unload "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi
+
+# ---- errors raised in the prelude are reported at the user's call ----
+printf 'obj = Shift (1, 2) UnitCube\nDensity 0.1 (0, 0, 0) obj\n' >"$tmp/e1.qcs"
+(cd "$tmp" && $lim "$QCS" e1.qcs >out 2>err); rc=$?
+if [ "$rc" = 1 ] && [ "$(head -1 "$tmp/err")" = "e1.qcs:1:7: error: the second argument of dot must be a 3-tuple of Reals, not a tuple: (1, 2)" ] &&
+   grep -q '^  (raised inside the prelude, at <prelude>:[0-9]*:[0-9]*)$' "$tmp/err" &&
+   grep -q '^  in Density, called at e1.qcs:2:1$' "$tmp/err"
+then ok error-at-user-shift; else fail error-at-user-shift "status $rc: $(cat "$tmp/err")"; fi
+printf 'b = Rounded 0.1 (Box (1, 1, 1) (0, 0, 0))\nrender "b.png" b\n' >"$tmp/e2.qcs"
+(cd "$tmp" && $lim "$QCS" e2.qcs >out 2>err); rc=$?
+if [ "$rc" = 1 ] && [ "$(head -1 "$tmp/err")" = "e2.qcs:1:18: error: Scale needs finite factors > 0, not (-1, -1, -1)" ] &&
+   grep -q '^  in the prelude: error, ScalePlane, ShiftPlane, renderWith (4 calls)$' "$tmp/err" &&
+   grep -q '^  in render, called at e2.qcs:2:1$' "$tmp/err"
+then ok error-at-user-box; else fail error-at-user-box "status $rc: $(cat "$tmp/err")"; fi
+q 'c = Shift (1, 2) UnitCube' 'Density 0.1 (0, 0, 0) c'
+if [ "$rc" = 1 ] && grep -q '^<stdin>:1:5: error: the second argument of dot' "$tmp/err" &&
+   grep -q '^  c = Shift (1, 2) UnitCube$' "$tmp/err"
+then ok error-at-user-prompt; else fail error-at-user-prompt "status $rc: $(cat "$tmp/err")"; fi

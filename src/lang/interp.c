@@ -29,19 +29,59 @@ static int run_counter;
 
 /* ---- error display ---- */
 
+static int in_prelude(Interp *I, Pos p) {
+  return p.src && I->prelude_src && p.src == I->prelude_src;
+}
+
+/* A call made by the prelude's code to a prelude function or a built-in
+   (not to a function of the user's, such as a lambda given to map). */
+static int prelude_frame(Interp *I, const TraceEntry *t) {
+  if (!in_prelude(I, t->pos) || t->name[0] == '%') return 0;
+  Sym *s = sym_intern(I, t->name, (int)strlen(t->name));
+  return !s->user && (s->def || s->builtin);
+}
+
 static void report_error(Interp *I) {
   ErrInfo *e = err_info();
   /* Found where no position was at hand (a lazy list's tail, printing):
      the top-level expression being run. */
   if (!e->pos.line && I->item_pos.line) e->pos = I->item_pos;
   I->item_pos = pos_none;
-  err_report(stderr, "error", e->pos, e->msg);
+  /* Raised in the prelude: reported at the user's call that led there
+     (Interp.origin), the prelude's line after it. */
+  int from_prelude = in_prelude(I, e->pos);
+  if (from_prelude && I->origin && I->origin->src && I->origin->line &&
+      !in_prelude(I, *I->origin)) {
+    err_report(stderr, "error", *I->origin, e->msg);
+    fprintf(stderr, "  (raised inside the prelude, at <prelude>:%d:%d)\n",
+            e->pos.line, e->pos.col);
+  } else {
+    err_report(stderr, "error", e->pos, e->msg);
+  }
+  I->origin = NULL;
   int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
   int lines = 0, i = n - 1;
   /* Innermost first; a run of identical entries (deep recursion) is
-     shown once with its count. */
+     shown once with its count; a run of calls made by the prelude's own
+     code is one line naming them. */
   while (i >= 0 && lines < 8) {
     TraceEntry *t = &I->trace[i];
+    if (prelude_frame(I, t) && i > 0 && prelude_frame(I, &I->trace[i - 1])) {
+      fputs("  in the prelude:", stderr);
+      int shown = 0, calls = 0;
+      const char *prev = NULL;
+      for (; i >= 0 && prelude_frame(I, &I->trace[i]); i--, calls++) {
+        const char *nm = I->trace[i].name;
+        if (prev && !strcmp(prev, nm)) continue;
+        if (shown < 5) fprintf(stderr, "%s %s", shown ? "," : "", nm);
+        else if (shown == 5) fputs(", ...", stderr);
+        shown++;
+        prev = nm;
+      }
+      fprintf(stderr, " (%d call%s)\n", calls, calls == 1 ? "" : "s");
+      lines++;
+      continue;
+    }
     int same = 1;
     while (i - same >= 0 && I->trace[i - same].name == t->name &&
            I->trace[i - same].pos.line == t->pos.line &&
@@ -67,6 +107,7 @@ static void report_error(Interp *I) {
 static void unwind(Interp *I, int nforcing) {
   eval_restore(I, nforcing);
   I->ntrace = 0;
+  I->origin = NULL;
   qcs_interrupted = 0;
 }
 

@@ -91,7 +91,7 @@ struct Value {
       Env *env;
     } fn;
     struct { Value *fn; int n; Value **args; } pap; /* V_PAP, V_APTHUNK */
-    struct { Expr *e; Env *env; } thunk;
+    struct { Expr *e; Env *env; const Pos *origin; } thunk; /* origin: see Interp.origin */
     struct { Pat *pat; Sym *var; Value *whole; } patsel;
     struct { void *ptr; const char *tag; } foreign;
   } u;
@@ -141,6 +141,11 @@ struct Interp {
   unsigned long long max_list; /* max-list: elements of one list */
   unsigned long long max_pixels; /* max-pixels: of one rendered image */
   int max_spp;               /* max-spp: samples per pixel of a render */
+  const Pos *origin;         /* the call from the user's code that led
+                                into the prelude code now running (a
+                                thunk made by the prelude keeps the one in
+                                force when it was made): errors raised in
+                                the prelude are reported there */
   Pos item_pos;              /* the top-level item being run, for errors
                                 found where no position is at hand */
   TraceEntry trace[TRACE_MAX];
