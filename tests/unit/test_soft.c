@@ -454,9 +454,10 @@ static void test_surface_bounds(void)
   for (int trial = 0; trial < 20; trial++) {
     tkey tk[40];
     double off[3] = {0, 0, 0};
-    make_cloud(tk, 40, off, trial % 2 ? 0.5 : 1.5, 1);
+    int nk = trial % 2 ? 40 : 10; /* dense or sparse */
+    make_cloud(tk, nk, off, trial % 3 != 0, 1);
     double magic = magics[trial % 5];
-    o = build(tk, 40, magic);
+    o = build(tk, nk, magic);
     if (!o) { out++; continue; }
     double blo[3], bhi[3];
     if (soft_bounds(o, blo, bhi)) {
