@@ -141,3 +141,46 @@ q 'c = Shift (1, 2) UnitCube' 'Density 0.1 (0, 0, 0) c'
 if [ "$rc" = 1 ] && grep -q '^<stdin>:1:5: error: the second argument of dot' "$tmp/err" &&
    grep -q '^  c = Shift (1, 2) UnitCube$' "$tmp/err"
 then ok error-at-user-prompt; else fail error-at-user-prompt "status $rc: $(cat "$tmp/err")"; fi
+
+# ---- the terminal, through tmux: the ...> prompt of a continued definition ----
+TMUX_CHECKS="prompt-tmux-where prompt-tmux-guards prompt-tmux-type"
+if ! command -v tmux >/dev/null 2>&1; then
+  for c in $TMUX_CHECKS; do echo "skip $c: tmux is not installed"; done
+  exit 0
+fi
+unset TMUX
+sock=qcs-prompt-$$
+T() { tmux -L "$sock" -f /dev/null "$@"; }
+trap 'T kill-server >/dev/null 2>&1; rm -rf "$tmp"' EXIT
+mkdir -p "$tmp/home"
+T new-session -d -s qcs -x 100 -y 40 \
+  "env HOME='$tmp/home' INPUTRC=/dev/null TERM=xterm '$QCS'; sleep 60" ||
+  { for c in $TMUX_CHECKS; do echo "skip $c: tmux could not start"; done; exit 0; }
+pane() { T capture-pane -p -J -t qcs -S - 2>/dev/null; }
+count() { pane | grep -cE -- "$1"; }
+wait_count() {
+  i=0
+  while [ "$(count "$1")" -lt "$2" ]; do
+    i=$((i + 1)); [ $i -gt 100 ] && return 1; sleep 0.05
+  done
+}
+enter() {
+  n=$(count "$1")
+  T send-keys -t qcs -l "$2"; T send-keys -t qcs Enter
+  wait_count "$1" $((n + 1))
+}
+why() { echo "$1; screen ends: $(pane | grep -v '^$' | tail -n 4 | tr '\n' '|')"; }
+if ! wait_count '^qcs> ' 1; then
+  for c in $TMUX_CHECKS; do echo "skip $c: the REPL showed no prompt"; done
+  exit 0
+fi
+# f x = y runs (y is unknown); "  where" continues it at ...>; the
+# definition is then run whole
+if enter "unknown name 'y'" 'f x = y' && enter '^\.\.\.> ' '  where' &&
+   enter '^qcs> ' '    y = x + 1' && enter '^2$' 'f 1'
+then ok prompt-tmux-where; else fail prompt-tmux-where "$(why 'f x = y / where / y = x + 1 / f 1')"; fi
+if enter '^qcs> ' 'g x' && enter '^qcs> ' '  | x < 0 = 0' && enter '^qcs> ' '  | otherwise = x' &&
+   enter '^5$' 'g 5' && enter '^0$' 'g (-3)'
+then ok prompt-tmux-guards; else fail prompt-tmux-guards "$(why 'g x / guards / g 5 / g (-3)')"; fi
+if enter '^a function of 1 argument \(f\)$' ':t f' && enter '^  e\.g\. Shift ' ':i Shift'
+then ok prompt-tmux-type; else fail prompt-tmux-type "$(why ':t f / :i Shift')"; fi

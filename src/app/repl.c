@@ -286,7 +286,9 @@ static void cmd_help(Repl *R, const char *arg, int bang) {
        "  42\n"
        "  qcs> Density 0.1 (0,0,0) UnitCube\n"
        "An unfinished entry (open bracket, trailing operator, \"g x =\")\n"
-       "continues at the ...> prompt. Ctrl-C stops a running evaluation or\n"
+       "continues at the ...> prompt; an indented line (or one starting\n"
+       "with | = or where) after a definition continues it, which then\n"
+       "runs again whole. Ctrl-C stops a running evaluation or\n"
        "abandons the line being typed; an error never loses earlier\n"
        "definitions. Tab completes names, commands and file names after\n"
        ":load. History is kept in ~/.qcs_history.\n"
@@ -1114,17 +1116,19 @@ static char *name_generator(const char *text, int state) {
   return l->next < l->n ? l->names[l->next++] : NULL;
 }
 
-/* If line is ":CMD ..." with CMD naming :load, where its argument starts. */
+/* If line is ":CMD ..." with CMD naming :load or :unload, where its
+   argument (a file name) starts. */
 static const char *load_argument(const char *line) {
   const char *s = skip_blanks(line);
   if (*s++ != ':') return NULL;
   const char *end = s;
   while (*end && *end != ' ' && *end != '\t') end++;
   size_t n = (size_t)(end - s);
-  if (n == 0 || *end == '\0' || n > strlen("load") ||
-      strncmp(s, "load", n) != 0)
-    return NULL;
-  return end;
+  if (n == 0 || *end == '\0') return NULL;
+  if ((n <= strlen("load") && strncmp(s, "load", n) == 0) ||
+      (n <= strlen("unload") && strncmp(s, "unload", n) == 0))
+    return end;
+  return NULL;
 }
 
 static char *word_breaks(void) {
