@@ -90,6 +90,10 @@ q 'sqrt x = x' 'sqrt 9' 'length [1, 2]'
 if [ "$rc" = 0 ] && grep -q 'warning: sqrt shadows the built-in sqrt' "$tmp/err" &&
    [ "$(cat "$tmp/out")" = "$(printf '9\n2')" ]
 then ok shadow-builtin; else fail shadow-builtin "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi
+printf 'floor = Halfspace ((0, 1, 0), 0)\n' >"$tmp/fl.qcs"
+(cd "$tmp" && $lim "$QCS" fl.qcs >out 2>err); rc=$?
+if [ "$rc" = 0 ] && [ ! -s "$tmp/err" ]; then ok shadow-script-quiet
+else fail shadow-script-quiet "status $rc: $(cat "$tmp/err")"; fi
 
 # ---- continuation lines (piped: the definition is joined before it runs) ----
 q 'f x = y' '  where' '    y = x + 1' 'f 1' \

@@ -1290,8 +1290,10 @@ int repl_run(Interp *I) {
   R.interactive = isatty(STDIN_FILENO);
   R.preview = PREVIEW_AUTO;
   interp_set_show(I, repl_show, &R);
+  interp_set_warn_shadow(I, 1);
   int status = R.interactive ? run_terminal(&R) : run_plain(&R);
   interp_set_show(I, NULL, NULL);
+  interp_set_warn_shadow(I, 0);
   for (size_t i = 0; i < R.nfiles; i++) free(R.files[i]);
   free(R.files);
   free(R.pending.s);

@@ -194,9 +194,13 @@ static void read_doc(Sym *s, Pos pos) {
 }
 
 /* A user definition of a name the built-ins or the prelude define: said
-   once per name, as a warning (the prelude's own code keeps its own). */
+   once per name, as a warning (the prelude's own code keeps its own);
+   only where asked (the REPL: the paper's scripts call their ground
+   plane floor, and say so in their comments). */
 static void warn_shadow(Interp *I, Sym *s, Pos pos) {
-  if (I->loading_prelude || !s->prelude_value || s->shadow_warned) return;
+  if (!I->warn_shadow || I->loading_prelude || !s->prelude_value ||
+      s->shadow_warned)
+    return;
   s->shadow_warned = 1;
   qcs_warning(pos, "%s shadows the %s %s: your definition is used from now "
               "on (the prelude's own functions keep the original)", s->name,
@@ -683,6 +687,8 @@ void interp_describe(Interp *I, Value *v, char *buf, size_t n) {
   }
   snprintf(buf, n, "%s", val_describe(v));
 }
+
+void interp_set_warn_shadow(Interp *I, int on) { I->warn_shadow = on; }
 
 int interp_has_global(Interp *I, const char *name) {
   Sym *s = sym_intern(I, name, (int)strlen(name));

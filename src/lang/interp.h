@@ -189,6 +189,10 @@ const char *interp_signature(Interp *I, const char *name);
 struct Value;
 void interp_describe(Interp *I, struct Value *v, char *buf, size_t n);
 
+/* Warn, once per name, when a definition shadows a built-in or prelude
+   name (the REPL turns it on; scripts run by qcs FILE stay quiet). */
+void interp_set_warn_shadow(Interp *I, int on);
+
 /* Is there a top-level value called name? */
 int interp_has_global(Interp *I, const char *name);
 

@@ -162,6 +162,8 @@ struct Interp {
   Pos warned[64];            /* warnings already given (said once each) */
   int nwarned;
   const char *run_name;      /* the file currently being run */
+  int warn_shadow;           /* warn of definitions that shadow a
+                                built-in or prelude name (the REPL) */
   const Src *prelude_src;    /* the prelude's source, for its own scope */
   int loading_prelude;
   Value *v_true, *v_false, *v_nil;
