@@ -182,6 +182,7 @@ typedef struct {
   int show_forced;       /* the entry is a :show: show it, or say why not */
   const char *show_settings; /* :show ... with SETTINGS: their text */
   int reload_renders;    /* :set reload-renders on: :reload renders too */
+  int joined;            /* the pending entry continues the last one */
 } Repl;
 
 static Interp *completion_interp; /* readline's callbacks take no user data */
@@ -794,6 +795,7 @@ static void run_command(Repl *R, const char *line) {
 static void reset_entry(Repl *R) {
   buf_clear(&R->pending);
   R->in_block = 0;
+  R->joined = 0;
 }
 
 /* Does text start with a definition, "name args = ..." or "name args |"
@@ -864,6 +866,11 @@ static void submit(Repl *R, RunMode mode) {
   RUN_GUARDED(st, interp_run_string(R->I, SOURCE_NAME, R->pending.s, mode));
   if (st == RUN_INCOMPLETE) return;
   note_status(R, st);
+  /* On a terminal the line before has run already: say that it was run
+     again with this one (an indent typed by mistake shows here). */
+  if (R->joined && st == RUN_OK && R->interactive)
+    printf("(joined to the definition above, which runs again)\n");
+  R->joined = 0;
   buf_clear(&R->last);
   if (mode == MODE_REPL && (looks_like_definition(R->pending.s) ||
                             (st == RUN_ERROR && looks_like_head(R->pending.s))))
@@ -909,6 +916,7 @@ static void feed_line(Repl *R, const char *line) {
       if (R->last.len > 0) {
         buf_add(&R->pending, R->last.s, R->last.len);
         buf_add(&R->pending, "\n", 1);
+        R->joined = 1;
       }
     }
   } else {
