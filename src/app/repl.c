@@ -167,6 +167,8 @@ typedef struct {
   Interp *I;
   int interactive;   /* stdin is a terminal */
   Buf pending;       /* the unfinished entry, lines joined by '\n' */
+  Buf last;          /* the last entry run, if it was a definition: an
+                        indented line after it continues it (layout) */
   int in_block;      /* between ":{" and ":}" */
   long block_line;   /* input line of the ":{", for messages */
   long line_no;      /* input lines read so far */
@@ -180,6 +182,8 @@ typedef struct {
   int preview_cols, preview_rows; /* 0: from the terminal */
   int show_forced;       /* the entry is a :show: show it, or say why not */
   const char *show_settings; /* :show ... with SETTINGS: their text */
+  int reload_renders;    /* :set reload-renders on: :reload renders too */
+  int joined;            /* the pending entry continues the last one */
 } Repl;
 
 static Interp *completion_interp; /* readline's callbacks take no user data */
@@ -222,7 +226,7 @@ static void note_status(Repl *R, RunStatus st) {
 
 /* ---- commands ---- */
 
-typedef enum { ARG_NONE, ARG_FILE, ARG_ANY } ArgKind;
+typedef enum { ARG_NONE, ARG_FILE, ARG_ANY, ARG_NAME } ArgKind;
 
 typedef struct {
   const char *name;
@@ -235,28 +239,41 @@ typedef struct {
 static void cmd_help(Repl *R, const char *arg, int bang);
 static void cmd_load(Repl *R, const char *arg, int bang);
 static void cmd_reload(Repl *R, const char *arg, int bang);
+static void cmd_unload(Repl *R, const char *arg, int bang);
 static void cmd_browse(Repl *R, const char *arg, int bang);
 static void cmd_quit(Repl *R, const char *arg, int bang);
 static void cmd_tradeoff(Repl *R, const char *arg, int bang);
 static void cmd_set(Repl *R, const char *arg, int bang);
 static void cmd_show(Repl *R, const char *arg, int bang);
 static void cmd_view(Repl *R, const char *arg, int bang);
+static void cmd_type(Repl *R, const char *arg, int bang);
+static void cmd_info(Repl *R, const char *arg, int bang);
+static void cmd_doc(Repl *R, const char *arg, int bang);
 
 /* Sorted by name; a command may be abbreviated to any unique prefix. */
 static const Command commands[] = {
   {"browse", ARG_NONE, 1, cmd_browse, ":browse[!]",
    "list your definitions (! adds the prelude and built-ins)"},
+  {"doc", ARG_NAME, 0, cmd_doc, ":doc NAME",
+   "what NAME does, in one line, and an example"},
   {"help", ARG_NONE, 0, cmd_help, ":help", "this text"},
+  {"info", ARG_NAME, 0, cmd_info, ":info NAME",
+   "kind, arity, where defined, signature, doc (also :i)"},
   {"load", ARG_FILE, 0, cmd_load, ":load FILE",
    "run a qcs file and remember it for :reload"},
   {"quit", ARG_NONE, 0, cmd_quit, ":quit", "leave qcs (so does Ctrl-D)"},
-  {"reload", ARG_NONE, 0, cmd_reload, ":reload", "run the loaded files again"},
+  {"reload", ARG_NONE, 1, cmd_reload, ":reload[!]",
+   "run the loaded files again, but not their renders (! renders too)"},
   {"set", ARG_ANY, 0, cmd_set, ":set [NAME VALUE]",
    "list the settings and limits, or change one (:set digits 6)"},
   {"show", ARG_ANY, 0, cmd_show, ":show EXPR [with S]",
    "draw a scene object as a picture (S: render settings, [Size 600 380])"},
   {"tradeoff", ARG_FILE, 0, cmd_tradeoff, ":tradeoff FILE",
    "error against run time over root tolerances (writes tradeoff.svg)"},
+  {"type", ARG_ANY, 0, cmd_type, ":type EXPR",
+   "what kind of value EXPR is (also :t); a scene object is summarised"},
+  {"unload", ARG_FILE, 0, cmd_unload, ":unload FILE",
+   "forget a loaded file and the definitions it made"},
   {"view", ARG_ANY, 0, cmd_view, ":view [EXPR]",
    "serve EXPR (default scene) in the browser until Enter (qcs view)"},
 };
@@ -274,7 +291,9 @@ static void cmd_help(Repl *R, const char *arg, int bang) {
        "  42\n"
        "  qcs> Density 0.1 (0,0,0) UnitCube\n"
        "An unfinished entry (open bracket, trailing operator, \"g x =\")\n"
-       "continues at the ...> prompt. Ctrl-C stops a running evaluation or\n"
+       "continues at the ...> prompt; an indented line (or one starting\n"
+       "with | = or where) after a definition continues it, which then\n"
+       "runs again whole. Ctrl-C stops a running evaluation or\n"
        "abandons the line being typed; an error never loses earlier\n"
        "definitions. Tab completes names, commands and file names after\n"
        ":load. History is kept in ~/.qcs_history.\n"
@@ -308,6 +327,8 @@ static void cmd_set(Repl *R, const char *arg, int bang) {
              "auto");
     printf("digits        %-12d significant digits of printed Reals "
            "(0: shortest that reads back)\n", R->I->digits);
+    printf("reload-renders %-11s whether :reload runs the files' renders "
+           "again (on, off)\n", R->reload_renders ? "on" : "off");
     interp_list_limits(R->I, stdout);
     fflush(stdout);
     return;
@@ -320,6 +341,16 @@ static void cmd_set(Repl *R, const char *arg, int bang) {
   memcpy(name, arg, n);
   name[n] = 0;
   char err[300];
+  if (!strcmp(name, "reload-renders")) {
+    if (!strcmp(val, "on") || !strcmp(val, "off")) {
+      R->reload_renders = !strcmp(val, "on");
+    } else {
+      fprintf(stderr, "error: :set reload-renders needs on or off, not "
+              "'%s'\n", val);
+      R->had_error = 1;
+    }
+    return;
+  }
   if (!strcmp(name, "preview") || !strcmp(name, "preview-size")) {
     if (set_preview(R, name, val)) R->had_error = 1;
     return;
@@ -587,18 +618,55 @@ static void cmd_tradeoff(Repl *R, const char *arg, int bang) {
   if (st) R->had_error = 1;
 }
 
+/* :reload runs the files' definitions and expressions again, but not
+   their renders (a file that renders at its end would redraw it on every
+   edit): those are counted and said. :reload! (or :set reload-renders
+   on) runs them too. */
 static void cmd_reload(Repl *R, const char *arg, int bang) {
   if (R->nfiles == 0) {
     fputs("error: no files to reload; use :load FILE first\n", stderr);
     R->had_error = 1;
     return;
   }
+  RenderOverrides *old = render_get_overrides(R->I);
+  RenderOverrides skip = old ? *old : (RenderOverrides){0};
+  skip.skip = !bang && !R->reload_renders;
   for (size_t i = 0; i < R->nfiles; i++) { /* all, as :load ran them */
     RunStatus st;
+    skip.skipped = 0;
+    render_set_overrides(R->I, &skip);
     RUN_GUARDED(st, interp_run_file(R->I, R->files[i]));
+    render_set_overrides(R->I, old);
+    if (old) old->renders = skip.renders;
     note_status(R, st);
     if (st == RUN_OK && R->interactive) printf("reloaded %s\n", R->files[i]);
+    if (skip.skipped)
+      printf("(%d render%s in %s not run again; :reload! runs them)\n",
+             skip.skipped, skip.skipped == 1 ? "" : "s", R->files[i]);
+    fflush(stdout);
   }
+}
+
+/* :unload FILE: forget a loaded file and the definitions it made. */
+static void cmd_unload(Repl *R, const char *arg, int bang) {
+  size_t i = 0;
+  while (i < R->nfiles && strcmp(R->files[i], arg)) i++;
+  if (i == R->nfiles) {
+    fprintf(stderr, "error: %s is not loaded (:unload takes a file as "
+            ":load was given it:", arg);
+    for (size_t k = 0; k < R->nfiles; k++) fprintf(stderr, " %s", R->files[k]);
+    fputs(R->nfiles ? ")\n" : " none is loaded)\n", stderr);
+    R->had_error = 1;
+    return;
+  }
+  int n = interp_unload(R->I, R->files[i]);
+  printf("unloaded %s: %d definition%s removed\n", R->files[i], n,
+         n == 1 ? "" : "s");
+  fflush(stdout);
+  free(R->files[i]);
+  memmove(R->files + i, R->files + i + 1,
+          (R->nfiles - i - 1) * sizeof *R->files);
+  R->nfiles--;
 }
 
 static void cmd_browse(Repl *R, const char *arg, int bang) {
@@ -607,6 +675,48 @@ static void cmd_browse(Repl *R, const char *arg, int bang) {
 }
 
 static void cmd_quit(Repl *R, const char *arg, int bang) { R->quit = 1; }
+
+static void cmd_info(Repl *R, const char *arg, int bang) {
+  if (interp_info(R->I, stdout, arg)) R->had_error = 1;
+  fflush(stdout);
+}
+
+static void cmd_doc(Repl *R, const char *arg, int bang) {
+  if (interp_doc(R->I, stdout, arg)) R->had_error = 1;
+  fflush(stdout);
+}
+
+/* :type EXPR runs as an item, so that an error in EXPR is reported as
+   one; the value is described, not printed. */
+static Value *type_item(Interp *I, void *ud) {
+  const char *text = ud;
+  Value *v = interp_eval_expr(I, SOURCE_NAME, text);
+  char desc[400];
+  interp_describe(I, v, desc, sizeof desc);
+  const char *t = skip_blanks(text);
+  const char *sig = interp_signature(I, t);
+  if (sig) printf("%s :: %s\n", t, sig);
+  printf("%s\n", desc);
+  if (compile_is_object(I, v)) { /* a scene object: what it compiles to */
+    Scene *s = compile_scene_any(I, v, pos_none);
+    char line[512];
+    report_scene(line, sizeof line, s, "a scene object");
+    scene_free(s);
+    printf("%s\n", line);
+  }
+  return NULL;
+}
+
+static void cmd_type(Repl *R, const char *arg, int bang) {
+  if (!*arg) {
+    fputs("error: :type needs an expression (usage: :type EXPR)\n", stderr);
+    R->had_error = 1;
+    return;
+  }
+  RunStatus st;
+  RUN_GUARDED(st, interp_run_item(R->I, pos_none, type_item, (void *)arg));
+  note_status(R, st);
+}
 
 static void unknown_command(Repl *R, const char *word) {
   const char *best = NULL;
@@ -664,6 +774,8 @@ static void run_command(Repl *R, const char *line) {
   int bang = n > 0 && word[n - 1] == '!';
   if (bang) word[n - 1] = '\0';
   if (strcmp(word, "?") == 0) strcpy(word, "help");
+  if (strcmp(word, "t") == 0) strcpy(word, "type"); /* as in GHCi */
+  if (strcmp(word, "i") == 0) strcpy(word, "info");
 
   /* the argument, without surrounding blanks */
   const char *arg = skip_blanks(end);
@@ -688,6 +800,10 @@ static void run_command(Repl *R, const char *line) {
     fprintf(stderr, "error: ':%s' takes no argument (usage: %s)\n", c->name,
             c->usage);
     R->had_error = 1;
+  } else if (c->arg == ARG_NAME && (alen == 0 || strpbrk(argcopy, " \t"))) {
+    fprintf(stderr, "error: ':%s' needs one name (usage: %s)\n", c->name,
+            c->usage);
+    R->had_error = 1;
   } else if (c->arg == ARG_FILE && alen == 0) {
     fprintf(stderr, "error: ':%s' needs a file name (usage: %s)\n", c->name,
             c->usage);
@@ -703,6 +819,69 @@ static void run_command(Repl *R, const char *line) {
 static void reset_entry(Repl *R) {
   buf_clear(&R->pending);
   R->in_block = 0;
+  R->joined = 0;
+}
+
+/* Does text start with a definition, "name args = ..." or "name args |"
+   (a '=' or '|' outside brackets and strings, not part of an operator)? */
+static int looks_like_definition(const char *text) {
+  const char *p = skip_blanks(text);
+  if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || *p == '_'))
+    return 0;
+  static const char *const keywords[] = {"let", "if", "case", NULL};
+  for (int k = 0; keywords[k]; k++) {
+    size_t n = strlen(keywords[k]);
+    if (!strncmp(p, keywords[k], n) &&
+        !strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                "0123456789_'", p[n] ? p[n] : 'a'))
+      return 0;
+  }
+  int depth = 0, in_str = 0;
+  for (; *p; p++) {
+    if (in_str) {
+      if (*p == '\\' && p[1]) p++;
+      else if (*p == '"') in_str = 0;
+      continue;
+    }
+    if (*p == '"') in_str = 1;
+    else if (*p == '(' || *p == '[') depth++;
+    else if ((*p == ')' || *p == ']') && depth > 0) depth--;
+    else if (*p == '/' && p[1] == '/') { /* a comment, to the end of its line */
+      while (p[1] && p[1] != '\n') p++;
+    }
+    else if (depth == 0 && (*p == '=' || *p == '|')) {
+      char a = p[1], b = p[-1];
+      if (*p == '=' && (a == '=' || b == '=' || b == '<' || b == '>' ||
+                        b == '/' || b == '!'))
+        continue;
+      if (*p == '|' && (a == '|' || b == '|')) continue;
+      return 1;
+    }
+  }
+  return 0;
+}
+
+/* "g x (a, b)": one line of names, numbers and brackets, which an
+   error (unknown name g) may have met because guards follow. */
+static int looks_like_head(const char *text) {
+  const char *p = skip_blanks(text);
+  if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || *p == '_'))
+    return 0;
+  for (; *p; p++)
+    if (!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                "0123456789_' \t()[],:.", *p))
+      return 0;
+  return 1;
+}
+
+/* A line that continues the definition before it, as the layout rule
+   has it: indented, or starting with '|', '=' or "where". */
+static int continues_definition(const char *line) {
+  const char *p = skip_blanks(line);
+  if (!*p || (p[0] == '/' && p[1] == '/')) return 0;
+  return p != line || *p == '|' || *p == '=' ||
+         (!strncmp(p, "where", 5) &&
+          (p[5] == 0 || p[5] == ' ' || p[5] == '\t'));
 }
 
 /* Give the pending text to the interpreter; keep it if it is unfinished. */
@@ -711,6 +890,15 @@ static void submit(Repl *R, RunMode mode) {
   RUN_GUARDED(st, interp_run_string(R->I, SOURCE_NAME, R->pending.s, mode));
   if (st == RUN_INCOMPLETE) return;
   note_status(R, st);
+  /* On a terminal the line before has run already: say that it was run
+     again with this one (an indent typed by mistake shows here). */
+  if (R->joined && st == RUN_OK && R->interactive)
+    printf("(joined to the definition above, which runs again)\n");
+  R->joined = 0;
+  buf_clear(&R->last);
+  if (mode == MODE_REPL && (looks_like_definition(R->pending.s) ||
+                            (st == RUN_ERROR && looks_like_head(R->pending.s))))
+    buf_add(&R->last, R->pending.s, R->pending.len);
   reset_entry(R);
 }
 
@@ -741,8 +929,19 @@ static void feed_line(Repl *R, const char *line) {
       return;
     }
     if (*skip_blanks(line) == ':') {
+      buf_clear(&R->last);
       run_command(R, line);
       return;
+    }
+    /* "f x = y" then "  where y = ...": the definition is run again with
+       the new line (a definition replaces the one before it) */
+    if ((R->last.len > 0 || *skip_blanks(line) == '|') &&
+        continues_definition(line)) {
+      if (R->last.len > 0) {
+        buf_add(&R->pending, R->last.s, R->last.len);
+        buf_add(&R->pending, "\n", 1);
+        R->joined = 1;
+      }
     }
   } else {
     buf_add(&R->pending, "\n", 1);
@@ -809,15 +1008,47 @@ static void feed_eof(Repl *R) {
 
 /* ---- plain loop: stdin is not a terminal ---- */
 
+/* Reads one line without its end; 0 at end of input. */
+static int plain_line(char **line, size_t *cap) {
+  ssize_t n = getline(line, cap, stdin);
+  if (n < 0) return 0;
+  while (n > 0 && ((*line)[n - 1] == '\n' || (*line)[n - 1] == '\r'))
+    (*line)[--n] = 0;
+  return 1;
+}
+
+/* Piped input can look ahead: lines that continue a definition (the
+   layout rule: indented, or starting with '|', '=' or where) join it
+   before it runs, so "f x = y" is not run without its "  where y = ...". */
 static int run_plain(Repl *R) {
-  char *line = NULL;
-  size_t cap = 0;
-  ssize_t n;
-  while (!R->quit && (n = getline(&line, &cap, stdin)) >= 0) {
-    while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r')) line[--n] = 0;
-    feed_line(R, line);
+  char *line = NULL, *next = NULL;
+  size_t cap = 0, ncap = 0;
+  int have = plain_line(&line, &cap);
+  Buf entry = {0};
+  while (!R->quit && have) {
+    buf_clear(&entry);
+    buf_add(&entry, line, strlen(line));
+    int joined = 0;
+    int have_next;
+    while ((have_next = plain_line(&next, &ncap)) != 0 &&
+           R->pending.len == 0 && !R->in_block &&
+           *skip_blanks(line) != ':' && continues_definition(next) &&
+           (looks_like_definition(entry.s) || looks_like_head(entry.s))) {
+      buf_add(&entry, "\n", 1);
+      buf_add(&entry, next, strlen(next));
+      joined++;
+    }
+    R->line_no += joined;
+    feed_line(R, entry.s);
+    char *t = line;
+    size_t tc = cap;
+    line = next, cap = ncap;
+    next = t, ncap = tc;
+    have = have_next;
   }
+  free(entry.s);
   free(line);
+  free(next);
   if (!R->quit) feed_eof(R);
   fflush(stdout);
   return R->had_error ? 1 : 0;
@@ -917,17 +1148,19 @@ static char *name_generator(const char *text, int state) {
   return l->next < l->n ? l->names[l->next++] : NULL;
 }
 
-/* If line is ":CMD ..." with CMD naming :load, where its argument starts. */
+/* If line is ":CMD ..." with CMD naming :load or :unload, where its
+   argument (a file name) starts. */
 static const char *load_argument(const char *line) {
   const char *s = skip_blanks(line);
   if (*s++ != ':') return NULL;
   const char *end = s;
   while (*end && *end != ' ' && *end != '\t') end++;
   size_t n = (size_t)(end - s);
-  if (n == 0 || *end == '\0' || n > strlen("load") ||
-      strncmp(s, "load", n) != 0)
-    return NULL;
-  return end;
+  if (n == 0 || *end == '\0') return NULL;
+  if ((n <= strlen("load") && strncmp(s, "load", n) == 0) ||
+      (n <= strlen("unload") && strncmp(s, "unload", n) == 0))
+    return end;
+  return NULL;
 }
 
 static char *word_breaks(void) {
@@ -1089,10 +1322,13 @@ int repl_run(Interp *I) {
   R.interactive = isatty(STDIN_FILENO);
   R.preview = PREVIEW_AUTO;
   interp_set_show(I, repl_show, &R);
+  interp_set_warn_shadow(I, 1);
   int status = R.interactive ? run_terminal(&R) : run_plain(&R);
   interp_set_show(I, NULL, NULL);
+  interp_set_warn_shadow(I, 0);
   for (size_t i = 0; i < R.nfiles; i++) free(R.files[i]);
   free(R.files);
   free(R.pending.s);
+  free(R.last.s);
   return status;
 }

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "bind/compile.h"
+#include "lang/builtins.h"
 #include "core/bounds.h"
 #include "core/csg.h"
 #include "core/lg.h"
@@ -917,14 +918,20 @@ static Value *pl_slice(Interp *I, Value **args, Pos pos) {
 #define PLOTS(X)                                                              \
   X("plotRay", 4, pl_ray,                                                     \
     "plotRay \"f.svg\" obj o d: density or field along the ray, the bounds, "  \
-    "the Figure 9 segments and their LG cones, the roots")                    \
+    "the Figure 9 segments and their LG cones, the roots; e.g. plotRay "      \
+    "\"ray.svg\" (Rounded 0.1 UnitCube) (-1, 0.95, 0.5) (1, 0, 0)")            \
   X("plotSlice", 4, pl_slice,                                                 \
     "plotSlice \"f.png\" r tree (c, u, v): density over c + a u + b v as "     \
-    "colour, isolines, edges, bounds (and f.svg with axes and legend)")       \
+    "colour, isolines, edges, bounds (and f.svg with axes and legend); e.g. " \
+    "plotSlice \"slice.png\" 0.1 UnitCube ((0.5, 0.5, 0.5), (0.8, 0, 0), "     \
+    "(0, 0.8, 0))")                                                           \
   X("plotDisplacement", 1, pl_displacement,                                   \
-    "plotDisplacement \"f.svg\": eq. (5), the isosurface offset against t")   \
+    "plotDisplacement \"f.svg\": eq. (5), the isosurface offset against t; "  \
+    "e.g. plotDisplacement \"d.svg\"")                                         \
   X("plotField", 4, pl_field,                                                 \
-    "plotField \"f.svg\" soft o d: Wyvill's C(r) and the field along a line")
+    "plotField \"f.svg\" soft o d: Wyvill's C(r) and the field along a line; " \
+    "e.g. plotField \"c.svg\" (SoftObject 0.5 [Key (0, 0, 0) 1 1]) "           \
+    "(-2, 0, 0) (1, 0, 0)")
 
 static const Builtin plots[] = {
 #define X(name, arity, fn, doc) {name, arity, fn, doc},
@@ -933,9 +940,6 @@ static const Builtin plots[] = {
 };
 
 void plot_install(Interp *I) {
-  for (size_t i = 0; i < sizeof plots / sizeof *plots; i++) {
-    Sym *s = sym_intern(I, plots[i].name, (int)strlen(plots[i].name));
-    s->global = val_builtin(&plots[i]);
-    s->sig = plots[i].doc;
-  }
+  for (size_t i = 0; i < sizeof plots / sizeof *plots; i++)
+    builtin_define(I, &plots[i]);
 }

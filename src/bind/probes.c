@@ -12,6 +12,7 @@
 
 #include "core/bounds.h"
 #include "core/density.h"
+#include "lang/builtins.h"
 #include "lang/eval.h"
 #include "core/lg.h"
 #include "lang/print.h"
@@ -485,24 +486,35 @@ static Value *pr_lg(Interp *I, Value **args, Pos pos) {
 
 #define PROBES(X)                                                            \
   X("Density", 3, pr_density,                                                \
-    "Density r p tree: the density of the tree smoothed with radius r at p") \
+    "Density r p tree: the density of the tree smoothed with radius r at p"  \
+    "; e.g. Density 0.1 (0.5, 0.5, 0.5) UnitCube")                           \
   X("Gradient", 3, pr_gradient,                                              \
-    "Gradient r p tree: the density's (or soft field's) gradient at p")                      \
+    "Gradient r p tree: the density's (or soft field's) gradient at p"      \
+    "; e.g. Gradient 0.1 (1, 0.5, 0.5) UnitCube")                            \
   X("PointInObject", 2, pr_inside,                                           \
-    "PointInObject p obj: is p inside the object?")                          \
+    "PointInObject p obj: is p inside the object?"                           \
+    "; e.g. PointInObject (0.5, 0.5, 0.5) (Rounded 0.1 UnitCube)")           \
   X("Displacement", 2, pr_displacement,                                      \
-    "Displacement r t: distance from a plane to its t-isosurface, outward")  \
-  X("Field", 2, pr_field, "Field p soft: the soft object's field at p")   \
+    "Displacement r t: distance from a plane to its t-isosurface, outward"   \
+    "; e.g. Displacement 0.1 0.5")                                           \
+  X("Field", 2, pr_field,                                                    \
+    "Field p soft: the soft object's field at p"                             \
+    "; e.g. Field (0, 0, 0) (SoftObject 0.5 [Key (0, 0, 0) 1 1])")           \
   X("OuterBounds", 3, pr_outer,                                              \
-    "OuterBounds r t tree: a sharp object outside which density <= t")       \
+    "OuterBounds r t tree: a sharp object outside which density <= t"        \
+    "; e.g. OuterBounds 0.1 0.01 UnitCube")                                  \
   X("InnerBounds", 3, pr_inner,                                              \
-    "InnerBounds r t tree: a sharp object inside which density >= t")       \
+    "InnerBounds r t tree: a sharp object inside which density >= t"         \
+    "; e.g. InnerBounds 0.1 0.99 UnitCube")                                  \
   X("Roots", 3, pr_roots,                                                    \
-    "Roots obj o d: every t >= 0 where o + t d crosses obj's surface")       \
+    "Roots obj o d: every t >= 0 where o + t d crosses obj's surface"        \
+    "; e.g. Roots (Rounded 0.1 UnitCube) (-1, 0.5, 0.5) (1, 0, 0)")          \
   X("Trace", 3, pr_trace,                                                    \
-    "Trace obj o d: Roots, printing the root search step by step")           \
+    "Trace obj o d: Roots, printing the root search step by step"            \
+    "; e.g. Trace (Rounded 0.1 UnitCube) (-1, 0.5, 0.5) (1, 0, 0)")          \
   X("LG", 5, pr_lg,                                                          \
-    "LG r tree o d (t0, t1): (M, L, G) bounds over the ray segment")
+    "LG r tree o d (t0, t1): (M, L, G) bounds over the ray segment"         \
+    "; e.g. LG 0.1 UnitCube (-1, 0.5, 0.5) (1, 0, 0) (0, 3)")
 
 static const Builtin probes[] = {
 #define X(name, arity, fn, doc) {name, arity, fn, doc},
@@ -511,9 +523,6 @@ static const Builtin probes[] = {
 };
 
 void probes_install(Interp *I) {
-  for (size_t i = 0; i < sizeof probes / sizeof *probes; i++) {
-    Sym *s = sym_intern(I, probes[i].name, (int)strlen(probes[i].name));
-    s->global = val_builtin(&probes[i]);
-    s->sig = probes[i].doc;
-  }
+  for (size_t i = 0; i < sizeof probes / sizeof *probes; i++)
+    builtin_define(I, &probes[i]);
 }

@@ -189,6 +189,10 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
   int quiet = 0, float_pixels = 0;
   if (settings) read_settings(I, settings, pos, &rs, &quiet, &float_pixels);
   RenderOverrides *ov = overrides_of(I);
+  if (ov && ov->skip) {
+    ov->skipped++;
+    return val_str(path);
+  }
   if (ov) {
     if (ov->output) path = ov->output;
     if (ov->width) rs.width = ov->width, rs.height = ov->height;
@@ -260,14 +264,11 @@ static Value *bi_render_with(Interp *I, Value **args, Pos pos) {
 
 static const Builtin render_builtins[] = {
     {"renderWith", 3, bi_render_with,
-     "renderWith settings file scene: render to file (.exr, .png, .ppm)"},
+     "renderWith settings file scene: render to file (.exr, .png, .ppm); "
+     "e.g. renderWith [Size 60 38, Quiet] \"cube.png\" (Rounded 0.1 UnitCube)"},
 };
 
 void render_install(Interp *I) {
-  for (size_t i = 0; i < sizeof render_builtins / sizeof *render_builtins; i++) {
-    const Builtin *b = &render_builtins[i];
-    Sym *s = sym_intern(I, b->name, (int)strlen(b->name));
-    s->global = val_builtin(b);
-    s->sig = b->doc;
-  }
+  for (size_t i = 0; i < sizeof render_builtins / sizeof *render_builtins; i++)
+    builtin_define(I, &render_builtins[i]);
 }

@@ -35,6 +35,10 @@ typedef struct RenderOverrides {
                            owns kept and frees it with scene_free (qcs
                            view) */
   struct Scene *kept;
+  int skip;             /* renders do nothing but count themselves in
+                           skipped and give their file name (the REPL's
+                           :reload) */
+  int skipped;
 } RenderOverrides;
 
 void render_install(Interp *I);

@@ -217,6 +217,81 @@ int soft_bounds(const soft_obj *obj, double lo[3], double hi[3]) {
   return obj->lo[0] <= obj->hi[0];
 }
 
+/* Positive keys whose bounds overlap key j's (j among them), through the
+ * BVH; counting stops past cap. */
+static size_t overlaps(const soft_obj *o, const nkey *kj, size_t cap) {
+  size_t n = 0;
+  int stack[BVH_STACK], sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0) {
+    const bvh_node *nd = &o->tree.nodes[stack[--sp]];
+    int meets = 1;
+    for (int i = 0; i < 3; i++)
+      if (nd->hi[i] < kj->lo[i] || nd->lo[i] > kj->hi[i]) meets = 0;
+    if (!meets) continue;
+    if (nd->count == 0) {
+      stack[sp++] = nd->first;
+      stack[sp++] = nd->first + 1;
+      continue;
+    }
+    for (int j = nd->first; j < nd->first + nd->count; j++) {
+      const nkey *k = &o->keys[j];
+      if (!(k->w > 0)) continue;
+      int over = 1;
+      for (int i = 0; i < 3; i++)
+        if (k->hi[i] < kj->lo[i] || k->lo[i] > kj->hi[i]) over = 0;
+      n += (size_t)over;
+      if (n > cap) return n;
+    }
+  }
+  return n;
+}
+
+/* Past this many overlapping keys a key's level magic / n is so low that
+ * its surface box is nearly its whole bound: the bound is used. */
+#define OVERLAP_CAP 32
+/* Past this many keys soft_surface_bounds gives soft_bounds' box (the
+ * counting would cost more than the framing gains). */
+#define SURFACE_BOUNDS_MAX_KEYS 200000
+
+/* The s at which C(s) = level, for 0 < level <= C(k0), k0 <= s <= 1:
+ * bisection on the decreasing C, the upper end of the bracket (so that
+ * C(s) <= level: conservative). */
+static double cinverse(double level, double k0) {
+  double lo = k0 > 0 ? k0 : 0, hi = 1;
+  for (int it = 0; it < 200 && hi - lo > 1e-15; it++) {
+    double mid = 0.5 * (lo + hi);
+    if (cfield(mid) >= level) lo = mid;
+    else hi = mid;
+  }
+  return hi;
+}
+
+int soft_surface_bounds(const soft_obj *o, double lo[3], double hi[3]) {
+  if (o->nkeys > SURFACE_BOUNDS_MAX_KEYS) return soft_bounds(o, lo, hi);
+  for (int i = 0; i < 3; i++) { lo[i] = INFINITY; hi[i] = -INFINITY; }
+  for (size_t j = 0; j < o->nkeys; j++) {
+    const nkey *k = &o->keys[j];
+    if (!(k->w > 0)) continue;
+    size_t n = overlaps(o, k, OVERLAP_CAP);
+    if (n < 1) n = 1;
+    double f = 1;
+    if (n <= OVERLAP_CAP) {
+      double level = o->magic / ((double)n * k->w);
+      if (level > k->cmax) continue; /* never the largest part of magic */
+      double sstar = cinverse(level, k->k);
+      f = sqrt((sstar - k->k) / (1 - k->k)) * (1 + 1e-9);
+      if (!(f <= 1)) f = 1;
+    }
+    for (int i = 0; i < 3; i++) {
+      double e = (k->hi[i] - k->lo[i]) * 0.5 * f;
+      lo[i] = fmin(lo[i], k->x0[i] - e);
+      hi[i] = fmax(hi[i], k->x0[i] + e);
+    }
+  }
+  return lo[0] <= hi[0];
+}
+
 /* ---- field and gradient ---------------------------------------------- */
 
 /* ap = A p for the key's matrix A. */

@@ -75,6 +75,17 @@ double soft_magic(const soft_obj *obj);
  * of the bounds of the positive keys. Returns 0 (and lo > hi) if empty. */
 int soft_bounds(const soft_obj *obj, double lo[3], double hi[3]);
 
+/* A tighter box holding the surface and the inside (field >= magic), for
+ * framing: where the field is >= magic, some positive key i gives at least
+ * magic / n_i of it, n_i the positive keys whose bounds meet key i's
+ * (every key acting there does); so the box is the union over the
+ * positive keys of where w_i C(s) >= magic / n_i. A lone key of weight 1
+ * and magic 0.5: radius R / 2, not R. Negative keys only subtract and
+ * are left out. A key met by more than 32 others keeps its whole bound,
+ * and past 200000 keys this is soft_bounds. Returns 0 (and lo > hi) if
+ * empty. */
+int soft_surface_bounds(const soft_obj *obj, double lo[3], double hi[3]);
+
 /* eq. (1) summed over the keys: the field at p. */
 double soft_field(const soft_obj *obj, const double p[3]);
 

@@ -240,13 +240,28 @@ static const Builtin builtins[] = {
 #undef X
 };
 
+/* A table's doc is "WHAT; e.g. EXAMPLE": split at the last "; e.g. ". */
+void builtin_define(Interp *I, const Builtin *b) {
+  Sym *s = sym_intern(I, b->name, (int)strlen(b->name));
+  s->global = b->arity == 0 ? b->fn(I, NULL, pos_none) : val_builtin(b);
+  s->builtin = 1;
+  s->doc = b->doc;
+  s->example = NULL;
+  if (!b->doc) return;
+  const char *eg = NULL;
+  for (const char *p = b->doc; (p = strstr(p, "; e.g. ")) != NULL; p++) eg = p;
+  if (!eg) return;
+  size_t n = (size_t)(eg - b->doc);
+  char *doc = GC_MALLOC_ATOMIC(n + 1);
+  memcpy(doc, b->doc, n);
+  doc[n] = 0;
+  s->doc = doc;
+  s->example = eg + strlen("; e.g. ");
+}
+
 void builtins_install(Interp *I) {
-  for (size_t i = 0; i < sizeof builtins / sizeof *builtins; i++) {
-    const Builtin *b = &builtins[i];
-    Sym *s = sym_intern(I, b->name, (int)strlen(b->name));
-    s->global = b->arity == 0 ? b->fn(I, NULL, pos_none) : val_builtin(b);
-    s->sig = b->doc;
-  }
+  for (size_t i = 0; i < sizeof builtins / sizeof *builtins; i++)
+    builtin_define(I, &builtins[i]);
 }
 
 const Builtin *builtins_table(size_t *n) {

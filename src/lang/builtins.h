@@ -17,43 +17,56 @@
 #include "lang/value.h"
 
 #define BUILTINS(X)                                                          \
-  X("sqrt", 1, bi_sqrt, "sqrt x: square root")                               \
-  X("sin", 1, bi_sin, "sin x: sine of x radians")                            \
-  X("cos", 1, bi_cos, "cos x: cosine of x radians")                          \
-  X("tan", 1, bi_tan, "tan x: tangent of x radians")                         \
-  X("asin", 1, bi_asin, "asin x: in radians")                                \
-  X("acos", 1, bi_acos, "acos x: in radians")                                \
-  X("atan", 1, bi_atan, "atan x: in radians")                                \
-  X("atan2", 2, bi_atan2, "atan2 y x: angle of (x, y) in radians")           \
-  X("exp", 1, bi_exp, "exp x")                                               \
-  X("log", 1, bi_log, "log x: natural logarithm")                            \
-  X("floor", 1, bi_floor, "floor x")                                         \
-  X("ceiling", 1, bi_ceiling, "ceiling x")                                   \
-  X("round", 1, bi_round, "round x: halves away from zero")                  \
-  X("truncate", 1, bi_truncate, "truncate x: towards zero")                  \
-  X("abs", 1, bi_abs, "abs x")                                               \
-  X("min", 2, bi_min, "min a b")                                             \
-  X("max", 2, bi_max, "max a b")                                             \
-  X("mod", 2, bi_mod, "mod x y: remainder with the sign of y")               \
-  X("pi", 0, bi_pi, "pi: 3.141592653589793")                                 \
-  X("isNaN", 1, bi_isNaN, "isNaN x")                                         \
-  X("isInfinite", 1, bi_isInfinite, "isInfinite x")                          \
-  X("not", 1, bi_not, "not b")                                               \
-  X("show", 1, bi_show, "show v: v printed as a String")                     \
+  X("sqrt", 1, bi_sqrt, "sqrt x: square root; e.g. sqrt 16")                 \
+  X("sin", 1, bi_sin, "sin x: sine of x radians; e.g. sin (pi / 2)")         \
+  X("cos", 1, bi_cos, "cos x: cosine of x radians; e.g. cos pi")             \
+  X("tan", 1, bi_tan, "tan x: tangent of x radians; e.g. tan (pi / 4)")      \
+  X("asin", 1, bi_asin, "asin x: arcsine, in radians; e.g. asin 1")          \
+  X("acos", 1, bi_acos, "acos x: arccosine, in radians; e.g. acos 0")        \
+  X("atan", 1, bi_atan, "atan x: arctangent, in radians; e.g. atan 1")       \
+  X("atan2", 2, bi_atan2,                                                    \
+    "atan2 y x: angle of (x, y) in radians; e.g. atan2 1 0")                 \
+  X("exp", 1, bi_exp, "exp x: e to the power x; e.g. exp 1")                 \
+  X("log", 1, bi_log, "log x: natural logarithm; e.g. log (exp 2)")          \
+  X("floor", 1, bi_floor, "floor x: the whole number at or below x; e.g. floor (-1.5)") \
+  X("ceiling", 1, bi_ceiling, "ceiling x: the whole number at or above x; e.g. ceiling 1.2") \
+  X("round", 1, bi_round, "round x: halves away from zero; e.g. round 2.5")  \
+  X("truncate", 1, bi_truncate,                                              \
+    "truncate x: towards zero; e.g. truncate (-1.7)")                        \
+  X("abs", 1, bi_abs, "abs x: x without its sign; e.g. abs (-3)")            \
+  X("min", 2, bi_min, "min a b: the smaller; e.g. min 2 3")                  \
+  X("max", 2, bi_max, "max a b: the larger; e.g. max 2 3")                   \
+  X("mod", 2, bi_mod,                                                        \
+    "mod x y: remainder with the sign of y; e.g. mod (-1) 3")                \
+  X("pi", 0, bi_pi, "pi: 3.141592653589793; e.g. pi / 2")                    \
+  X("isNaN", 1, bi_isNaN, "isNaN x: is x not a number?; e.g. isNaN (0 / 0)") \
+  X("isInfinite", 1, bi_isInfinite, "isInfinite x: is x +-infinity?; e.g. isInfinite (1 / 0)") \
+  X("not", 1, bi_not, "not b: True for False, False for True; e.g. not True") \
+  X("show", 1, bi_show, "show v: v printed as a String; e.g. show (1, \"a\")") \
   X("showReal", 2, bi_showReal,                                              \
-    "showReal digits x: x to that many significant digits (0: shortest)")     \
-  X("error", 1, bi_error, "error msg: stop with an error")                   \
-  X("seq", 2, bi_seq, "seq a b: evaluate a, then give b")                    \
-  X("dot", 2, bi_dot, "dot u v: scalar product of 3-vectors")                \
-  X("cross", 2, bi_cross, "cross u v: vector product of 3-vectors")          \
-  X("norm", 1, bi_norm, "norm v: length of a 3-vector")                      \
-  X("length", 1, bi_length, "length xs")                                     \
-  X("sum", 1, bi_sum, "sum xs: of Reals or of vectors")                      \
-  X("product", 1, bi_product, "product xs")                                  \
-  X("foldl", 3, bi_foldl, "foldl f z xs: strict left fold")                  \
-  X("concatMap", 2, bi_concatMap, "concatMap f xs: lazy")                    \
+    "showReal digits x: x to that many significant digits (0: shortest); e.g. showReal 3 pi") \
+  X("error", 1, bi_error,                                                    \
+    "error msg: stop with an error; e.g. if 2 < 0 then error \"negative\" else 2") \
+  X("seq", 2, bi_seq, "seq a b: evaluate a, then give b; e.g. seq (1 + 1) 3") \
+  X("dot", 2, bi_dot,                                                        \
+    "dot u v: scalar product of 3-vectors; e.g. dot (1, 2, 3) (4, 5, 6)")    \
+  X("cross", 2, bi_cross,                                                    \
+    "cross u v: vector product of 3-vectors; e.g. cross (1, 0, 0) (0, 1, 0)") \
+  X("norm", 1, bi_norm, "norm v: length of a 3-vector; e.g. norm (3, 4, 0)") \
+  X("length", 1, bi_length, "length xs: the number of elements; e.g. length [1, 2, 3]") \
+  X("sum", 1, bi_sum,                                                        \
+    "sum xs: of Reals or of vectors; e.g. sum [(1, 0, 0), (0, 2, 0)]")       \
+  X("product", 1, bi_product, "product xs: of Reals; e.g. product [1 .. 5]") \
+  X("foldl", 3, bi_foldl,                                                    \
+    "foldl f z xs: strict left fold; e.g. foldl (\\acc x -> acc * 10 + x) 0 [1, 2, 3]") \
+  X("concatMap", 2, bi_concatMap,                                            \
+    "concatMap f xs: f on each element, the results joined, lazily; e.g. concatMap (\\x -> [x, x]) [1, 2]") \
   X("%concatMap", 2, bi_concatMap, NULL)
 
 void builtins_install(Interp *I);
+/* Install one built-in as a global (the layers above use it for theirs).
+   Its doc reads "NAME ARGS: what it does; e.g. EXAMPLE": :doc and :info
+   show both parts, and the suite runs the example. */
+void builtin_define(Interp *I, const Builtin *b);
 const Builtin *builtins_table(size_t *n);
 #endif

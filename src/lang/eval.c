@@ -135,11 +135,15 @@ static Value *lookup(Interp *I, Expr *e, Env *env) {
 
 /* ---- thunks ---- */
 
-static Value *mk_thunk(Expr *e, Env *env) {
+/* A thunk of the prelude's code remembers the user's call it was made
+   under (Interp.origin), to report its errors there when it is forced
+   later, from elsewhere. */
+static Value *mk_thunk(Interp *I, Expr *e, Env *env) {
   Value *v = val_cell();
   v->kind = V_THUNK;
   v->u.thunk.e = e;
   v->u.thunk.env = env;
+  if (I->origin && e->pos.src == I->prelude_src) v->u.thunk.origin = I->origin;
   return v;
 }
 
@@ -191,7 +195,7 @@ Value *delay(Interp *I, Expr *e, Env *env) {
   case E_STR: return val_str(e->u.str);
   case E_BOOL: return val_bool(I, e->u.b);
   case E_VAR: return lookup(I, e, env);
-  default: return mk_thunk(e, env);
+  default: return mk_thunk(I, e, env);
   }
 }
 
@@ -277,8 +281,12 @@ Value *force(Interp *I, Value *v) {
     Value saved = *v;
     v->kind = V_BLACKHOLE;
     Value *r;
-    if (saved.kind == V_THUNK)
+    const Pos *origin = I->origin;
+    if (saved.kind == V_THUNK) {
+      I->origin = saved.u.thunk.origin;
       r = eval(I, saved.u.thunk.e, saved.u.thunk.env);
+      I->origin = origin;
+    }
     else if (saved.kind == V_APTHUNK)
       r = apply(I, saved.u.pap.fn, saved.u.pap.n, saved.u.pap.args, pos_none);
     else {
@@ -441,11 +449,10 @@ static Expr *defbody_expr(Def *d) {
 /* Bind local definitions (where, let) in frame; they may refer to each
    other and to themselves. */
 static void bind_defs(Interp *I, int n, Def **defs, Env *frame) {
-  (void)I;
   for (int i = 0; i < n; i++) {
     Def *d = defs[i];
     if (d->pat) {
-      Value *whole = mk_thunk(defbody_expr(d), frame);
+      Value *whole = mk_thunk(I, defbody_expr(d), frame);
       pat_bind_vars(d->pat, whole, frame, d->pat);
     } else if (d->arity > 0) {
       env_bind(frame, d->name, mk_fn(d, frame));
@@ -455,15 +462,14 @@ static void bind_defs(Interp *I, int n, Def **defs, Env *frame) {
                     c->nwhere == 0)
                        ? c->bodies[0]
                        : defbody_expr(d);
-      env_bind(frame, d->name, mk_thunk(body, frame));
+      env_bind(frame, d->name, mk_thunk(I, body, frame));
     }
   }
 }
 
 Value *eval_global_value(Interp *I, Def *d) {
   if (d->arity > 0) return mk_fn(d, NULL);
-  (void)I;
-  return mk_thunk(defbody_expr(d), NULL);
+  return mk_thunk(I, defbody_expr(d), NULL);
 }
 
 /* Forces v a few levels deep for an error message; an error on the way
@@ -545,6 +551,7 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
    reported where the user wrote Shift). */
 Pos eval_user_pos(Interp *I, Pos pos) {
   if (!pos.src || strcmp(pos.src->name, "<prelude>")) return pos;
+  if (I->origin) return *I->origin;
   int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
   for (int i = n - 1; i >= 0; i--) {
     const Pos *t = &I->trace[i].pos;
@@ -617,6 +624,14 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
     case F_DEF: {
       Def *d = f->u.fn.u.def;
       trace_set(I, depth, d->name ? d->name->name : "a lambda", pos);
+      /* the user's code calls the prelude: errors in there are reported
+         here (eval() puts the origin back when it returns) */
+      if (pos.src && pos.src != I->prelude_src &&
+          d->pos.src == I->prelude_src) {
+        Pos *o = GC_MALLOC(sizeof *o);
+        *o = pos;
+        I->origin = o;
+      }
       Env *env;
       Expr *b = select_clause(I, d, f->u.fn.env, args, pos, &env);
       if (n == a) {
@@ -933,6 +948,7 @@ static Value *range(Interp *I, Expr *e, Env *env) {
 
 Value *eval(Interp *I, Expr *e, Env *env) {
   int depth = I->ntrace;
+  const Pos *origin = I->origin;
   /* Trace slots: the first call made here, then the latest tail call. */
   int tslot = depth;
   Value *result;
@@ -1029,6 +1045,7 @@ Value *eval(Interp *I, Expr *e, Env *env) {
   }
 done:
   I->ntrace = depth;
+  I->origin = origin;
   return result;
 }
 

@@ -29,19 +29,59 @@ static int run_counter;
 
 /* ---- error display ---- */
 
+static int in_prelude(Interp *I, Pos p) {
+  return p.src && I->prelude_src && p.src == I->prelude_src;
+}
+
+/* A call made by the prelude's code to a prelude function or a built-in
+   (not to a function of the user's, such as a lambda given to map). */
+static int prelude_frame(Interp *I, const TraceEntry *t) {
+  if (!in_prelude(I, t->pos) || t->name[0] == '%') return 0;
+  Sym *s = sym_intern(I, t->name, (int)strlen(t->name));
+  return !s->user && (s->def || s->builtin);
+}
+
 static void report_error(Interp *I) {
   ErrInfo *e = err_info();
   /* Found where no position was at hand (a lazy list's tail, printing):
      the top-level expression being run. */
   if (!e->pos.line && I->item_pos.line) e->pos = I->item_pos;
   I->item_pos = pos_none;
-  err_report(stderr, "error", e->pos, e->msg);
+  /* Raised in the prelude: reported at the user's call that led there
+     (Interp.origin), the prelude's line after it. */
+  int from_prelude = in_prelude(I, e->pos);
+  if (from_prelude && I->origin && I->origin->src && I->origin->line &&
+      !in_prelude(I, *I->origin)) {
+    err_report(stderr, "error", *I->origin, e->msg);
+    fprintf(stderr, "  (raised inside the prelude, at <prelude>:%d:%d)\n",
+            e->pos.line, e->pos.col);
+  } else {
+    err_report(stderr, "error", e->pos, e->msg);
+  }
+  I->origin = NULL;
   int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
   int lines = 0, i = n - 1;
   /* Innermost first; a run of identical entries (deep recursion) is
-     shown once with its count. */
+     shown once with its count; a run of calls made by the prelude's own
+     code is one line naming them. */
   while (i >= 0 && lines < 8) {
     TraceEntry *t = &I->trace[i];
+    if (prelude_frame(I, t) && i > 0 && prelude_frame(I, &I->trace[i - 1])) {
+      fputs("  in the prelude:", stderr);
+      int shown = 0, calls = 0;
+      const char *prev = NULL;
+      for (; i >= 0 && prelude_frame(I, &I->trace[i]); i--, calls++) {
+        const char *nm = I->trace[i].name;
+        if (prev && !strcmp(prev, nm)) continue;
+        if (shown < 5) fprintf(stderr, "%s %s", shown ? "," : "", nm);
+        else if (shown == 5) fputs(", ...", stderr);
+        shown++;
+        prev = nm;
+      }
+      fprintf(stderr, " (%d call%s)\n", calls, calls == 1 ? "" : "s");
+      lines++;
+      continue;
+    }
     int same = 1;
     while (i - same >= 0 && I->trace[i - same].name == t->name &&
            I->trace[i - same].pos.line == t->pos.line &&
@@ -67,6 +107,7 @@ static void report_error(Interp *I) {
 static void unwind(Interp *I, int nforcing) {
   eval_restore(I, nforcing);
   I->ntrace = 0;
+  I->origin = NULL;
   qcs_interrupted = 0;
 }
 
@@ -93,6 +134,77 @@ static void refresh_values(Interp *I) {
     for (Sym *s = I->symtab[h]; s; s = s->next)
       if (s->user && s->def && s->def->arity == 0 && !s->overridden)
         s->global = eval_global_value(I, s->def);
+}
+
+/* ---- doc comments ----
+ *
+ * The comment lines right above a definition (or above its signature) may
+ * hold "// doc: TEXT", one line saying what it does, and "// e.g. EXPR",
+ * an expression showing it; :doc and :info show them. */
+
+static char *gc_strndup(const char *s, size_t n) {
+  char *p = GC_MALLOC_ATOMIC(n + 1);
+  memcpy(p, s, n);
+  p[n] = 0;
+  return p;
+}
+
+static void read_doc(Sym *s, Pos pos) {
+  s->doc = s->example = NULL;
+  if (!pos.src || !pos.src->text || pos.line < 2) return;
+  const char *text = pos.src->text, *cur = text;
+  for (int l = 1; l < pos.line; l++) {
+    cur = strchr(cur, '\n');
+    if (!cur) return;
+    cur++;
+  }
+  size_t nlen = strlen(s->name);
+  while (cur > text) {
+    const char *end = cur - 1; /* the '\n' ending the line above */
+    const char *start = end;
+    while (start > text && start[-1] != '\n') start--;
+    cur = start;
+    const char *p = start;
+    while (p < end && (*p == ' ' || *p == '\t')) p++;
+    const char *q = end;
+    while (q > p && (q[-1] == ' ' || q[-1] == '\t' || q[-1] == '\r')) q--;
+    if (p == q) break; /* a blank line ends the block */
+    if (q - p >= 2 && p[0] == '/' && p[1] == '/') {
+      const char *c = p + 2;
+      while (c < q && *c == ' ') c++;
+      if (q - c > 4 && !strncmp(c, "doc:", 4)) {
+        c += 4;
+        while (c < q && *c == ' ') c++;
+        if (!s->doc) s->doc = gc_strndup(c, (size_t)(q - c));
+      } else if (q - c > 4 && !strncmp(c, "e.g.", 4)) {
+        c += 4;
+        while (c < q && *c == ' ') c++;
+        if (!s->example) s->example = gc_strndup(c, (size_t)(q - c));
+      }
+      continue;
+    }
+    /* the name's signature: "name :: type" */
+    if ((size_t)(q - p) > nlen && !strncmp(p, s->name, nlen)) {
+      const char *c = p + nlen;
+      while (c < q && (*c == ' ' || *c == '\t')) c++;
+      if (q - c >= 2 && c[0] == ':' && c[1] == ':') continue;
+    }
+    break;
+  }
+}
+
+/* A user definition of a name the built-ins or the prelude define: said
+   once per name, as a warning (the prelude's own code keeps its own);
+   only where asked (the REPL: the paper's scripts call their ground
+   plane floor, and say so in their comments). */
+static void warn_shadow(Interp *I, Sym *s, Pos pos) {
+  if (!I->warn_shadow || I->loading_prelude || !s->prelude_value ||
+      s->shadow_warned)
+    return;
+  s->shadow_warned = 1;
+  qcs_warning(pos, "%s shadows the %s %s: your definition is used from now "
+              "on (the prelude's own functions keep the original)", s->name,
+              s->builtin ? "built-in" : "prelude's", s->name);
 }
 
 static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
@@ -124,11 +236,13 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
       Sym *s = it->def->name;
       if (s->overridden) continue;
       if (s->def && s->user) redefined = 1;
+      warn_shadow(I, s, it->def->pos);
       s->def = it->def;
       s->global = eval_global_value(I, it->def);
       s->user = !I->loading_prelude;
       s->def_pos = it->def->pos;
       s->def_file = runname;
+      read_doc(s, it->def->pos);
       (void)runid;
     }
   }
@@ -364,7 +478,14 @@ void interp_browse(Interp *I, FILE *out, int all) {
   qsort(list, n, sizeof *list, cmp_sym);
   for (size_t i = 0; i < n; i++) {
     Sym *s = list[i];
-    if (s->con_arity >= 0) {
+    if (s->user && s->prelude_value) {
+      fprintf(out, "%s  -- yours, shadows the %s %s", s->name,
+              s->builtin ? "built-in" : "prelude's", s->name);
+      if (s->sig) fprintf(out, "; %s :: %s", s->name, s->sig);
+      fputc('\n', out);
+    } else if (s->builtin) {
+      fprintf(out, "%s  -- built-in: %s\n", s->name, s->doc ? s->doc : "");
+    } else if (s->con_arity >= 0) {
       fprintf(out, "%s  -- constructor of %s, %d argument%s\n", s->name,
               s->con_type ? s->con_type->name : "?", s->con_arity,
               s->con_arity == 1 ? "" : "s");
@@ -379,6 +500,195 @@ void interp_browse(Interp *I, FILE *out, int all) {
     }
   }
 }
+
+int interp_unload(Interp *I, const char *file) {
+  int n = 0;
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next) {
+      if (!s->user || s->overridden || s->con_arity >= 0 || !s->def_file ||
+          strcmp(s->def_file, file))
+        continue;
+      s->global = s->prelude_value;
+      s->def = s->prelude_def;
+      s->sig = s->prelude_sig;
+      s->doc = s->prelude_doc;
+      s->example = s->prelude_example;
+      s->def_pos = s->prelude_pos;
+      s->def_file = NULL;
+      s->user = 0;
+      n++;
+    }
+  if (n) refresh_values(I);
+  return n;
+}
+
+/* ---- :info, :doc, :type ---- */
+
+/* The symbol of a global or constructor called name, or NULL. */
+static Sym *known_sym(Interp *I, const char *name) {
+  Sym *s = sym_intern(I, name, (int)strlen(name));
+  return s->global || s->con_arity >= 0 ? s : NULL;
+}
+
+static void where_defined(FILE *out, Pos pos) {
+  if (!pos.src || !pos.line) return;
+  if (!strcmp(pos.src->name, "<stdin>"))
+    fputs(", defined at the prompt", out);
+  else
+    fprintf(out, ", defined at %s:%d", pos.src->name, pos.line);
+}
+
+static void no_such_name(Interp *I, const char *name) {
+  fprintf(stderr, "error: '%s' is not defined", name);
+  const char *best = NULL;
+  int best_d = 3;
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next)
+      if ((s->global || s->con_arity >= 0) && s->name[0] != '%') {
+        int d = edit_distance(name, s->name);
+        if (d < best_d && (size_t)d < strlen(name)) best = s->name, best_d = d;
+      }
+  if (best) fprintf(stderr, " (did you mean '%s'?)", best);
+  fputc('\n', stderr);
+}
+
+int interp_info(Interp *I, FILE *out, const char *name) {
+  Sym *s = known_sym(I, name);
+  if (!s) {
+    no_such_name(I, name);
+    return -1;
+  }
+  if (s->con_arity >= 0) {
+    fprintf(out, "%s  -- constructor of %s, %d argument%s", s->name,
+            s->con_type ? s->con_type->name : "?", s->con_arity,
+            s->con_arity == 1 ? "" : "s");
+    where_defined(out, s->def_pos);
+    fputc('\n', out);
+  } else {
+    const char *kind = s->user ? "your definition"
+                       : s->builtin ? "built-in"
+                       : s->def ? "prelude function" : "value";
+    int arity = -1;
+    if (s->def) arity = s->def->arity;
+    else if (s->global && s->global->kind == V_FUNC)
+      arity = s->global->u.fn.arity;
+    else if (s->builtin) arity = 0;
+    if (arity == 0 && !s->builtin)
+      kind = s->user ? "your definition, a value" : "prelude value";
+    fprintf(out, "%s  -- %s", s->name, kind);
+    if (arity > 0 || (arity == 0 && s->builtin))
+      fprintf(out, ", %d argument%s", arity, arity == 1 ? "" : "s");
+    if (s->overridden) fputs(", set by --set", out);
+    else if (!s->builtin || s->user) where_defined(out, s->def_pos);
+    fputc('\n', out);
+    if (s->user && s->prelude_value)
+      fprintf(out, "  (shadows the %s %s; the prelude's own functions keep "
+              "the original)\n", s->builtin ? "built-in" : "prelude's",
+              s->name);
+  }
+  if (s->sig) fprintf(out, "%s :: %s\n", s->name, s->sig);
+  if (s->doc) fprintf(out, "  %s\n", s->doc);
+  if (s->example) fprintf(out, "  e.g. %s\n", s->example);
+  return 0;
+}
+
+int interp_doc(Interp *I, FILE *out, const char *name) {
+  Sym *s = known_sym(I, name);
+  if (!s) {
+    no_such_name(I, name);
+    return -1;
+  }
+  if (s->sig) fprintf(out, "%s :: %s\n", s->name, s->sig);
+  if (s->doc) fprintf(out, "%s\n", s->doc);
+  if (s->example) fprintf(out, "e.g. %s\n", s->example);
+  if (!s->doc && !s->example) {
+    if (s->con_arity >= 0)
+      fprintf(out, "%s: a constructor of %s with %d argument%s (no doc)\n",
+              s->name, s->con_type ? s->con_type->name : "?", s->con_arity,
+              s->con_arity == 1 ? "" : "s");
+    else
+      fprintf(out, "%s has no doc (a \"// doc: TEXT\" line above its "
+              "definition gives it one)\n", s->name);
+  }
+  return 0;
+}
+
+const char *interp_signature(Interp *I, const char *name) {
+  Sym *s = known_sym(I, name);
+  return s ? s->sig : NULL;
+}
+
+static const char *plural(int n) { return n == 1 ? "" : "s"; }
+
+void interp_describe(Interp *I, Value *v, char *buf, size_t n) {
+  v = force(I, v);
+  switch (v->kind) {
+  case V_TUPLE:
+    snprintf(buf, n, "a %d-tuple", v->u.tup.n);
+    return;
+  case V_NIL:
+    snprintf(buf, n, "a list, empty");
+    return;
+  case V_CONS: {
+    Value *h = force(I, v->u.cons.head);
+    char hd[200];
+    interp_describe(I, h, hd, sizeof hd);
+    snprintf(buf, n, "a list whose first element is %s", hd);
+    return;
+  }
+  case V_CON: {
+    Sym *c = v->u.con.con;
+    snprintf(buf, n, "a %s, made by the constructor %s",
+             c->con_type ? c->con_type->name : "value", c->name);
+    return;
+  }
+  case V_FUNC:
+    switch (v->u.fn.kind) {
+    case F_CON:
+      snprintf(buf, n, "the constructor %s of %s: a function of %d "
+               "argument%s", v->u.fn.u.con->name,
+               v->u.fn.u.con->con_type ? v->u.fn.u.con->con_type->name : "?",
+               v->u.fn.arity, plural(v->u.fn.arity));
+      return;
+    case F_BUILTIN:
+      snprintf(buf, n, "a built-in function of %d argument%s (%s)",
+               v->u.fn.arity, plural(v->u.fn.arity), v->u.fn.u.bi->name);
+      return;
+    case F_DEF:
+      if (v->u.fn.u.def->name)
+        snprintf(buf, n, "a function of %d argument%s (%s)", v->u.fn.arity,
+                 plural(v->u.fn.arity), v->u.fn.u.def->name->name);
+      else
+        snprintf(buf, n, "a function of %d argument%s", v->u.fn.arity,
+                 plural(v->u.fn.arity));
+      return;
+    }
+    break;
+  case V_PAP: {
+    Value *f = force(I, v->u.pap.fn);
+    int arity = f->kind == V_FUNC ? f->u.fn.arity : v->u.pap.n;
+    int left = arity - v->u.pap.n;
+    const char *fname = NULL;
+    if (f->kind == V_FUNC) {
+      if (f->u.fn.kind == F_CON) fname = f->u.fn.u.con->name;
+      else if (f->u.fn.kind == F_BUILTIN) fname = f->u.fn.u.bi->name;
+      else if (f->u.fn.u.def->name) fname = f->u.fn.u.def->name->name;
+    }
+    if (fname)
+      snprintf(buf, n, "a function of %d more argument%s (%s given %d of %d)",
+               left, plural(left), fname, v->u.pap.n, arity);
+    else
+      snprintf(buf, n, "a function of %d more argument%s", left,
+               plural(left));
+    return;
+  }
+  default:
+    break;
+  }
+  snprintf(buf, n, "%s", val_describe(v));
+}
+
+void interp_set_warn_shadow(Interp *I, int on) { I->warn_shadow = on; }
 
 int interp_has_global(Interp *I, const char *name) {
   Sym *s = sym_intern(I, name, (int)strlen(name));
@@ -445,7 +755,14 @@ Interp *interp_new(void (*install)(Interp *I)) {
     exit(2);
   }
   for (size_t h = 0; h < I->symcap; h++)
-    for (Sym *s = I->symtab[h]; s; s = s->next) s->prelude_value = s->global;
+    for (Sym *s = I->symtab[h]; s; s = s->next) {
+      s->prelude_value = s->global;
+      s->prelude_def = s->def;
+      s->prelude_sig = s->sig;
+      s->prelude_doc = s->doc;
+      s->prelude_example = s->example;
+      s->prelude_pos = s->def_pos;
+    }
   return I;
 }
 

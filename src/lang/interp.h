@@ -167,6 +167,32 @@ void interp_list_limits(Interp *I, FILE *out);
 
 const char *interp_version(void);
 
+/* :info NAME: what kind of name it is (constructor, built-in, prelude
+   function, your definition), its arity, where it was defined, its
+   signature, doc and example, to out. :doc NAME: the signature, doc and
+   example only. An unknown name: a message on stderr and -1. */
+int interp_info(Interp *I, FILE *out, const char *name);
+int interp_doc(Interp *I, FILE *out, const char *name);
+/* Forget the definitions that the run of file (a path as given to
+   interp_run_file) made: a name that shadowed a built-in or the prelude's
+   gets the original back; the others are undefined (code still using
+   them says "unknown name" when it runs). Type declarations' constructors
+   stay. Returns how many names were removed. */
+int interp_unload(Interp *I, const char *file);
+/* The signature written for name (name :: type), or NULL. */
+const char *interp_signature(Interp *I, const char *name);
+/* What can be known of a value's type, forcing it to weak-head normal
+   form (and a list's first element): "a Real", "a 3-tuple", "a function
+   of 2 arguments (f)", "a SceneObject, made by the constructor Rounded".
+   qcs is dynamically typed: this is the value's kind, not a static type.
+   Raises errors (call it inside an item, e.g. interp_run_item). */
+struct Value;
+void interp_describe(Interp *I, struct Value *v, char *buf, size_t n);
+
+/* Warn, once per name, when a definition shadows a built-in or prelude
+   name (the REPL turns it on; scripts run by qcs FILE stay quiet). */
+void interp_set_warn_shadow(Interp *I, int on);
+
 /* Is there a top-level value called name? */
 int interp_has_global(Interp *I, const char *name);
 

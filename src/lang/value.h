@@ -47,6 +47,16 @@ struct Sym {
   const char *sig;     /* type signature text */
   Pos def_pos;         /* where it was defined (for "already defined") */
   const char *def_file;/* which run defined it */
+  const char *doc;     /* one line for :doc and :info ("// doc:" above the
+                          definition, or a built-in's table entry) */
+  const char *example; /* an expression showing it ("// e.g."), or NULL */
+  int builtin;         /* a built-in (written in C) */
+  int shadow_warned;   /* a user definition that shadows a built-in or a
+                          prelude name has been warned about */
+  /* As the prelude left them, for :unload of a file that shadowed it. */
+  Def *prelude_def;
+  const char *prelude_sig, *prelude_doc, *prelude_example;
+  Pos prelude_pos;
 };
 
 typedef enum {
@@ -81,7 +91,7 @@ struct Value {
       Env *env;
     } fn;
     struct { Value *fn; int n; Value **args; } pap; /* V_PAP, V_APTHUNK */
-    struct { Expr *e; Env *env; } thunk;
+    struct { Expr *e; Env *env; const Pos *origin; } thunk; /* origin: see Interp.origin */
     struct { Pat *pat; Sym *var; Value *whole; } patsel;
     struct { void *ptr; const char *tag; } foreign;
   } u;
@@ -133,6 +143,11 @@ struct Interp {
   int max_spp;               /* max-spp: samples per pixel of a render */
   int digits;                /* :set digits: significant digits of printed
                                 Reals; 0 = the shortest that reads back */
+  const Pos *origin;         /* the call from the user's code that led
+                                into the prelude code now running (a
+                                thunk made by the prelude keeps the one in
+                                force when it was made): errors raised in
+                                the prelude are reported there */
   Pos item_pos;              /* the top-level item being run, for errors
                                 found where no position is at hand */
   TraceEntry trace[TRACE_MAX];
@@ -149,6 +164,8 @@ struct Interp {
   Pos warned[64];            /* warnings already given (said once each) */
   int nwarned;
   const char *run_name;      /* the file currently being run */
+  int warn_shadow;           /* warn of definitions that shadow a
+                                built-in or prelude name (the REPL) */
   const Src *prelude_src;    /* the prelude's source, for its own scope */
   int loading_prelude;
   Value *v_true, *v_false, *v_nil;

@@ -6,11 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/soft.h"
 #include "core/vec.h"
 
 
 /* The primitives in the renderer's order (the top-level union, a before
-   b, Empty skipped), boxed by render_node_box; an explicit stack. */
+   b, Empty skipped), boxed by render_node_box (a soft object by
+   soft_surface_bounds: where its surface can be); an explicit stack. */
 int camera_scene_box(const Scene *s, double lo[3], double hi[3]) {
   int local[32], *st = local, cap = 32, n = 0, any = 0;
   double blo[3] = {INFINITY, INFINITY, INFINITY};
@@ -39,7 +41,12 @@ int camera_scene_box(const Scene *s, double lo[3], double hi[3]) {
     }
     if (nd->kind == SC_EMPTY) continue;
     double plo[3], phi[3];
-    if (!render_node_box(s, node, plo, phi)) continue; /* unbounded */
+    /* a soft object by where its surface can be, not by its keys' reach */
+    if (nd->kind == SC_SOFT) {
+      if (!soft_surface_bounds(nd->soft, plo, phi)) continue;
+    } else if (!render_node_box(s, node, plo, phi)) {
+      continue; /* unbounded */
+    }
     for (int i = 0; i < 3; i++) {
       blo[i] = fmin(blo[i], plo[i]);
       bhi[i] = fmax(bhi[i], phi[i]);

@@ -10,7 +10,8 @@
  *
  * Framing. The framed box is camera_scene_box's: the union of the boxes
  * of the scene's bounded primitives (the top-level union split as the
- * renderer splits it; an unbounded floor does not count), or the unit
+ * renderer splits it; an unbounded floor does not count; a soft object
+ * boxed by soft_surface_bounds, where its surface can be), or the unit
  * box [0, 1]^3 if there are none. The eye looks at the box's centre from
  * the direction (0.45, 0.6, 1), far enough that the bounding sphere
  * (radius R, half the diagonal, at least 1e-9) fits the vertical field

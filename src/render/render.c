@@ -762,8 +762,16 @@ void render_defaults(RenderSettings *rs) {
 static int setup_camera(Tracer *T, char *err, size_t errlen) {
   const RenderSettings *rs = T->rs;
   Box all = box_empty();
-  for (int i = 0; i < T->nprims; i++)
-    if (T->prims[i].bounded) all = box_union(all, T->prims[i].box);
+  for (int i = 0; i < T->nprims; i++) {
+    if (!T->prims[i].bounded) continue;
+    const ScNode *nd = &T->s->nodes[T->prims[i].node];
+    Box b = T->prims[i].box;
+    /* a soft object is framed by where its surface can be (as
+       camera_scene_box does), not by its keys' reach */
+    if (nd->kind == SC_SOFT && !soft_surface_bounds(nd->soft, b.lo, b.hi))
+      continue;
+    all = box_union(all, b);
+  }
   if (camera_setup(&T->cam, rs, !box_is_empty(&all), all.lo, all.hi, err, errlen))
     return -1;
   const double *eye = T->cam.eye, *c = T->cam.centre;

@@ -430,6 +430,63 @@ static void test_field(void)
   soft_free(o);
 }
 
+/* soft_surface_bounds is conservative: no point with field >= magic lies
+ * outside it, over clouds of mixed keys (spheres, ellipsoids, negative
+ * weights), dense and sparse, and magic from 0.05 to 2. */
+static void test_surface_bounds(void)
+{
+  soft_key one = {0};
+  one.kind = SOFT_SPHERE;
+  one.R = 2;
+  one.w = 1;
+  soft_obj *o;
+  size_t bad;
+  double lo[3], hi[3];
+  int ok = soft_build(&one, 1, 0.5, &o, &bad) == SOFT_OK &&
+           soft_surface_bounds(o, lo, hi);
+  /* C(1/4) = 1/2: the surface is at r = R / 2 */
+  CHECK("surface bounds: a lone key of weight 1, magic 0.5: radius R / 2",
+        ok && fabs(hi[0] - 1) < 1e-6 && fabs(lo[2] + 1) < 1e-6);
+  if (o) soft_free(o);
+  static const double magics[] = {0.05, 0.3, 0.5, 1, 2};
+  int out = 0, inside = 0;
+  double shrink = 0;
+  for (int trial = 0; trial < 20; trial++) {
+    tkey tk[40];
+    double off[3] = {0, 0, 0};
+    int nk = trial % 2 ? 40 : 10; /* dense or sparse */
+    make_cloud(tk, nk, off, trial % 3 != 0, 1);
+    double magic = magics[trial % 5];
+    o = build(tk, nk, magic);
+    if (!o) { out++; continue; }
+    double blo[3], bhi[3];
+    if (soft_bounds(o, blo, bhi)) {
+      int has = soft_surface_bounds(o, lo, hi);
+      double vb = 1, vs = 1;
+      for (int a = 0; a < 3; a++) {
+        vb *= bhi[a] - blo[a];
+        vs *= has ? hi[a] - lo[a] : 0;
+      }
+      shrink += vs / vb;
+      for (int i = 0; i < 20000; i++) {
+        double p[3];
+        for (int a = 0; a < 3; a++) p[a] = blo[a] + rnd() * (bhi[a] - blo[a]);
+        if (soft_field(o, p) >= magic) {
+          inside++;
+          for (int a = 0; a < 3; a++)
+            if (!has || p[a] < lo[a] || p[a] > hi[a]) { out++; break; }
+        }
+      }
+    }
+    soft_free(o);
+  }
+  char name[200];
+  snprintf(name, sizeof name, "surface bounds: all of %d sampled points with "
+           "field >= magic inside (20 clouds; mean volume %.2f of soft_bounds')",
+           inside, shrink / 20);
+  CHECK(name, out == 0 && inside > 1000);
+}
+
 static void cloud_rays(const char *what, tkey *tk, int n, double magic,
                        const double off[3], int nrays, double dscale)
 {
@@ -715,6 +772,7 @@ int main(void)
   check_prefix = "soft";
   test_build();
   test_field();
+  test_surface_bounds();
   test_clouds();
   test_helix();
   test_magic_extremes();
