@@ -260,11 +260,15 @@ $(BUILD)/fuzz/fuzz_%: fuzz/fuzz_%.c fuzz/fuzz.h $(LAYER_LIBS)
 	@mkdir -p $(BUILD)/fuzz
 	$(CC) $(ALL_CFLAGS) -fsanitize=fuzzer -Ifuzz -o $@ $< $(LAYER_LIBS) $(LIBS)
 
+# import "NAME" looks in $(PREFIX)/share/qcs last (after QCS_PATH).
+$(BUILD)/lang/interp.o: ALL_CFLAGS += -DQCS_LIBDIR='"$(PREFIX)/share/qcs"'
+
 install: qcs
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/qcs \
 	  $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 755 qcs $(DESTDIR)$(PREFIX)/bin/qcs
 	install -m 644 stdlib/prelude.qcs $(DESTDIR)$(PREFIX)/share/qcs/prelude.qcs
+	install -m 644 examples/parts/*.qcs $(DESTDIR)$(PREFIX)/share/qcs/
 	install -m 644 doc/qcs.1 $(DESTDIR)$(PREFIX)/share/man/man1/qcs.1
 
 uninstall:

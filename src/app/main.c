@@ -58,6 +58,11 @@ typedef struct Options {
   int view;                /* qcs view: files[0] is followed */
   ViewOptions vopt;
   char *stack_base;        /* the interpreter thread's, for qcs view */
+  int params;              /* qcs params: files[0]'s parameters */
+  int frames;              /* --frames A-B[:STEP] given */
+  int f_first, f_last, f_step;
+  int animation;           /* --animation F-L given (else: --frames A-B) */
+  int a_first, a_last;
 } Options;
 
 static double now(void) {
@@ -107,6 +112,7 @@ static void usage(FILE *out) {
           "  qcs FILE...         run scripts (top-level expressions are printed)\n"
           "  qcs -e EXPR         evaluate EXPR with the prelude loaded and print it\n"
           "  qcs view FILE       a live view in the browser (qcs view --help)\n"
+          "  qcs params FILE     list FILE's parameters (for --set)\n"
           "\n"
           "options:\n"
           "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
@@ -120,6 +126,10 @@ static void usage(FILE *out) {
           "  --tolerance T       root tolerance, a distance (default 1e-9)\n"
           "  --cost              add the root-finder cost channel to an EXR\n"
           "  --float             EXR colour as 32-bit floats (default half)\n"
+          "  --frames A-B[:STEP] render frames A to B of an animation (frame\n"
+          "                      and clock); -o out.####.png numbers the files\n"
+          "  --animation F-L     the whole animation's frames, over which clock\n"
+          "                      runs from 0 to 1 (default: the --frames range)\n"
           "  --show              draw what the scripts render in the terminal,\n"
           "                      coarse first, instead of writing files\n"
           "  --preview MODE      how: auto (default), kitty, iterm, sixel,\n"
@@ -176,6 +186,103 @@ static Interp *view_interp(void *ud) {
   return I ? I : bind_interp_new();
 }
 
+/* ---- animation: --frames A-B[:STEP], --animation F-L ---- */
+
+/* "A-B[:STEP]" (or "A") into first, last, step; -1 if malformed. */
+static int parse_frames(const char *t, int *first, int *last, int *step,
+                        int allow_step) {
+  char *end;
+  long a = strtol(t, &end, 10), b = a, s = 1;
+  if (end == t || a < 0 || a > 999999999) return -1;
+  if (*end == '-') {
+    const char *u = end + 1;
+    b = strtol(u, &end, 10);
+    if (end == u || b < 0 || b > 999999999) return -1;
+  }
+  if (*end == ':' && allow_step) {
+    const char *u = end + 1;
+    s = strtol(u, &end, 10);
+    if (end == u || s < 1 || s > 999999999) return -1;
+  }
+  if (*end || b < a) return -1;
+  *first = (int)a;
+  *last = (int)b;
+  *step = (int)s;
+  return 0;
+}
+
+/* Parses --frames or --animation's argument into o; 0, or -1 (said). */
+static int frames_option(Options *o, const char *opt, const char *arg) {
+  int frames = !strcmp(opt, "--frames"), step = 1;
+  if (!arg || parse_frames(arg, frames ? &o->f_first : &o->a_first,
+                           frames ? &o->f_last : &o->a_last, &step,
+                           frames)) {
+    fprintf(stderr, "qcs: error: %s needs %s, like %s, not '%s'\n", opt,
+            frames ? "FIRST-LAST[:STEP] (frame numbers, LAST >= FIRST)"
+                   : "FIRST-LAST (frame numbers, LAST >= FIRST)",
+            frames ? "1-100 or 1-100:5" : "1-100", arg ? arg : "nothing");
+    return -1;
+  }
+  if (frames) o->frames = 1, o->f_step = step;
+  else o->animation = 1;
+  return 0;
+}
+
+/* After all options: the frames rendered must lie in the animation. */
+static int frames_check(Options *o) {
+  if (o->animation && !o->frames) {
+    o->frames = 1;
+    o->f_first = o->a_first;
+    o->f_last = o->a_last;
+    o->f_step = 1;
+  }
+  if (!o->frames) return 0;
+  if (!o->animation) o->a_first = o->f_first, o->a_last = o->f_last;
+  if (o->f_first < o->a_first || o->f_last > o->a_last) {
+    fprintf(stderr, "qcs: error: --frames %d-%d is not within the animation's "
+            "frames %d-%d (--animation)\n", o->f_first, o->f_last,
+            o->a_first, o->a_last);
+    return -1;
+  }
+  if (o->nfiles == 0) {
+    fprintf(stderr, "qcs: error: --frames needs a scene file\n");
+    return -1;
+  }
+  o->render.animating = 1;
+  return 0;
+}
+
+/* Runs the scripts (and -e) once per frame: the first frame evaluates
+   them; later ones re-bind frame and clock and evaluate again what depends
+   on them, then every top-level expression. 0, or 1 after an error. */
+static int run_scripts(Options *o, Interp *I) {
+  int first = o->frames ? o->f_first : 0, last = o->frames ? o->f_last : 0;
+  int step = o->frames ? o->f_step : 1;
+  for (int f = first; f <= last; f += step) {
+    int before = o->render.renders;
+    if (o->frames) {
+      double clock = o->a_last == o->a_first ? 0.0 :
+          (double)(f - o->a_first) / (double)(o->a_last - o->a_first);
+      o->render.frame = f;
+      interp_set_frame(I, (double)f, clock);
+    }
+    if (f == first) {
+      for (int i = 0; i < o->nfiles; i++)
+        if (interp_run_file(I, o->files[i]) != RUN_OK) return 1;
+    } else if (interp_rerun(I) != RUN_OK) {
+      return 1;
+    }
+    for (int i = 0; i < o->nexprs; i++)
+      if (interp_eval_print(I, o->exprs[i]) != RUN_OK) return 1;
+    /* -o or --show with scripts that render nothing: their `scene`. */
+    if ((o->render.output || o->show) && o->render.renders == before &&
+        render_lang_scene(I, o->render.output ? o->render.output : "scene") !=
+            RUN_OK)
+      return 1;
+  }
+  return 0;
+}
+
 static void *run(void *arg) {
   Options *o = arg;
   char probe;
@@ -200,20 +307,11 @@ static void *run(void *arg) {
     o->render.capture = show_capture;
     o->render.capture_ctx = o;
   }
-  for (int i = 0; i < o->nfiles; i++)
-    if (interp_run_file(I, o->files[i]) != RUN_OK) {
-      o->status = 1;
-      return NULL;
-    }
-  for (int i = 0; i < o->nexprs; i++)
-    if (interp_eval_print(I, o->exprs[i]) != RUN_OK) {
-      o->status = 1;
-      return NULL;
-    }
-  /* -o or --show with scripts that render nothing: their `scene`. */
-  if ((o->render.output || o->show) && o->render.renders == 0 &&
-      render_lang_scene(I, o->render.output ? o->render.output : "scene") !=
-          RUN_OK) {
+  if (o->params) {
+    o->status = interp_params(I, o->files[0], stdout) != RUN_OK;
+    return NULL;
+  }
+  if (run_scripts(o, I)) {
     o->status = 1;
     return NULL;
   }
@@ -329,6 +427,22 @@ static int view_args(int argc, char **argv, Options *o) {
   return 0;
 }
 
+/* qcs params FILE: the table of FILE's parameters. -1: exit 1, 1: exit
+   0, 0: run. */
+static int params_args(int argc, char **argv, Options *o) {
+  if (argc == 3 && strcmp(argv[2], "-h") && strcmp(argv[2], "--help")) {
+    o->params = 1;
+    o->files[o->nfiles++] = argv[2];
+    return 0;
+  }
+  int help = argc == 3;
+  fputs("usage: qcs params FILE.qcs\n\nList the parameters FILE declares "
+        "(`param NAME = DEFAULT in [LOW, HIGH] \"DOC\"`),\nwhich --set "
+        "NAME=VALUE may change: name, default, range, doc.\n",
+        help ? stdout : stderr);
+  return help ? 1 : -1;
+}
+
 int main(int argc, char **argv) {
   static Options o;
   o.t_start = now();
@@ -344,6 +458,10 @@ int main(int argc, char **argv) {
     }
     return conv_report(stdout) ? 1 : 0;
   }
+  if (argc > 1 && !strcmp(argv[1], "params")) {
+    int rc = params_args(argc, argv, &o);
+    if (rc) return rc < 0 ? 1 : 0;
+  }
   int sub = argc > 1 && !strcmp(argv[1], "tradeoff");
   if (sub) {
     int rc = tradeoff_args(argc, argv, &o);
@@ -354,6 +472,7 @@ int main(int argc, char **argv) {
     if (rc) return rc < 0 ? 1 : 0;
     sub = 1;
   }
+  if (o.params) sub = 1;
   for (int i = 1; i < argc && !sub; i++) {
     const char *a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -487,6 +606,9 @@ int main(int argc, char **argv) {
       i++;
     } else if (!strcmp(a, "--float")) {
       o.render.float_pixels = 1;
+    } else if (!strcmp(a, "--frames") || !strcmp(a, "--animation")) {
+      if (frames_option(&o, a, i + 1 < argc ? argv[i + 1] : NULL)) return 1;
+      i++;
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "qcs: error: unknown option '%s' (see qcs --help)\n", a);
       return 1;
@@ -494,6 +616,7 @@ int main(int argc, char **argv) {
       o.files[o.nfiles++] = argv[i];
     }
   }
+  if (!sub && frames_check(&o)) return 1;
   if (o.render.output && o.nfiles == 0 && o.nexprs == 0) {
     fprintf(stderr, "qcs: error: -o needs a scene file to render\n");
     return 1;

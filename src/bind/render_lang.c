@@ -11,6 +11,7 @@
  * is the name of the file written. */
 #include "bind/render_lang.h"
 
+#include <gc.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -180,6 +181,36 @@ void render_lang_settings(Interp *I, Value *settings, Pos pos,
   if (settings) read_settings(I, settings, pos, rs, &quiet, &float_pixels);
 }
 
+const char *render_frame_path(const char *path, int frame) {
+  size_t len = strlen(path), hash_end = 0, hashes = 0;
+  for (size_t i = len; i > 0; i--)
+    if (path[i - 1] == '#') {
+      hash_end = i;
+      while (i > 0 && path[i - 1] == '#') i--, hashes++;
+      break;
+    }
+  size_t before, after;
+  int width;
+  const char *dot = "";
+  if (hashes) {
+    before = hash_end - hashes;
+    after = hash_end;
+    width = (int)hashes;
+  } else {
+    const char *slash = strrchr(path, '/'), *ext = strrchr(path, '.');
+    if (!ext || (slash && ext < slash) || ext == path || ext[-1] == '/')
+      ext = path + len;
+    before = after = (size_t)(ext - path);
+    width = 4;
+    dot = ".";
+  }
+  size_t n = len + 32 + (size_t)width;
+  char *out = GC_MALLOC_ATOMIC(n);
+  snprintf(out, n, "%.*s%s%0*d%s", (int)before, path, dot, width, frame,
+           path + after);
+  return out;
+}
+
 Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
                     Pos pos) {
   RenderSettings rs;
@@ -195,6 +226,7 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
   }
   if (ov) {
     if (ov->output) path = ov->output;
+    if (ov->animating) path = render_frame_path(path, ov->frame);
     if (ov->width) rs.width = ov->width, rs.height = ov->height;
     if (ov->spp) rs.spp = ov->spp;
     if (ov->threads) rs.threads = ov->threads;

@@ -39,7 +39,15 @@ typedef struct RenderOverrides {
                            skipped and give their file name (the REPL's
                            :reload) */
   int skipped;
+  int animating;        /* --frames: every file name gets the frame's number */
+  int frame;            /* the frame being rendered */
 } RenderOverrides;
+
+/* An animation's file name for a frame: the last run of '#' in path
+   replaced by the frame number, zero-padded to the run's length
+   (out.####.png, frame 5: out.0005.png); a path without '#' gets
+   .NNNN before its extension (out.png: out.0005.png). In the GC heap. */
+const char *render_frame_path(const char *path, int frame);
 
 void render_install(Interp *I);
 /* The conventions (render_defaults) with a settings list applied (NULL:

@@ -112,6 +112,10 @@ struct Def {
      guard_pos is then where its first guard's '|' stood, if it has one (a
      pattern binding takes none). */
   Pos guard_pos;
+  /* A top-level definition: the globals its clauses name (resolve.c), so
+     that an animation re-evaluates only what depends on frame and clock. */
+  int nuses;
+  Sym **uses;
 };
 
 /* Type declarations: constructors with their arities. */
@@ -121,7 +125,15 @@ typedef struct ConDecl {
   int arity;
 } ConDecl;
 
-typedef enum { ITEM_DEF, ITEM_EXPR, ITEM_TYPE, ITEM_SIG } ItemKind;
+typedef enum { ITEM_DEF, ITEM_EXPR, ITEM_TYPE, ITEM_SIG, ITEM_IMPORT } ItemKind;
+
+/* `param NAME = DEFAULT [in [LO, HI]] ["DOC"]`: an ITEM_DEF of NAME with
+   this attached (interp.c checks --set values against it). */
+typedef struct Param {
+  Expr *lo, *hi;      /* the range, or NULL */
+  const char *doc;    /* the doc string, or NULL */
+  const char *text;   /* the default's source text, for qcs params */
+} Param;
 
 typedef struct Item {
   ItemKind kind;
@@ -133,6 +145,8 @@ typedef struct Item {
   ConDecl *cons;
   Sym *signame;       /* ITEM_SIG */
   const char *sigtext;
+  Param *param;       /* ITEM_DEF made by `param` */
+  const char *import; /* ITEM_IMPORT: the path as written */
 } Item;
 
 #endif

@@ -9,6 +9,7 @@
 
 #include <errno.h>
 #include <gc.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -206,10 +207,236 @@ static void warn_shadow(Interp *I, Sym *s, Pos pos) {
               "on (the prelude's own functions keep the original)", s->name,
               s->builtin ? "built-in" : "prelude's", s->name);
 }
+/* ---- growing arrays (GC heap) ---- */
+
+static void *grow(void *a, int n, int *cap, size_t size) {
+  if (n < *cap) return a;
+  int nc = *cap ? 2 * *cap : 8;
+  void *b = GC_MALLOC(size * (size_t)nc);
+  if (n) memcpy(b, a, size * (size_t)n);
+  *cap = nc;
+  return b;
+}
+
+static char *gc_strdup(const char *t) {
+  char *c = GC_MALLOC_ATOMIC(strlen(t) + 1);
+  strcpy(c, t);
+  return c;
+}
+
+/* ---- parameters ---- */
+
+static int same_kind(Value *a, Value *b) {
+  int la = a->kind == V_NIL || a->kind == V_CONS;
+  int lb = b->kind == V_NIL || b->kind == V_CONS;
+  if (la || lb) return la && lb;
+  int fa = a->kind == V_FUNC || a->kind == V_PAP;
+  int fb = b->kind == V_FUNC || b->kind == V_PAP;
+  if (fa || fb) return fa && fb;
+  if (a->kind != b->kind) return 0;
+  if (a->kind == V_TUPLE) return a->u.tup.n == b->u.tup.n;
+  if (a->kind == V_CON) return a->u.con.con->con_type == b->u.con.con->con_type;
+  return 1;
+}
+
+/* The range of a parameter, evaluated: lo and hi. */
+static void param_range(Interp *I, const Param *pm, double *lo, double *hi) {
+  *lo = force_num(I, eval(I, pm->lo, NULL), pm->lo->pos,
+                  "the low end of a parameter's range");
+  *hi = force_num(I, eval(I, pm->hi, NULL), pm->hi->pos,
+                  "the high end of a parameter's range");
+  if (!(*lo <= *hi))
+    qcs_error(pm->lo->pos, "a parameter's range [LOW, HIGH] needs LOW <= "
+              "HIGH, not [%g, %g]", *lo, *hi);
+}
+
+static void record_param(Interp *I, Sym *s, const Param *pm) {
+  int known = s->param != NULL;
+  s->param = pm;
+  if (known) return;
+  I->params = grow(I->params, I->nparams, &I->capparams, sizeof(Sym *));
+  I->params[I->nparams++] = s;
+}
+
+/* A declared parameter's default must lie in its range. */
+static void check_default(Interp *I, Sym *s, Def *d) {
+  const Param *pm = s->param;
+  if (!pm->lo) return;
+  double lo, hi;
+  param_range(I, pm, &lo, &hi);
+  Value *v = force(I, eval_global_value(I, d));
+  if (v->kind != V_NUM)
+    qcs_error(d->clauses[0]->bodies[0]->pos, "parameter %s has a range, so "
+              "its default must be a number, not %s", s->name,
+              val_describe(v));
+  if (!(v->u.num >= lo && v->u.num <= hi))
+    qcs_error(d->clauses[0]->bodies[0]->pos, "the default %g of parameter %s "
+              "is outside its range [%g, %g]", v->u.num, s->name, lo, hi);
+}
+
+/* Every --set must name a declared parameter, with a value of the
+   default's kind, within its range; checked once the first script's
+   definitions are in, before any of its expressions run. */
+static void check_sets(Interp *I, const char *runname) {
+  I->sets_pending = 0;
+  for (int i = 0; i < I->nset_syms; i++) {
+    Sym *s = I->set_syms[i];
+    if (s->set_checked) continue;
+    const char *best = NULL;
+    int bestd = (int)strlen(s->name) / 2 + 1;
+    if (bestd > 4) bestd = 4;
+    for (int j = 0; j < I->nparams; j++) {
+      int d = edit_distance(s->name, I->params[j]->name);
+      if (d < bestd) bestd = d, best = I->params[j]->name;
+    }
+    if (best)
+      qcs_error(pos_none, "--set %s: %s declares no parameter %s (did you "
+                "mean %s?)", s->name, runname, s->name, best);
+    if (I->nparams == 0)
+      qcs_error(pos_none, "--set %s: %s declares no parameters (declare one "
+                "with `param %s = DEFAULT`)", s->name, runname, s->name);
+    char names[400];
+    size_t k = 0;
+    names[0] = 0;
+    for (int j = 0; j < I->nparams && k < sizeof names - 40; j++)
+      k += (size_t)snprintf(names + k, sizeof names - k, "%s%s",
+                            j ? ", " : "", I->params[j]->name);
+    qcs_error(pos_none, "--set %s: %s declares no parameter %s (its "
+              "parameters: %s)", s->name, runname, s->name, names);
+  }
+  for (int i = 0; i < I->nset_syms; i++) {
+    Sym *s = I->set_syms[i];
+    const Param *pm = s->param;
+    Value *v = force(I, s->global);
+    Value *dv = force(I, eval_global_value(I, s->def));
+    Pos at = s->set_expr->pos;
+    if (pm->lo) {
+      double lo, hi;
+      param_range(I, pm, &lo, &hi);
+      if (v->kind != V_NUM)
+        qcs_error(at, "parameter %s (%s:%d) takes a number in [%g, %g], not "
+                  "%s", s->name, s->def_pos.src->name, s->def_pos.line, lo, hi,
+                  val_describe(v));
+      if (!(v->u.num >= lo && v->u.num <= hi))
+        qcs_error(at, "%g is outside the range [%g, %g] of parameter %s "
+                  "(%s:%d)", v->u.num, lo, hi, s->name, s->def_pos.src->name,
+                  s->def_pos.line);
+    } else if (!same_kind(v, dv)) {
+      qcs_error(at, "parameter %s (%s:%d) takes %s like its default %s, not "
+                "%s", s->name, s->def_pos.src->name, s->def_pos.line,
+                val_describe(dv), pm->text, val_describe(v));
+    }
+  }
+}
+
+/* ---- imports ---- */
 
 static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
-                           const char *runname) {
+                           const char *runname, int imported);
+
+#ifndef QCS_LIBDIR
+#define QCS_LIBDIR "/usr/local/share/qcs"
+#endif
+
+/* Where `import "NAME"` finds NAME: beside the importing file, then in
+   each folder of QCS_PATH (':'-separated), then in QCS_LIBDIR (where make
+   install puts the prelude and the example parts). NULL if nowhere; the
+   folders tried are listed in tried. */
+static char *find_import(const char *importer, const char *name, char *tried,
+                         size_t tn) {
+  size_t k = 0;
+  tried[0] = 0;
+  if (name[0] == '/') {
+    snprintf(tried, tn, "%s", name);
+    return access(name, R_OK) == 0 ? gc_strdup(name) : NULL;
+  }
+  char dir[PATH_MAX];
+  const char *slash = importer[0] == '<' ? NULL : strrchr(importer, '/');
+  if (slash) snprintf(dir, sizeof dir, "%.*s", (int)(slash - importer),
+                      importer);
+  else snprintf(dir, sizeof dir, ".");
+  const char *env = getenv("QCS_PATH");
+  char list[4 * PATH_MAX];
+  snprintf(list, sizeof list, "%s:%s:%s", dir, env ? env : "", QCS_LIBDIR);
+  for (char *d = list, *e; d; d = e) {
+    e = strchr(d, ':');
+    if (e) *e++ = 0;
+    if (!*d) continue;
+    size_t pl = strlen(d) + strlen(name) + 2;
+    char *path = GC_MALLOC_ATOMIC(pl);
+    if (d == list && !slash) snprintf(path, pl, "%s", name);
+    else snprintf(path, pl, "%s/%s", d, name);
+    if (access(path, R_OK) == 0) return path;
+    if (k < tn)
+      k += (size_t)snprintf(tried + k, tn - k, "%s%s", k ? ", " : "", d);
+  }
+  return NULL;
+}
+
+static char *read_file(const char *path, size_t *len);
+
+static void push_file(Interp *I, const char *real, const char *shown) {
+  int cap = I->capfiles;
+  I->files = grow(I->files, I->nfiles, &cap, sizeof(char *));
+  I->shown = grow(I->shown, I->nfiles, &I->capfiles, sizeof(char *));
+  I->files[I->nfiles] = gc_strdup(real);
+  I->shown[I->nfiles++] = gc_strdup(shown);
+}
+
+/* import "NAME": runs the file once (its definitions, types and
+   parameters; its top-level expressions are checked, not run). */
+static void run_import(Interp *I, Item *it, const char *runname) {
+  char tried[1024];
+  char *path = find_import(runname, it->import, tried, sizeof tried);
+  if (!path)
+    qcs_error(it->pos, "cannot find \"%s\" to import (looked in %s)",
+              it->import, tried);
+  char *real = realpath(path, NULL);
+  if (!real)
+    qcs_error(it->pos, "cannot import %s: %s", path, strerror(errno));
+  char *r = gc_strdup(real);
+  free(real);
+  for (int i = 0; i < I->nfiles; i++)
+    if (!strcmp(I->files[i], r)) {
+      char chain[2048];
+      size_t k = 0;
+      chain[0] = 0;
+      for (int j = i; j < I->nfiles && k < sizeof chain; j++)
+        k += (size_t)snprintf(chain + k, sizeof chain - k, "%s -> ",
+                              I->shown[j]);
+      if (k < sizeof chain) snprintf(chain + k, sizeof chain - k, "%s", path);
+      qcs_error(it->pos, "import cycle: %s", chain);
+    }
+  for (int i = 0; i < I->nimported; i++)
+    if (!strcmp(I->imported[i], r)) return;
+  size_t len;
+  char *text = read_file(path, &len);
+  if (!text) qcs_error(it->pos, "cannot read %s: %s", path, strerror(errno));
+  Src *src = GC_MALLOC(sizeof *src);
+  src->name = path;
+  char *tx = GC_MALLOC_ATOMIC(len + 1);
+  memcpy(tx, text, len + 1);
+  free(text);
+  if (strlen(tx) < len)
+    qcs_error(it->pos, "cannot import %s: it holds a NUL byte", path);
+  src->text = tx;
+  push_file(I, r, path);
+  int n;
+  Item **items = parse_program(I, src, MODE_SCRIPT, &n);
+  run_items(I, items, n, MODE_SCRIPT, path, 1);
+  I->nfiles--;
+  I->imported = grow(I->imported, I->nimported, &I->capimported,
+                     sizeof(char *));
+  I->imported[I->nimported++] = r;
+}
+
+/* ---- running items ---- */
+
+static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
+                           const char *runname, int imported) {
   int runid = ++run_counter;
+  for (int i = 0; i < n; i++)
+    if (items[i]->kind == ITEM_IMPORT) run_import(I, items[i], runname);
   /* Duplicate definitions within one script are mistakes. */
   for (int i = 0; i < n; i++) {
     if (items[i]->kind != ITEM_DEF) continue;
@@ -226,6 +453,21 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
     if (items[i]->kind == ITEM_DEF && items[i]->def->name->con_arity >= 0)
       qcs_error(items[i]->def->pos, "'%s' is a constructor; a function needs "
                 "another name", items[i]->def->name->name);
+  /* An imported definition may not clash with another file's: the
+     importer's own, or another import's. */
+  if (mode == MODE_SCRIPT && !I->loading_prelude)
+    for (int i = 0; i < n; i++) {
+      if (items[i]->kind != ITEM_DEF) continue;
+      Def *d = items[i]->def;
+      Sym *s = d->name;
+      if (!s->def || !s->user || s->overridden) continue;
+      if ((s->imported && s->imported != runname) ||
+          (imported && s->def_file != runname))
+        qcs_error(d->pos, "%s is defined here and at %s:%d:%d%s; rename one "
+                  "of them", s->name, s->def_pos.src ? s->def_pos.src->name
+                  : "?", s->def_pos.line, s->def_pos.col,
+                  s->imported ? " (imported)" : "");
+    }
   resolve_items(I, items, n);
   int redefined = 0;
   for (int i = 0; i < n; i++) {
@@ -234,7 +476,18 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
       it->signame->sig = it->sigtext;
     } else if (it->kind == ITEM_DEF) {
       Sym *s = it->def->name;
-      if (s->overridden) continue;
+      if (s->overridden) {
+        if (!it->param)
+          qcs_error(it->def->pos, "--set %s: %s is defined here but is not "
+                    "a parameter (declare it with `param %s = ...`)", s->name,
+                    s->name, s->name);
+        s->def = it->def;
+        s->def_pos = it->def->pos;
+        s->def_file = runname;
+        s->set_checked = 1;
+        record_param(I, s, it->param);
+        continue;
+      }
       if (s->def && s->user) redefined = 1;
       warn_shadow(I, s, it->def->pos);
       s->def = it->def;
@@ -243,12 +496,26 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
       s->def_pos = it->def->pos;
       s->def_file = runname;
       read_doc(s, it->def->pos);
+      s->imported = imported ? runname : NULL;
+      if (it->param) {
+        record_param(I, s, it->param);
+        check_default(I, s, it->def);
+      } else {
+        s->param = NULL;
+      }
       (void)runid;
     }
   }
   if (redefined && mode == MODE_REPL) refresh_values(I);
+  if (I->sets_pending && !imported && !I->loading_prelude)
+    check_sets(I, runname);
+  if (imported || I->declare_only) return RUN_OK;
   for (int i = 0; i < n; i++) {
     if (items[i]->kind != ITEM_EXPR) continue;
+    if (mode == MODE_SCRIPT) {
+      I->anim = grow(I->anim, I->nanim, &I->capanim, sizeof(Item *));
+      I->anim[I->nanim++] = items[i];
+    }
     /* max-steps counts per top-level expression */
     I->steps = 0;
     I->item_pos = items[i]->expr->pos;
@@ -275,16 +542,17 @@ RunStatus interp_run_string(Interp *I, const char *name, const char *text,
   src->text = tx;
   if (I->loading_prelude) I->prelude_src = src;
   I->item_pos = pos_none;
-  int nforcing = I->nforcing;
+  int nforcing = I->nforcing, nfiles = I->nfiles;
   ErrFrame f;
   if (ERR_TRY(f)) {
     int n;
     Item **items = parse_program(I, src, mode, &n);
-    RunStatus st = run_items(I, items, n, mode, nm);
+    RunStatus st = run_items(I, items, n, mode, nm, 0);
     err_pop(&f);
     return st;
   }
   err_pop(&f);
+  I->nfiles = nfiles;
   fflush(stdout);
   if (err_info()->incomplete && mode == MODE_REPL) {
     unwind(I, nforcing);
@@ -347,7 +615,12 @@ RunStatus interp_run_file(Interp *I, const char *path) {
     free(text);
     return RUN_ERROR;
   }
+  char *real = realpath(path, NULL);
+  int nfiles = I->nfiles;
+  push_file(I, real ? real : path, path);
+  free(real);
   RunStatus st = interp_run_string(I, path, text, MODE_SCRIPT);
+  I->nfiles = nfiles;
   free(text);
   return st;
 }
@@ -364,7 +637,7 @@ RunStatus interp_eval_print(Interp *I, const char *text) {
   if (ERR_TRY(f)) {
     int n;
     Item **items = parse_program(I, src, MODE_REPL, &n);
-    RunStatus st = run_items(I, items, n, MODE_REPL, "<-e>");
+    RunStatus st = run_items(I, items, n, MODE_REPL, "<-e>", 0);
     err_pop(&f);
     return st;
   }
@@ -440,14 +713,118 @@ RunStatus interp_set_override(Interp *I, const char *name, const char *expr) {
     Sym *s = sym_intern(I, name, (int)strlen(name));
     if (s->con_arity >= 0)
       qcs_error(pos_none, "--set cannot replace the constructor %s", name);
+    if (!s->overridden) {
+      if (I->nset_syms == 64) qcs_error(pos_none, "too many --set options");
+      I->set_syms[I->nset_syms++] = s;
+    }
     s->global = delay(I, e, NULL);
     s->overridden = 1;
     s->user = 1;
+    s->set_expr = e;
+    I->sets_pending = 1;
     err_pop(&f);
     return RUN_OK;
   }
   err_pop(&f);
   report_error(I);
+  return RUN_ERROR;
+}
+
+/* ---- qcs params ---- */
+
+static void range_text(Interp *I, const Param *pm, char *buf, size_t n) {
+  buf[0] = 0;
+  if (!pm->lo) return;
+  double lo, hi;
+  param_range(I, pm, &lo, &hi);
+  snprintf(buf, n, "[%.15g, %.15g]", lo, hi);
+}
+
+RunStatus interp_params(Interp *I, const char *path, FILE *out) {
+  I->declare_only = 1;
+  RunStatus st = interp_run_file(I, path);
+  I->declare_only = 0;
+  if (st != RUN_OK) return st;
+  int wn = 4, wd = 7, wr = 5;
+  char range[128];
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    for (int i = 0; i < I->nparams; i++) {
+      Sym *s = I->params[i];
+      if (!s->param) continue;
+      range_text(I, s->param, range, sizeof range);
+      if ((int)strlen(s->name) > wn) wn = (int)strlen(s->name);
+      if ((int)strlen(s->param->text) > wd) wd = (int)strlen(s->param->text);
+      if ((int)strlen(range) > wr) wr = (int)strlen(range);
+    }
+    if (wd > 40) wd = 40;
+    fprintf(out, "%-*s  %-*s  %-*s  %s\n", wn, "name", wd, "default", wr,
+            "range", "doc");
+    for (int i = 0; i < I->nparams; i++) {
+      Sym *s = I->params[i];
+      if (!s->param) continue;
+      range_text(I, s->param, range, sizeof range);
+      fprintf(out, "%-*s  %-*s  %-*s  %s\n", wn, s->name, wd, s->param->text,
+              wr, range, s->param->doc ? s->param->doc : "");
+    }
+    err_pop(&f);
+    return RUN_OK;
+  }
+  err_pop(&f);
+  report_error(I);
+  unwind(I, I->nforcing);
+  return RUN_ERROR;
+}
+
+/* ---- animation ---- */
+
+void interp_set_frame(Interp *I, double frame, double clock) {
+  Sym *sf = sym_intern(I, "frame", 5), *sc = sym_intern(I, "clock", 5);
+  if (!sf->user) sf->global = val_num(frame);
+  if (!sc->user) sc->global = val_num(clock);
+  /* What depends on frame or clock, through any chain of globals: marked
+     by passes until nothing changes (cycles among globals are fine). */
+  int epoch = ++I->anim_epoch, changed = 1;
+  sf->anim_mark = sc->anim_mark = epoch * 2 + 1;
+  while (changed) {
+    changed = 0;
+    for (size_t h = 0; h < I->symcap; h++)
+      for (Sym *s = I->symtab[h]; s; s = s->next) {
+        if (!s->def || !s->user || s->anim_mark == epoch * 2 + 1) continue;
+        for (int i = 0; i < s->def->nuses; i++)
+          if (s->def->uses[i]->anim_mark == epoch * 2 + 1) {
+            s->anim_mark = epoch * 2 + 1;
+            changed = 1;
+            break;
+          }
+      }
+  }
+  for (size_t h = 0; h < I->symcap; h++)
+    for (Sym *s = I->symtab[h]; s; s = s->next)
+      if (s->anim_mark == epoch * 2 + 1 && s->def && s->def->arity == 0 &&
+          !s->overridden && s != sf && s != sc)
+        s->global = eval_global_value(I, s->def);
+}
+
+RunStatus interp_rerun(Interp *I) {
+  int nforcing = I->nforcing;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    for (int i = 0; i < I->nanim; i++) {
+      I->steps = 0;
+      I->item_pos = I->anim[i]->expr->pos;
+      Value *v = eval(I, I->anim[i]->expr, NULL);
+      print_value(I, stdout, v);
+      fputc('\n', stdout);
+      fflush(stdout);
+    }
+    err_pop(&f);
+    return RUN_OK;
+  }
+  err_pop(&f);
+  fflush(stdout);
+  report_error(I);
+  unwind(I, nforcing);
   return RUN_ERROR;
 }
 
@@ -745,6 +1122,20 @@ Interp *interp_new(void (*install)(Interp *I)) {
   I->v_nil = GC_MALLOC(sizeof(Value));
   I->v_nil->kind = V_NIL;
   builtins_install(I);
+  /* The animation's frame and clock (0 outside one): globals the
+     interpreter re-binds per frame (interp_set_frame), documented like
+     the built-ins. */
+  Sym *sf = sym_intern(I, "frame", 5), *sc = sym_intern(I, "clock", 5);
+  sf->global = val_num(0);
+  sf->builtin = 1;
+  sf->doc = "frame: the number of the animation frame being rendered "
+            "(--frames A-B), 0 outside an animation";
+  sf->example = "frame + 1";
+  sc->global = val_num(0);
+  sc->builtin = 1;
+  sc->doc = "clock: 0 at the animation's first frame to 1 at its last "
+            "(--animation F-L), 0 outside an animation";
+  sc->example = "360 * clock";
   if (install) install(I);
   I->loading_prelude = 1;
   RunStatus st = interp_run_string(I, "<prelude>", qcs_prelude_source,

@@ -82,6 +82,20 @@ RunStatus interp_run_item(Interp *I, Pos pos,
    is then ignored. */
 RunStatus interp_set_override(Interp *I, const char *name, const char *expr);
 
+/* qcs params FILE: declares what FILE (and what it imports) defines,
+   running none of its top-level expressions, and prints a table of its
+   parameters (`param`): name, default, range, doc. */
+RunStatus interp_params(Interp *I, const char *path, FILE *out);
+
+/* Animation: binds the globals frame and clock and re-evaluates the
+   top-level definitions that depend on them (through any chain of
+   globals); the others keep their values. Before the scripts run, it only
+   binds the two. */
+void interp_set_frame(Interp *I, double frame, double clock);
+/* Evaluates the scripts' top-level expressions again, in order (the next
+   frame of an animation); they were recorded as the scripts ran. */
+RunStatus interp_rerun(Interp *I);
+
 /* Show values instead of printing them: show(I, v, pos, ud) is called for
    each value of a MODE_REPL entry and returns 1 if it showed it (the REPL's
    pictures of scene objects); NULL: print everything. */

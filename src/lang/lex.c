@@ -209,6 +209,7 @@ static const struct {
     {"where", T_WHERE}, {"let", T_LET},   {"in", T_IN},     {"if", T_IF},
     {"then", T_THEN},   {"else", T_ELSE}, {"True", T_TRUE}, {"False", T_FALSE},
     {"and", T_KAND},    {"or", T_KOR},    {"case", T_CASE}, {"of", T_OF},
+    {"param", T_PARAM}, {"import", T_IMPORT},
 };
 
 /* Punctuation, longest first. */

@@ -31,6 +31,7 @@
   X(THEN, "'then'") X(ELSE, "'else'") X(TRUE, "'True'")                \
   X(FALSE, "'False'") X(KAND, "'and'") X(KOR, "'or'")                  \
   X(CASE, "'case'") X(OF, "'of'")                                     \
+  X(PARAM, "'param'") X(IMPORT, "'import'")                            \
   X(VSEP, "end of definition") X(VEND, "end of block")
 
 typedef enum {

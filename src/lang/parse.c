@@ -1160,9 +1160,74 @@ static Item *type_sig(Parser *P, Pos pos) {
   return it;
 }
 
-/* item -> typedecl | sig | binding | expr */
+/* param -> 'param' name '=' expr ['in' '[' expr ',' expr ']'] [string]
+   A string literal last in the default (`param n = 100 "doc"`) is the doc
+   string, not an argument: bracket a default that ends in a string. */
+static Item *param_item(Parser *P, Pos pos) {
+  next(P); /* param */
+  if (peek(P) != T_NAME)
+    error_at_token(P, "expected a parameter's name after 'param', found %s",
+                   describe(P));
+  Token *name = next(P);
+  expect(P, T_EQUALS, "after the parameter's name");
+  const char *start = cur(P)->start;
+  Expr *e = expr(P);
+  Param *pm = GC_MALLOC(sizeof *pm);
+  Token *last = &P->toks[P->i - 1];
+  if (e->kind == E_APP && e->u.app.args[e->u.app.n - 1]->kind == E_STR &&
+      peek(P) != T_IN) {
+    pm->doc = e->u.app.args[e->u.app.n - 1]->u.str;
+    last = &P->toks[P->i - 2];
+    if (e->u.app.n == 1) e = e->u.app.fn;
+    else e->u.app.n--;
+  }
+  size_t len = (size_t)(last->start + last->len - start);
+  char *text = GC_MALLOC_ATOMIC(len + 1);
+  memcpy(text, start, len);
+  text[len] = 0;
+  pm->text = text;
+  if (peek(P) == T_IN) {
+    next(P);
+    Pos open = pos_here(P);
+    expect(P, T_LBRACK, "after 'in' (a range is [LOW, HIGH])");
+    pm->lo = expr(P);
+    expect(P, T_COMMA, "in the range [LOW, HIGH]");
+    pm->hi = expr(P);
+    expect_close(P, T_RBRACK, open);
+  }
+  if (peek(P) == T_STR) {
+    if (pm->doc) error_at_token(P, "a parameter has one doc string");
+    pm->doc = next(P)->str;
+  }
+  Def *d = GC_MALLOC(sizeof *d);
+  d->name = tok_sym(P, name);
+  d->pos = name->pos;
+  d->nclauses = 1;
+  d->clauses = GC_MALLOC(sizeof(Clause *));
+  d->clauses[0] = mk_clause(pos, 0, NULL, e);
+  Item *it = GC_MALLOC(sizeof *it);
+  it->kind = ITEM_DEF;
+  it->pos = pos;
+  it->def = d;
+  it->param = pm;
+  return it;
+}
+
+/* item -> typedecl | sig | param | import | binding | expr */
 static Item *item(Parser *P) {
   Pos pos = pos_here(P);
+  if (peek(P) == T_PARAM) return param_item(P, pos);
+  if (peek(P) == T_IMPORT) {
+    next(P);
+    if (peek(P) != T_STR)
+      error_at_token(P, "expected a file name in quotes after 'import', "
+                     "found %s", describe(P));
+    Item *it = GC_MALLOC(sizeof *it);
+    it->kind = ITEM_IMPORT;
+    it->pos = pos;
+    it->import = next(P)->str;
+    return it;
+  }
   if (peek(P) == T_COLONCOLON) return type_decl(P, pos);
   if ((peek(P) == T_NAME || peek(P) == T_CNAME) &&
       P->toks[P->i + 1].kind == T_COLONCOLON)
@@ -1206,9 +1271,9 @@ Item **parse_program(Interp *I, const Src *src, RunMode mode, int *nitems) {
     if (peek(&P) == T_EOF) break;
     Item *it = item(&P);
     /* Clauses of one function on adjacent items form one definition. */
-    if (it->kind == ITEM_DEF && items.n > 0) {
+    if (it->kind == ITEM_DEF && !it->param && items.n > 0) {
       Item *last = items.items[items.n - 1];
-      if (last->kind == ITEM_DEF) {
+      if (last->kind == ITEM_DEF && !last->param) {
         Vec one = {(void **)&last->def, 1, 1};
         if (merge_clause(&one, it->def)) goto ended;
       }

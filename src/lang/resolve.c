@@ -18,7 +18,22 @@ typedef struct Resolver {
   Item **items;  /* the run's items, whose definitions count as known */
   int nitems;
   int depth;     /* of resolve_expr calls: one per 8 KB of max-stack */
+  Def *top;      /* the top-level definition being resolved, or NULL */
 } Resolver;
+
+/* Notes that the top-level definition being resolved names the global s. */
+static void note_use(Resolver *R, Sym *s) {
+  Def *d = R->top;
+  if (!d) return;
+  for (int i = 0; i < d->nuses; i++)
+    if (d->uses[i] == s) return;
+  if ((d->nuses & (d->nuses - 1)) == 0) {
+    Sym **a = GC_MALLOC(sizeof(Sym *) * (size_t)(d->nuses ? 2 * d->nuses : 1));
+    if (d->nuses) memcpy(a, d->uses, sizeof(Sym *) * (size_t)d->nuses);
+    d->uses = a;
+  }
+  d->uses[d->nuses++] = s;
+}
 
 static void scope_add(Scope *s, Sym *name) {
   if (s->n == s->cap) {
@@ -176,6 +191,7 @@ static void resolve_var(Resolver *R, Expr *e, Scope *sc) {
         return;
       }
   if (s->con_arity >= 0 || s->global || defined_in_batch(R, s)) {
+    if (s->con_arity < 0) note_use(R, s);
     set_var(e, 0, RES_GLOBAL);
     return;
   }
@@ -278,14 +294,24 @@ static void resolve_body(Resolver *R, Expr *e, Scope *sc) {
 }
 
 void resolve_items(Interp *I, Item **items, int n) {
-  Resolver R = {I, items, n, 0};
+  Resolver R = {I, items, n, 0, NULL};
   for (int i = 0; i < n; i++) {
-    if (items[i]->kind == ITEM_DEF) resolve_def(&R, items[i]->def, NULL);
-    else if (items[i]->kind == ITEM_EXPR) resolve(&R, items[i]->expr, NULL);
+    if (items[i]->kind == ITEM_DEF) {
+      R.top = items[i]->def;
+      R.top->nuses = 0;
+      resolve_def(&R, items[i]->def, NULL);
+      if (items[i]->param) {
+        if (items[i]->param->lo) resolve(&R, items[i]->param->lo, NULL);
+        if (items[i]->param->hi) resolve(&R, items[i]->param->hi, NULL);
+      }
+      R.top = NULL;
+    } else if (items[i]->kind == ITEM_EXPR) {
+      resolve(&R, items[i]->expr, NULL);
+    }
   }
 }
 
 void resolve_expr(Interp *I, Expr *e) {
-  Resolver R = {I, NULL, 0, 0};
+  Resolver R = {I, NULL, 0, 0, NULL};
   resolve(&R, e, NULL);
 }

@@ -57,6 +57,11 @@ struct Sym {
   Def *prelude_def;
   const char *prelude_sig, *prelude_doc, *prelude_example;
   Pos prelude_pos;
+  const struct Param *param; /* declared with `param` (ast.h), or NULL */
+  const char *imported;/* the file an import defined it from, or NULL */
+  Expr *set_expr;      /* --set NAME=EXPR: the expression */
+  int set_checked;     /* --set NAME matched a declared parameter */
+  int anim_mark;       /* interp_set_frame's walk: epoch * 2 + depends */
 };
 
 typedef enum {
@@ -169,6 +174,22 @@ struct Interp {
   const Src *prelude_src;    /* the prelude's source, for its own scope */
   int loading_prelude;
   Value *v_true, *v_false, *v_nil;
+  /* Parameters, imports and animation (interp.c). */
+  Sym **params;              /* declared parameters, in order */
+  int nparams, capparams;
+  int sets_pending;          /* --set given and not yet checked */
+  Sym *set_syms[64];         /* the names given to --set */
+  int nset_syms;
+  const char **files;        /* the files being run (real paths), for
+                                import cycles: the importer last */
+  const char **shown;        /* the same, as the user wrote them */
+  int nfiles, capfiles;
+  const char **imported;     /* files imported so far (real paths) */
+  int nimported, capimported;
+  int declare_only;          /* qcs params: top-level expressions not run */
+  Item **anim;               /* the scripts' top-level expressions, run */
+  int nanim, capanim;        /* again for each frame of an animation */
+  int anim_epoch;
   /* Shared symbols the evaluator looks for. */
   Sym *s_otherwise;
 };
