@@ -21,7 +21,7 @@ OPT     ?= -O2
 # Debian packages the build and the tests need.
 DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
             libmpfr-dev libgmp-dev tmux clang hugs libchafa-dev libglib2.0-dev \
-            libmicrohttpd-dev
+            libmicrohttpd-dev parallel openexr python3-yaml
 PC_PKGS  := readline bdw-gc libpng OpenEXR
 
 WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \

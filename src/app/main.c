@@ -63,6 +63,8 @@ typedef struct Options {
   int f_first, f_last, f_step;
   int animation;           /* --animation F-L given (else: --frames A-B) */
   int a_first, a_last;
+  int tiles;               /* --tiles N (with --index-env) */
+  int index_env;           /* --index-env */
 } Options;
 
 static double now(void) {
@@ -113,6 +115,7 @@ static void usage(FILE *out) {
           "  qcs -e EXPR         evaluate EXPR with the prelude loaded and print it\n"
           "  qcs view FILE       a live view in the browser (qcs view --help)\n"
           "  qcs params FILE     list FILE's parameters (for --set)\n"
+          "  qcs merge OUT PART...  assemble tiles into the whole picture\n"
           "\n"
           "options:\n"
           "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
@@ -130,6 +133,14 @@ static void usage(FILE *out) {
           "                      and clock); -o out.####.png numbers the files\n"
           "  --animation F-L     the whole animation's frames, over which clock\n"
           "                      runs from 0 to 1 (default: the --frames range)\n"
+          "  --alpha             transparent background (RGBA 0 where nothing is hit)\n"
+          "  --crop X0,X1,Y0,Y1  render a part: columns, rows (ends excluded) or\n"
+          "                      fractions (0.5,1.0,0,0.5); an EXR keeps its window\n"
+          "  --tile I/N          render tile I (1..N) of a near-square grid of N\n"
+          "  --tiles N --index-env  the tile from the job array's index\n"
+          "                      (SLURM_ARRAY_TASK_ID, JOB_COMPLETION_INDEX,\n"
+          "                      AWS_BATCH_JOB_ARRAY_INDEX, PARALLEL_SEQ)\n"
+          "  --skip-existing     do not render a file that exists (retries)\n"
           "  --show              draw what the scripts render in the terminal,\n"
           "                      coarse first, instead of writing files\n"
           "  --preview MODE      how: auto (default), kitty, iterm, sixel,\n"
@@ -260,6 +271,7 @@ static int run_scripts(Options *o, Interp *I) {
   int step = o->frames ? o->f_step : 1;
   for (int f = first; f <= last; f += step) {
     int before = o->render.renders;
+    o->render.frame_renders = before;
     if (o->frames) {
       double clock = o->a_last == o->a_first ? 0.0 :
           (double)(f - o->a_first) / (double)(o->a_last - o->a_first);
@@ -443,6 +455,181 @@ static int params_args(int argc, char **argv, Options *o) {
   return help ? 1 : -1;
 }
 
+/* ---- partial renders and farms (issue 17) ---- */
+
+/* --crop X0,X1,Y0,Y1: four numbers, a decimal point making one a
+   fraction of its side. 0 or -1. */
+static int parse_crop(const char *arg, RenderOverrides *r) {
+  const char *p = arg;
+  for (int k = 0; k < 4; k++) {
+    char *end;
+    double v = strtod(p, &end);
+    if (end == p || !(v >= 0) || v > IMG_MAX_SIDE) return -1;
+    int frac = memchr(p, '.', (size_t)(end - p)) != NULL;
+    if (frac ? v > 1 : v != (double)(long)v) return -1;
+    r->crop[k] = v;
+    r->crop_frac[k] = frac;
+    if (k < 3 && *end != ',') return -1;
+    p = end + (k < 3);
+    if (k == 3 && *end) return -1;
+  }
+  r->crop_set = 1;
+  return 0;
+}
+
+/* The farm options at argv[*i]: 1 if taken (and *i moved past a value),
+   0 if not one of them, -1 after an error message. */
+static int farm_option(int argc, char **argv, int *i, Options *o) {
+  const char *a = argv[*i], *v = *i + 1 < argc ? argv[*i + 1] : NULL;
+  if (!strcmp(a, "--crop")) {
+    if (!v || parse_crop(v, &o->render)) {
+      fprintf(stderr, "qcs: error: --crop needs X0,X1,Y0,Y1: pixel columns "
+              "and rows from 0, the ends excluded, or fractions of the "
+              "picture (0.0 to 1.0), like 0,320,0,240 or 0.5,1.0,0.0,0.5\n");
+      return -1;
+    }
+  } else if (!strcmp(a, "--tile")) {
+    int t, n;
+    char c;
+    if (!v || sscanf(v, "%d/%d%c", &t, &n, &c) != 2 || n < 1 || n > 65536 ||
+        t < 1 || t > n) {
+      fprintf(stderr, "qcs: error: --tile needs I/N with 1 <= I <= N, like "
+              "3/16 (tile 3 of a grid of 16)\n");
+      return -1;
+    }
+    o->render.tile_index = t;
+    o->render.tile_count = n;
+  } else if (!strcmp(a, "--tiles")) {
+    char *end;
+    long n = v ? strtol(v, &end, 10) : 0;
+    if (!v || *end || n < 1 || n > 65536) {
+      fprintf(stderr, "qcs: error: --tiles needs a count from 1 to 65536\n");
+      return -1;
+    }
+    o->tiles = (int)n;
+  } else if (!strcmp(a, "--index-env")) {
+    o->index_env = 1;
+    return 1;
+  } else if (!strcmp(a, "--alpha")) {
+    o->render.alpha = 1;
+    return 1;
+  } else if (!strcmp(a, "--skip-existing")) {
+    o->render.skip_existing = 1;
+    return 1;
+  } else {
+    return 0;
+  }
+  (*i)++;
+  return 1;
+}
+
+/* The task index a job array gives its task (0-based), from the first of
+   these that is set: Slurm (less SLURM_ARRAY_TASK_MIN), Kubernetes
+   Indexed Jobs, AWS Batch array jobs (0-based), GNU parallel (1-based).
+   -1 with a message when none is, or it is not a number. */
+static long farm_task_index(const char **from) {
+  static const char *const vars[] = {"SLURM_ARRAY_TASK_ID",
+                                     "JOB_COMPLETION_INDEX",
+                                     "AWS_BATCH_JOB_ARRAY_INDEX",
+                                     "PARALLEL_SEQ"};
+  for (size_t k = 0; k < sizeof vars / sizeof *vars; k++) {
+    const char *v = getenv(vars[k]);
+    if (!v || !*v) continue;
+    char *end;
+    long i = strtol(v, &end, 10);
+    if (*end || i < 0) {
+      fprintf(stderr, "qcs: error: --index-env: %s=%s is not a task index\n",
+              vars[k], v);
+      return -1;
+    }
+    if (k == 0 && getenv("SLURM_ARRAY_TASK_MIN"))
+      i -= strtol(getenv("SLURM_ARRAY_TASK_MIN"), NULL, 10);
+    if (k == 3) i--;
+    *from = vars[k];
+    return i;
+  }
+  fprintf(stderr, "qcs: error: --index-env: none of SLURM_ARRAY_TASK_ID, "
+          "JOB_COMPLETION_INDEX, AWS_BATCH_JOB_ARRAY_INDEX, PARALLEL_SEQ is "
+          "set\n");
+  return -1;
+}
+
+/* --tiles N with --index-env: task k renders tile k + 1 of N. (With
+   frames, task k would be frame k / N, tile k % N + 1.) 0 or -1. */
+static int farm_resolve(Options *o) {
+  if (o->tiles && o->render.tile_count) {
+    fprintf(stderr, "qcs: error: give --tile I/N or --tiles N, not both\n");
+    return -1;
+  }
+  if (o->render.crop_set && (o->tiles || o->render.tile_count)) {
+    fprintf(stderr, "qcs: error: give --crop or a tile, not both\n");
+    return -1;
+  }
+  if (o->tiles && !o->index_env) {
+    fprintf(stderr, "qcs: error: --tiles N takes the tile from the job's "
+            "index: add --index-env (or give --tile I/N)\n");
+    return -1;
+  }
+  if (o->index_env && !o->tiles) {
+    fprintf(stderr, "qcs: error: --index-env needs --tiles N (how many "
+            "tasks share the picture)\n");
+    return -1;
+  }
+  if (!o->index_env) return 0;
+  const char *from = NULL;
+  long k = farm_task_index(&from);
+  if (k < 0) return -1;
+  if (k >= o->tiles) {
+    fprintf(stderr, "qcs: error: --index-env: task %ld (from %s) is past the "
+            "last of %d tiles (tasks count from 0)\n", k, from, o->tiles);
+    return -1;
+  }
+  o->render.tile_index = (int)k + 1;
+  o->render.tile_count = o->tiles;
+  return 0;
+}
+
+/* qcs merge OUT PART...: exit status. */
+static int merge_main(int argc, char **argv) {
+  if (argc == 3 && (!strcmp(argv[2], "-h") || !strcmp(argv[2], "--help"))) {
+    puts("usage: qcs merge OUT.exr|OUT.png PART...\n\n"
+         "Assemble the parts of one render (qcs --tile I/N or --crop, .exr "
+         "or .png)\ninto OUT, the single render's file bit for bit. Every "
+         "part must be of the\nsame render; together they must cover the "
+         "picture once.");
+    return 0;
+  }
+  if (argc < 4) {
+    fprintf(stderr, "qcs: error: merge needs OUT and at least one part "
+            "(qcs merge --help)\n");
+    return 1;
+  }
+  char err[1024];
+  const char *out = argv[2];
+  if (img_format(out, err, sizeof err) < 0 ||
+      render_writable(out, err, sizeof err) < 0) {
+    fprintf(stderr, "qcs: error: merge: %s\n", err);
+    return 1;
+  }
+  Image *im = img_merge((const char *const *)argv + 3, argc - 3, err,
+                        sizeof err);
+  if (!im) {
+    fprintf(stderr, "qcs: error: merge: %s; %s not written\n", err, out);
+    return 1;
+  }
+  ImgWriteOptions wo = {0};
+  wo.float_pixels = im->float_pixels;
+  const char *al = img_get_attr(im, "qcs.alpha");
+  wo.alpha = al && !strcmp(al, "on");
+  int rc = img_write(im, out, &wo, err, sizeof err);
+  img_free(im);
+  if (rc) {
+    fprintf(stderr, "qcs: error: merge: %s\n", err);
+    return 1;
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static Options o;
   o.t_start = now();
@@ -462,6 +649,7 @@ int main(int argc, char **argv) {
     int rc = params_args(argc, argv, &o);
     if (rc) return rc < 0 ? 1 : 0;
   }
+  if (argc > 1 && !strcmp(argv[1], "merge")) return merge_main(argc, argv);
   int sub = argc > 1 && !strcmp(argv[1], "tradeoff");
   if (sub) {
     int rc = tradeoff_args(argc, argv, &o);
@@ -475,6 +663,7 @@ int main(int argc, char **argv) {
   if (o.params) sub = 1;
   for (int i = 1; i < argc && !sub; i++) {
     const char *a = argv[i];
+    int fr;
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
       usage(stdout);
       return 0;
@@ -609,6 +798,8 @@ int main(int argc, char **argv) {
     } else if (!strcmp(a, "--frames") || !strcmp(a, "--animation")) {
       if (frames_option(&o, a, i + 1 < argc ? argv[i + 1] : NULL)) return 1;
       i++;
+    } else if (!strncmp(a, "--", 2) && (fr = farm_option(argc, argv, &i, &o))) {
+      if (fr < 0) return 1;
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "qcs: error: unknown option '%s' (see qcs --help)\n", a);
       return 1;
@@ -617,6 +808,7 @@ int main(int argc, char **argv) {
     }
   }
   if (!sub && frames_check(&o)) return 1;
+  if (!sub && farm_resolve(&o)) return 1;
   if (o.render.output && o.nfiles == 0 && o.nexprs == 0) {
     fprintf(stderr, "qcs: error: -o needs a scene file to render\n");
     return 1;

@@ -174,6 +174,70 @@ static void read_settings(Interp *I, Value *list, Pos pos, RenderSettings *rs,
   }
 }
 
+void render_tile_grid(int n, int w, int h, int *cols, int *rows) {
+  double best = INFINITY;
+  *cols = n;
+  *rows = 1;
+  for (int c = n; c >= 1; c--) {
+    if (n % c) continue;
+    int r = n / c;
+    double cost = fabs(log(((double)w / c) / ((double)h / r)));
+    if (cost < best - 1e-12) {
+      best = cost;
+      *cols = c;
+      *rows = r;
+    }
+  }
+}
+
+int render_crop_resolve(const RenderOverrides *o, int w, int h,
+                        RenderSettings *rs, char *err, size_t errlen) {
+  rs->crop_x0 = rs->crop_x1 = rs->crop_y0 = rs->crop_y1 = 0;
+  if (o->tile_count) {
+    int cols, rows;
+    render_tile_grid(o->tile_count, w, h, &cols, &rows);
+    if (cols > w || rows > h) {
+      snprintf(err, errlen, "--tile %d/%d: a grid of %dx%d tiles is finer "
+               "than the %dx%d image", o->tile_index, o->tile_count, cols,
+               rows, w, h);
+      return -1;
+    }
+    int i = o->tile_index - 1, cx = i % cols, cy = i / cols;
+    rs->crop_x0 = (int)((long)cx * w / cols);
+    rs->crop_x1 = (int)((long)(cx + 1) * w / cols);
+    rs->crop_y0 = (int)((long)cy * h / rows);
+    rs->crop_y1 = (int)((long)(cy + 1) * h / rows);
+    return 0;
+  }
+  if (!o->crop_set) return 0;
+  int v[4];
+  for (int k = 0; k < 4; k++) {
+    int side = k < 2 ? w : h;
+    double x = o->crop[k];
+    v[k] = o->crop_frac[k] ? (int)floor(x * side + 0.5) : (int)x;
+  }
+  if (v[0] < 0 || v[1] > w || v[0] >= v[1] || v[2] < 0 || v[3] > h ||
+      v[2] >= v[3]) {
+    snprintf(err, errlen, "--crop %d,%d,%d,%d is not a part of the %dx%d "
+             "image (columns x0,x1 then rows y0,y1, from 0, the ends "
+             "excluded)", v[0], v[1], v[2], v[3], w, h);
+    return -1;
+  }
+  rs->crop_x0 = v[0];
+  rs->crop_x1 = v[1];
+  rs->crop_y0 = v[2];
+  rs->crop_y1 = v[3];
+  return 0;
+}
+
+/* OUT.k.EXT for the k-th render of a script run with -o OUT.EXT. */
+static void numbered_path(char *buf, size_t n, const char *out, int k) {
+  const char *slash = strrchr(out, '/');
+  const char *dot = strrchr(slash ? slash + 1 : out, '.');
+  if (!dot) dot = out + strlen(out);
+  snprintf(buf, n, "%.*s.%d%s", (int)(dot - out), out, k, dot);
+}
+
 void render_lang_settings(Interp *I, Value *settings, Pos pos,
                           RenderSettings *rs) {
   int quiet = 0, float_pixels = 0;
@@ -224,8 +288,17 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
     ov->skipped++;
     return val_str(path);
   }
+  char numbered[4096];
   if (ov) {
-    if (ov->output) path = ov->output;
+    /* -o with a script that renders several times (one frame of an
+       animation counts once): out.png, out.2.png, ... never one over
+       another; frames get their number instead (--frames). */
+    if (ov->output && ov->renders > 0 && !ov->capture && !ov->animating) {
+      numbered_path(numbered, sizeof numbered, ov->output, ov->renders + 1);
+      path = numbered;
+    } else if (ov->output) {
+      path = ov->output;
+    }
     if (ov->animating) path = render_frame_path(path, ov->frame);
     if (ov->width) rs.width = ov->width, rs.height = ov->height;
     if (ov->spp) rs.spp = ov->spp;
@@ -233,6 +306,7 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
     if (ov->tol > 0) rs.tol = ov->tol;
     if (ov->cost) rs.aovs |= IMG_COST;
     if (ov->float_pixels) float_pixels = 1;
+    if (ov->alpha) rs.alpha = 1;
     ov->renders++;
   }
   /* The limits: a picture's size and its samples. */
@@ -261,6 +335,15 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
   if (img_format(path, err, sizeof err) < 0 ||
       render_writable(path, err, sizeof err) < 0)
     qcs_error(pos, "%s", err);
+  if (ov && render_crop_resolve(ov, rs.width, rs.height, &rs, err,
+                                sizeof err))
+    qcs_error(pos, "%s", err);
+  if (ov && ov->skip_existing && access(path, F_OK) == 0) {
+    if (!quiet)
+      fprintf(stderr, "%s exists: not rendered again (--skip-existing)\n",
+              path);
+    return val_str(path);
+  }
   Scene *s = compile_scene(I, obj, pos);
   RenderReport rep;
   Image *im = render_scene(s, &rs, &rep, &qcs_interrupted, err, sizeof err);
@@ -279,8 +362,20 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
     }
     qcs_error(pos, "%s", err);
   }
+  /* Which render of the script (of the frame, in an animation) this is,
+     and the frame: the same frame rendered alone or in the whole run
+     makes the same file. */
+  char nth[16], fr[16];
+  snprintf(nth, sizeof nth, "%d", ov ? ov->renders - ov->frame_renders : 1);
+  snprintf(fr, sizeof fr, "%d", ov ? ov->frame : 0);
+  if (img_set_attr(im, "qcs.render", nth) ||
+      (ov && ov->animating && img_set_attr(im, "qcs.frame", fr))) {
+    img_free(im);
+    qcs_error(pos, "out of memory for %s", path);
+  }
   ImgWriteOptions wo = {0};
   wo.float_pixels = float_pixels;
+  wo.alpha = rs.alpha;
   int wr = img_write(im, path, &wo, err, sizeof err);
   img_free(im);
   if (wr) qcs_error(pos, "%s", err);

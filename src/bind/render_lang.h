@@ -26,7 +26,20 @@ typedef struct RenderOverrides {
   double tol;           /* --tolerance T (0: the script's) */
   int cost;             /* --cost: add the root-finder cost channel */
   int float_pixels;     /* --float: EXR RGBA as 32-bit floats */
-  int renders;          /* renders done so far */
+  int renders;          /* renders done so far; with output, render k > 1
+                           writes OUT.k.EXT (out.2.png, ...) */
+  /* Partial renders (a farm's tasks): --crop X0,X1,Y0,Y1 (pixels, end
+     excluded; a value with a decimal point is a fraction of the side, as
+     POV-Ray's +SC/+EC) or --tile I/N (1 <= I <= N, a grid of N cells
+     chosen near square from the picture's size; render_tile_grid). */
+  int crop_set;
+  double crop[4];
+  int crop_frac[4];
+  int tile_index, tile_count;
+  int alpha;            /* --alpha: transparent background (render.h) */
+  int skip_existing;    /* --skip-existing: a render whose file exists is
+                           not done (the writers are atomic: a file there
+                           is whole) */
   RenderCapture capture;  /* non-NULL: renders call this instead (qcs
                              tradeoff); nothing is written */
   void *capture_ctx;
@@ -41,6 +54,7 @@ typedef struct RenderOverrides {
   int skipped;
   int animating;        /* --frames: every file name gets the frame's number */
   int frame;            /* the frame being rendered */
+  int frame_renders;    /* renders done before this frame began */
 } RenderOverrides;
 
 /* An animation's file name for a frame: the last run of '#' in path
@@ -50,6 +64,13 @@ typedef struct RenderOverrides {
 const char *render_frame_path(const char *path, int frame);
 
 void render_install(Interp *I);
+/* The grid of --tile I/N for a w x h picture: cols x rows = n, the cells
+   nearest square (ties: more columns). */
+void render_tile_grid(int n, int w, int h, int *cols, int *rows);
+/* The crop the overrides ask of a w x h picture, into rs's crop_* (left
+   all 0 when none). 0, or -1 with a message. */
+int render_crop_resolve(const RenderOverrides *o, int w, int h,
+                        struct RenderSettings *rs, char *err, size_t errlen);
 /* The conventions (render_defaults) with a settings list applied (NULL:
    none); errors raised at pos. FloatPixels and Quiet are accepted and
    mean nothing here. */

@@ -137,7 +137,7 @@ static exr_result_t write_chunks(exr_context_t ctxt, const Image *im,
   int started = 0;
   for (int y = 0; y < im->height && rv == EXR_ERR_SUCCESS; y += lines) {
     exr_chunk_info_t ci;
-    rv = exr_write_scanline_chunk_info(ctxt, 0, y, &ci);
+    rv = exr_write_scanline_chunk_info(ctxt, 0, im->y0 + y, &ci);
     if (rv != EXR_ERR_SUCCESS) break;
     rv = started ? exr_encoding_update(ctxt, 0, &ci, &enc)
                  : exr_encoding_initialize(ctxt, 0, &ci, &enc);
@@ -183,6 +183,29 @@ int img_write_exr(const Image *im, FILE *f, const ImgWriteOptions *opt,
     rv = exr_initialize_required_attr_simple(
         ctxt, part, im->width, im->height,
         opt->no_compression ? EXR_COMPRESSION_NONE : EXR_COMPRESSION_ZIP);
+  /* a part of a larger picture: its data window in the display window */
+  if (rv == EXR_ERR_SUCCESS) {
+    exr_attr_box2i_t disp, data;
+    disp.min.x = disp.min.y = 0;
+    disp.max.x = im->full_width - 1;
+    disp.max.y = im->full_height - 1;
+    data.min.x = im->x0;
+    data.min.y = im->y0;
+    data.max.x = im->x0 + im->width - 1;
+    data.max.y = im->y0 + im->height - 1;
+    rv = exr_set_display_window(ctxt, part, &disp);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_set_data_window(ctxt, part, &data);
+  }
+  if (rv == EXR_ERR_SUCCESS && im->has_camera) {
+    exr_attr_m44f_t m;
+    memcpy(m.m, im->world_to_camera, sizeof m.m);
+    rv = exr_attr_set_m44f(ctxt, part, "worldToCamera", &m);
+    memcpy(m.m, im->world_to_ndc, sizeof m.m);
+    if (rv == EXR_ERR_SUCCESS)
+      rv = exr_attr_set_m44f(ctxt, part, "worldToNDC", &m);
+  }
+  for (int i = 0; i < im->nattrs && rv == EXR_ERR_SUCCESS; i++)
+    rv = exr_attr_set_string(ctxt, part, im->attr_name[i], im->attr_value[i]);
   for (int i = 0; i < nch && rv == EXR_ERR_SUCCESS; i++) {
     /* colour is perceptually logarithmic; data planes are not colours */
     int is_colour = ch[i].base == im->rgba;
@@ -303,6 +326,46 @@ static exr_result_t read_chunks(exr_context_t ctxt, Image *im,
   return rv;
 }
 
+/* The windows, qcs's string attributes ("qcs." names), the camera
+   matrices and the colour's pixel type, into im. 0, or -1 (memory). */
+static int read_meta(exr_const_context_t ctxt, Image *im,
+                     const exr_attr_chlist_t *cl) {
+  exr_attr_box2i_t dw, disp;
+  if (exr_get_data_window(ctxt, 0, &dw) == EXR_ERR_SUCCESS &&
+      exr_get_display_window(ctxt, 0, &disp) == EXR_ERR_SUCCESS) {
+    im->x0 = dw.min.x - disp.min.x;
+    im->y0 = dw.min.y - disp.min.y;
+    im->full_width = disp.max.x - disp.min.x + 1;
+    im->full_height = disp.max.y - disp.min.y + 1;
+  }
+  int32_t n = 0;
+  if (exr_get_attribute_count(ctxt, 0, &n) != EXR_ERR_SUCCESS) n = 0;
+  for (int32_t i = 0; i < n; i++) {
+    const exr_attribute_t *a = NULL;
+    if (exr_get_attribute_by_index(ctxt, 0, EXR_ATTR_LIST_FILE_ORDER, i,
+                                   &a) != EXR_ERR_SUCCESS || !a)
+      continue;
+    if (a->type == EXR_ATTR_STRING && strncmp(a->name, "qcs.", 4) == 0 &&
+        a->string && im->nattrs < IMG_MAX_ATTRS) {
+      char *v = strndup(a->string->str, (size_t)a->string->length);
+      int bad = !v || img_set_attr(im, a->name, v);
+      free(v);
+      if (bad) return -1;
+    }
+  }
+  exr_attr_m44f_t c, ndc;
+  if (exr_attr_get_m44f(ctxt, 0, "worldToCamera", &c) == EXR_ERR_SUCCESS &&
+      exr_attr_get_m44f(ctxt, 0, "worldToNDC", &ndc) == EXR_ERR_SUCCESS) {
+    im->has_camera = 1;
+    memcpy(im->world_to_camera, c.m, sizeof c.m);
+    memcpy(im->world_to_ndc, ndc.m, sizeof ndc.m);
+  }
+  for (int i = 0; i < cl->num_channels; i++)
+    if (strcmp(cl->entries[i].name.str, "R") == 0)
+      im->float_pixels = cl->entries[i].pixel_type == EXR_PIXEL_FLOAT;
+  return 0;
+}
+
 Image *img_read_exr(const char *path, char *err, size_t errlen) {
   /* a missing or unreadable file gets the system's words for it */
   int fd = open(path, O_RDONLY | O_CLOEXEC);
@@ -359,6 +422,11 @@ Image *img_read_exr(const char *path, char *err, size_t errlen) {
         im = NULL;
       }
     }
+  }
+  if (im && read_meta(ctxt, im, cl) != 0) {
+    snprintf(err, errlen, "cannot read %s: out of memory", path);
+    img_free(im);
+    im = NULL;
   }
   exr_finish(&ctxt);
   return im;

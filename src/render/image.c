@@ -35,6 +35,8 @@ Image *img_new(int w, int h, int flags) {
   im->width = w;
   im->height = h;
   im->flags = flags & (IMG_Z | IMG_N | IMG_COST);
+  im->full_width = w;
+  im->full_height = h;
   im->rgba = calloc(np * 4, sizeof(float));
   if (im->flags & IMG_Z) im->z = malloc(np * sizeof(float));
   if (im->flags & IMG_N) im->n = calloc(np * 3, sizeof(float));
@@ -55,7 +57,50 @@ void img_free(Image *im) {
   free(im->z);
   free(im->n);
   free(im->cost);
+  for (int i = 0; i < im->nattrs; i++) {
+    free(im->attr_name[i]);
+    free(im->attr_value[i]);
+  }
   free(im);
+}
+
+int img_set_attr(Image *im, const char *name, const char *value) {
+  char *v = strdup(value);
+  if (!v) return -1;
+  for (int i = 0; i < im->nattrs; i++)
+    if (strcmp(im->attr_name[i], name) == 0) {
+      free(im->attr_value[i]);
+      im->attr_value[i] = v;
+      return 0;
+    }
+  char *n = im->nattrs < IMG_MAX_ATTRS ? strdup(name) : NULL;
+  if (!n) {
+    free(v);
+    return -1;
+  }
+  im->attr_name[im->nattrs] = n;
+  im->attr_value[im->nattrs++] = v;
+  return 0;
+}
+
+const char *img_get_attr(const Image *im, const char *name) {
+  for (int i = 0; i < im->nattrs; i++)
+    if (strcmp(im->attr_name[i], name) == 0) return im->attr_value[i];
+  return NULL;
+}
+
+int img_copy_meta(Image *a, const Image *b) {
+  for (int i = 0; i < a->nattrs; i++) {
+    free(a->attr_name[i]);
+    free(a->attr_value[i]);
+  }
+  a->nattrs = 0;
+  for (int i = 0; i < b->nattrs; i++)
+    if (img_set_attr(a, b->attr_name[i], b->attr_value[i])) return -1;
+  a->has_camera = b->has_camera;
+  memcpy(a->world_to_camera, b->world_to_camera, sizeof a->world_to_camera);
+  memcpy(a->world_to_ndc, b->world_to_ndc, sizeof a->world_to_ndc);
+  return 0;
 }
 
 int img_format(const char *path, char *err, size_t errlen) {

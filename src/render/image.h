@@ -37,8 +37,19 @@ enum {
 /* The EXR name of the IMG_COST plane (sorted after the upper-case names). */
 #define IMG_EXR_COST_CHANNEL "qcs.steps"
 
+/* Metadata carried to the file: string attributes (EXR string attributes,
+ * PNG tEXt chunks), in order, and the camera matrices (EXR's standard
+ * worldToCamera and worldToNDC, m44f, row vectors: p' = p M). */
+#define IMG_MAX_ATTRS 24
+
 /* Pixel (x, y) is at index y * width + x; row 0 is the top of the picture.
- * rgba holds 4 floats a pixel, n 3, z and cost 1; absent planes are NULL. */
+ * rgba holds 4 floats a pixel, n 3, z and cost 1; absent planes are NULL.
+ *
+ * A part of a larger picture (a crop, a tile): the image's pixels are the
+ * full picture's [x0, x0 + width) x [y0, y0 + height) of a full_width x
+ * full_height picture (EXR: the data window inside the display window;
+ * PNG: a "qcs.window" tEXt chunk). A whole picture has x0 = y0 = 0 and
+ * full_* = width, height (img_new's defaults). */
 typedef struct {
   int width, height;
   int flags;         /* IMG_Z | IMG_N | IMG_COST: the planes present */
@@ -46,7 +57,20 @@ typedef struct {
   float *z;
   float *n;
   float *cost;
+  int x0, y0, full_width, full_height;
+  int nattrs;
+  char *attr_name[IMG_MAX_ATTRS], *attr_value[IMG_MAX_ATTRS]; /* malloc'd */
+  int has_camera;
+  float world_to_camera[16], world_to_ndc[16];
+  int float_pixels;  /* set by img_read_exr: RGBA was stored as float */
 } Image;
+
+/* Set (add or replace) a string attribute; -1 if full or out of memory. */
+int img_set_attr(Image *im, const char *name, const char *value);
+/* The value of an attribute, or NULL. */
+const char *img_get_attr(const Image *im, const char *name);
+/* Copy b's metadata (attributes, camera) to a, replacing a's. 0 or -1. */
+int img_copy_meta(Image *a, const Image *b);
 
 /* Options of img_write; a NULL pointer means all zero (the defaults). */
 typedef struct {
@@ -109,6 +133,16 @@ int img_compare(const Image *a, const Image *b, double *rms,
  * and a code value in [0, 1] back to linear. */
 unsigned char img_srgb8(float v);
 double img_srgb_decode(double s);
+
+/* The parts of one picture (crops or farm tiles, .exr or .png, each
+ * knowing where it lies: image.h's window) assembled into the whole: the
+ * parts must be of the same render (same full size, channels, pixel type,
+ * attributes and camera), may not overlap, and must cover the picture.
+ * NULL with a message naming the file at fault otherwise. The result has
+ * the parts' metadata; written with img_write (float_pixels as the
+ * parts', PNG alpha when its "qcs.alpha" is "on") it is the single
+ * render's file. */
+Image *img_merge(const char *const *paths, int n, char *err, size_t errlen);
 
 /* The per-format writers under img_write, which owns the temporary file:
  * each writes im to f (a fresh, empty file; the EXR writer uses its file

@@ -90,6 +90,23 @@ int img_write_png(const Image *im, FILE *f, const ImgWriteOptions *opt,
                PNG_FILTER_TYPE_DEFAULT);
   /* sRGB, plus the gAMA and cHRM that describe it to older readers */
   png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  /* qcs's attributes as tEXt chunks; a part of a larger picture says
+     where it lies in "qcs.window" (x0 y0 full_width full_height) */
+  png_text text[IMG_MAX_ATTRS + 1];
+  char window[64];
+  int nt = 0;
+  for (int i = 0; i < im->nattrs; i++)
+    text[nt++] = (png_text){.compression = PNG_TEXT_COMPRESSION_NONE,
+                            .key = im->attr_name[i],
+                            .text = im->attr_value[i]};
+  if (im->x0 || im->y0 || im->full_width != im->width ||
+      im->full_height != im->height) {
+    snprintf(window, sizeof window, "%d %d %d %d", im->x0, im->y0,
+             im->full_width, im->full_height);
+    text[nt++] = (png_text){.compression = PNG_TEXT_COMPRESSION_NONE,
+                            .key = "qcs.window", .text = window};
+  }
+  if (nt) png_set_text(png, info, text, nt);
   png_write_info(png, info);
   for (int y = 0; y < im->height; y++) {
     encode_row(im, y, alpha, row);
@@ -173,7 +190,26 @@ Image *img_read_png(const char *path, char *err, size_t errlen) {
     png_read_row(png, row, NULL);
     decode_row(im, y, row, nc, depth);
   }
-  png_read_end(png, NULL);
+  png_read_end(png, info);
+  png_textp text = NULL;
+  int nt = png_get_text(png, info, &text, NULL);
+  for (int i = 0; i < nt; i++) {
+    int x0, y0, fw, fh;
+    char c;
+    if (strcmp(text[i].key, "qcs.window") == 0) {
+      if (sscanf(text[i].text, "%d %d %d %d%c", &x0, &y0, &fw, &fh, &c) == 4 &&
+          x0 >= 0 && y0 >= 0 && fw >= 1 && fh >= 1 &&
+          (long)x0 + im->width <= fw && (long)y0 + im->height <= fh) {
+        im->x0 = x0;
+        im->y0 = y0;
+        im->full_width = fw;
+        im->full_height = fh;
+      }
+    } else if (strncmp(text[i].key, "qcs.", 4) == 0 &&
+               img_set_attr(im, text[i].key, text[i].text)) {
+      png_error(png, "out of memory");
+    }
+  }
   png_destroy_read_struct(&png, &info, NULL);
   fclose(f);
   free(row);

@@ -5,6 +5,7 @@
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
+#include <stdint.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
@@ -684,15 +685,18 @@ static void render_tile(Worker *W, int tile) {
   Tracer *T = W->T;
   const RenderSettings *rs = T->rs;
   Image *im = T->im;
+  /* tiles cover the crop (im); pixel coordinates are the full picture's */
   int tx = tile % T->tiles_x, ty = tile / T->tiles_x;
-  int x0 = tx * TILE, y0 = ty * TILE;
-  int x1 = x0 + TILE < rs->width ? x0 + TILE : rs->width;
-  int y1 = y0 + TILE < rs->height ? y0 + TILE : rs->height;
+  int x0 = im->x0 + tx * TILE, y0 = im->y0 + ty * TILE;
+  int xe = im->x0 + im->width, ye = im->y0 + im->height;
+  int x1 = x0 + TILE < xe ? x0 + TILE : xe;
+  int y1 = y0 + TILE < ye ? y0 + TILE : ye;
   int g = T->grid;
   for (int y = y0; y < y1; y++)
     for (int x = x0; x < x1; x++) {
       double sum[3] = {0, 0, 0}, zmin = INFINITY, nrm0[3] = {0, 0, 0};
       long work0 = ray_work(W->c);
+      int hits = 0;
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++) {
           double d[3], rgb[3], z, nrm[3];
@@ -701,15 +705,17 @@ static void render_tile(Worker *W, int tile) {
           shade_sample(W, T->cam.eye, d, rgb, &z, nrm);
           long w = ray_work(W->c) - w0;
           if (w > W->max_work) W->max_work = w;
-          for (int i = 0; i < 3; i++) sum[i] += rgb[i];
+          if (z < INFINITY) hits++;
+          if (z < INFINITY || !rs->alpha)
+            for (int i = 0; i < 3; i++) sum[i] += rgb[i];
           if (sx == g / 2 && sy == g / 2) { /* AOVs from the central sample */
             zmin = z;
             memcpy(nrm0, nrm, sizeof nrm0);
           }
         }
-      size_t k = img_index(im, x, y);
+      size_t k = img_index(im, x - im->x0, y - im->y0);
       for (int i = 0; i < 3; i++) im->rgba[4 * k + (size_t)i] = (float)(sum[i] / (g * g));
-      im->rgba[4 * k + 3] = 1;
+      im->rgba[4 * k + 3] = rs->alpha ? (float)hits / (float)(g * g) : 1;
       if (im->z) im->z[k] = (float)zmin;
       if (im->n)
         for (int i = 0; i < 3; i++) im->n[3 * k + (size_t)i] = (float)nrm0[i];
@@ -804,6 +810,91 @@ static int setup_camera(Tracer *T, char *err, size_t errlen) {
   return 0;
 }
 
+/* FNV-1a over bytes. */
+static uint64_t fnv(uint64_t h, const void *p, size_t n) {
+  const unsigned char *b = p;
+  for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 1099511628211ULL;
+  return h;
+}
+
+/* The camera matrices and the settings as attributes of im (render.h). */
+static int image_meta(const Tracer *T, Image *im) {
+  const RenderSettings *rs = T->rs;
+  const Camera *c = &T->cam;
+  /* worldToCamera: camera space looks down -z, x right, y up; rows are
+     the images of the world axes (OpenEXR's row-vector convention) */
+  float *m = im->world_to_camera;
+  const double *ax[3] = {c->right, c->upv, c->fwd};
+  for (int j = 0; j < 3; j++) {
+    double sg = j == 2 ? -1 : 1;
+    for (int i = 0; i < 3; i++) m[4 * i + j] = (float)(sg * ax[j][i]);
+    m[12 + j] = (float)(-sg * (ax[j][0] * c->eye[0] + ax[j][1] * c->eye[1] +
+                               ax[j][2] * c->eye[2]));
+    m[4 * j + 3] = 0;
+  }
+  m[15] = 1;
+  /* worldToNDC = worldToCamera x projection: after the division by w
+     (the distance in front of the eye), x and y run over [-1, 1] across
+     the whole picture (y up), and z = near / w with near = 1e-3 R */
+  double sx = 1 / (c->tan_half * c->aspect), sy = 1 / c->tan_half;
+  double P[4][4] = {{sx, 0, 0, 0}, {0, sy, 0, 0}, {0, 0, 0, -1},
+                    {0, 0, 1e-3 * c->radius, 0}};
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++) {
+      double v = 0;
+      for (int k = 0; k < 4; k++) v += (double)m[4 * i + k] * P[k][j];
+      im->world_to_ndc[4 * i + j] = (float)v;
+    }
+  im->has_camera = 1;
+  char buf[512];
+  int r = 0;
+  snprintf(buf, sizeof buf, "%dx%d", rs->width, rs->height);
+  r |= img_set_attr(im, "qcs.size", buf);
+  snprintf(buf, sizeof buf, "%d", rs->spp);
+  r |= img_set_attr(im, "qcs.samples", buf);
+  snprintf(buf, sizeof buf, "eye %.17g %.17g %.17g forward %.17g %.17g %.17g "
+           "up %.17g %.17g %.17g fov %.17g", c->eye[0], c->eye[1], c->eye[2],
+           c->fwd[0], c->fwd[1], c->fwd[2], c->upv[0], c->upv[1], c->upv[2],
+           rs->fov);
+  r |= img_set_attr(im, "qcs.camera", buf);
+  int n = 0;
+  buf[0] = 0;
+  for (int l = 0; l < T->nlights && n < (int)sizeof buf - 80; l++)
+    n += snprintf(buf + n, sizeof buf - (size_t)n, "%s%.17g %.17g %.17g "
+                  "intensity %.17g", l ? "; " : "", T->lights[l][0],
+                  T->lights[l][1], T->lights[l][2], T->intensity[l]);
+  r |= img_set_attr(im, "qcs.lights", buf);
+  snprintf(buf, sizeof buf, "ambient %.17g background %.17g %.17g %.17g "
+           "object %.17g %.17g %.17g floor %.17g %.17g %.17g shadows %s",
+           rs->ambient, rs->background[0], rs->background[1],
+           rs->background[2], rs->object_colour[0], rs->object_colour[1],
+           rs->object_colour[2], rs->floor_colour[0], rs->floor_colour[1],
+           rs->floor_colour[2], rs->shadows ? "on" : "off");
+  r |= img_set_attr(im, "qcs.shading", buf);
+  snprintf(buf, sizeof buf, "%.17g", rs->tol);
+  r |= img_set_attr(im, "qcs.tolerance", buf);
+  r |= img_set_attr(im, "qcs.alpha", rs->alpha ? "on" : "off");
+  /* the scene: its nodes' kinds, links, planes and colours, and the
+     primitives' boxes (which rounded and soft shapes determine) */
+  uint64_t h = 1469598103934665603ULL;
+  for (int i = 0; i < T->s->n; i++) {
+    const ScNode *nd = &T->s->nodes[i];
+    int ints[4] = {(int)nd->kind, nd->a, nd->b, nd->has_colour};
+    h = fnv(h, ints, sizeof ints);
+    h = fnv(h, nd->n, sizeof nd->n);
+    h = fnv(h, &nd->d, sizeof nd->d);
+    h = fnv(h, nd->colour, sizeof nd->colour);
+  }
+  for (int i = 0; i < T->nprims; i++) {
+    h = fnv(h, T->prims[i].box.lo, sizeof T->prims[i].box.lo);
+    h = fnv(h, T->prims[i].box.hi, sizeof T->prims[i].box.hi);
+  }
+  snprintf(buf, sizeof buf, "%d nodes, %d primitives, fingerprint %016llx",
+           T->s->n, T->nprims, (unsigned long long)h);
+  r |= img_set_attr(im, "qcs.scene", buf);
+  return r ? -1 : 0;
+}
+
 Image *render_scene(const Scene *s, const RenderSettings *rs,
                     RenderReport *rep, atomic_int *cancel,
                     char *err, size_t errlen) {
@@ -820,6 +911,19 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
     snprintf(err, errlen, "the field of view must be between 0 and 180 "
              "degrees, not %g", rs->fov);
     return NULL;
+  }
+  int cx0 = 0, cx1 = rs->width, cy0 = 0, cy1 = rs->height;
+  if (rs->crop_x0 || rs->crop_x1 || rs->crop_y0 || rs->crop_y1) {
+    if (rs->crop_x0 < 0 || rs->crop_x1 > rs->width ||
+        rs->crop_x0 >= rs->crop_x1 || rs->crop_y0 < 0 ||
+        rs->crop_y1 > rs->height || rs->crop_y0 >= rs->crop_y1) {
+      snprintf(err, errlen, "the crop %d,%d,%d,%d (columns x0..x1, rows "
+               "y0..y1, end excluded) is not a part of the %dx%d image",
+               rs->crop_x0, rs->crop_x1, rs->crop_y0, rs->crop_y1,
+               rs->width, rs->height);
+      return NULL;
+    }
+    cx0 = rs->crop_x0, cx1 = rs->crop_x1, cy0 = rs->crop_y0, cy1 = rs->crop_y1;
   }
   Tracer T;
   memset(&T, 0, sizeof T);
@@ -845,11 +949,16 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   }
   if (T.nbounded && build_bvh(&T)) goto oom;
   if (setup_camera(&T, err, errlen)) goto fail;
-  im = img_new(rs->width, rs->height, rs->aovs);
+  im = img_new(cx1 - cx0, cy1 - cy0, rs->aovs);
   if (!im) goto oom;
+  im->x0 = cx0;
+  im->y0 = cy0;
+  im->full_width = rs->width;
+  im->full_height = rs->height;
+  if (image_meta(&T, im)) goto oom;
   T.im = im;
-  T.tiles_x = (rs->width + TILE - 1) / TILE;
-  T.tiles_y = (rs->height + TILE - 1) / TILE;
+  T.tiles_x = (im->width + TILE - 1) / TILE;
+  T.tiles_y = (im->height + TILE - 1) / TILE;
   T.ntiles = T.tiles_x * T.tiles_y;
   atomic_init(&T.next_tile, 0);
   atomic_init(&T.done_tiles, 0);
@@ -873,8 +982,8 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   for (int i = 1; i <= started; i++) pthread_join(threads[i], NULL);
   if (rs->progress && T.progressed) rs->progress(rs->progress_ud, 1, 0);
   rep->seconds = now() - T.start;
-  rep->width = rs->width;
-  rep->height = rs->height;
+  rep->width = im->width;
+  rep->height = im->height;
   rep->spp = rs->spp;
   rep->threads = started + 1;
   rep->tol = rs->tol;

@@ -67,6 +67,15 @@ typedef struct RenderSettings {
   double tol;               /* root tolerance, a distance in scene units */
   int shadows;
   int aovs;                 /* IMG_Z | IMG_N | IMG_COST */
+  /* A part of the picture (a crop, a farm's tile): pixels [crop_x0,
+     crop_x1) x [crop_y0, crop_y1) of the width x height picture, framed
+     as in the whole picture (the camera sees width x height) and
+     bit-identical to those pixels of it. All 0: the whole picture. */
+  int crop_x0, crop_x1, crop_y0, crop_y1;
+  /* 1: where no sample meets a surface the pixel is transparent (RGBA
+     0; a pixel's A is the share of its samples that hit, its RGB the
+     hits' light, premultiplied); 0: the background colour with A = 1. */
+  int alpha;
   /* Progress (may be NULL): called from a worker thread, under a lock,
      at most every 0.1 s once the render has run 0.5 s, with the fraction
      done and an estimate of the seconds left; and once at the end with
@@ -103,7 +112,14 @@ typedef struct RenderReport {
   int prims, bounded_prims;
 } RenderReport;
 
-/* Render s. Returns NULL with a message in err if the settings are bad
+/* The image returned is the crop (or the whole picture): width x height
+   of the crop, with x0, y0, full_width, full_height saying where it lies,
+   the camera matrices (worldToCamera, worldToNDC) and the render's
+   settings as "qcs.*" string attributes (size, samples, camera, lights,
+   shading, tolerance, alpha, a fingerprint of the scene): what tiles of
+   one render share, and what qcs merge checks.
+
+   Render s. Returns NULL with a message in err if the settings are bad
    or memory runs out; with *cancel set (non-zero) during the render,
    returns NULL with rep->interrupted = 1. cancel may be NULL. */
 Image *render_scene(const Scene *s, const RenderSettings *rs,
