@@ -553,6 +553,11 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
     }
   }
   double size = 0, scale = 1;
+  for (int i = 0; i < 3; i++)
+    if (!(hi[i] > lo[i])) {
+      snprintf(err, errlen, "the object is empty: nothing to mesh");
+      return MESH_EEMPTY;
+    }
   for (int i = 0; i < 3; i++) {
     if (!isfinite(lo[i]) || !isfinite(hi[i])) {
       snprintf(err, errlen, "the box to mesh is not finite");
