@@ -158,7 +158,14 @@ test-deps:
 	    echo "note: $(TEST_DEB_PKGS) is not installed: the browser tests are skipped"; \
 	  fi
 
-test: deps test-deps
+# suite-mesh.sh reads meshes back with admesh (skipped without it).
+.PHONY: test-deps-mesh
+test-deps-mesh:
+	@dpkg-query -W -f='$${Status}' admesh 2>/dev/null | grep -q 'ok installed' || \
+	  { [ "$$(id -u)" = 0 ] && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq admesh >/dev/null 2>&1; } || \
+	  echo "note: admesh is not installed: the mesh read-back tests are skipped"
+
+test: deps test-deps test-deps-mesh
 	@$(MAKE) -s $(BIN) units
 	@sh tests/run-all.sh
 

@@ -22,6 +22,8 @@
 #include "bind/bind.h"
 #include "lang/interp.h"
 #include "bind/render_lang.h"
+#include "bind/mesh_lang.h"
+#include "render/mesh.h"
 #include "app/preview.h"
 #include "app/repl.h"
 #include "app/view.h"
@@ -121,8 +123,9 @@ static void usage(FILE *out) {
           "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
           "  --set NAME=VALUE    replace the top-level definition NAME before\n"
           "                      the scripts run (VALUE is a qcs expression)\n"
-          "  -o FILE             render to FILE (.exr, .png or .ppm): what the\n"
-          "                      scripts render, or else their `scene`\n"
+          "  -o FILE             render to FILE (.exr, .png, .ppm), or mesh to it\n"
+          "                      (.stl, .obj): what the scripts render, or else\n"
+          "                      their `scene`\n"
           "  --size WxH          image size, overriding the scripts' own\n"
           "  --spp N             samples per pixel (1, 4, 9, ...: n x n strata)\n"
           "  --threads N         render threads (default: all cores)\n"
@@ -318,6 +321,8 @@ static void *run(void *arg) {
   if (o->show) {
     o->render.capture = show_capture;
     o->render.capture_ctx = o;
+  } else if (o->render.output && mesh_is_mesh_path(o->render.output)) {
+    o->render.capture = mesh_lang_capture; /* -o part.stl: mesh, not render */
   }
   if (o->params) {
     o->status = interp_params(I, o->files[0], stdout) != RUN_OK;
@@ -815,7 +820,8 @@ int main(int argc, char **argv) {
   }
   if (o.render.output) {
     char err[300];
-    if (img_format(o.render.output, err, sizeof err) < 0 ||
+    if ((!mesh_is_mesh_path(o.render.output) &&
+         img_format(o.render.output, err, sizeof err) < 0) ||
         render_writable(o.render.output, err, sizeof err) < 0) {
       fprintf(stderr, "qcs: error: -o: %s\n", err);
       return 1;

@@ -292,6 +292,69 @@ int soft_surface_bounds(const soft_obj *o, double lo[3], double hi[3]) {
   return lo[0] <= hi[0];
 }
 
+/* ---- the field's range over a box ------------------------------------ */
+
+/* Squared distances from the origin to the nearest and farthest points of
+ * the box [lo, hi]. */
+static void box_dist2(const double lo[3], const double hi[3], double *dmin2,
+                      double *dmax2) {
+  double a = 0, b = 0;
+  for (int i = 0; i < 3; i++) {
+    double n = lo[i] > 0 ? lo[i] : (hi[i] < 0 ? -hi[i] : 0);
+    double f = fabs(lo[i]) > fabs(hi[i]) ? fabs(lo[i]) : fabs(hi[i]);
+    a += n * n;
+    b += f * f;
+  }
+  *dmin2 = a;
+  *dmax2 = b;
+}
+
+int soft_field_box(const soft_obj *obj, const double lo[3], const double hi[3],
+                   double *flo, double *fhi) {
+  double fl = 0, fh = 0, mag = 0;
+  for (size_t i = 0; i < obj->nkeys; i++) {
+    const nkey *k = &obj->keys[i];
+    if (k->empty) continue;
+    int apart = 0;
+    for (int j = 0; j < 3; j++)
+      if (hi[j] < k->lo[j] || lo[j] > k->hi[j]) apart = 1;
+    if (apart) continue; /* s >= 1 over the box: no contribution */
+    double ol[3], oh[3], dmin2, dmax2, lmin, lmax;
+    for (int j = 0; j < 3; j++) {
+      ol[j] = lo[j] - k->x0[j];
+      oh[j] = hi[j] - k->x0[j];
+    }
+    box_dist2(ol, oh, &dmin2, &dmax2);
+    if (k->sphere) {
+      lmin = lmax = k->a[0];
+    } else { /* Gershgorin's discs bound A's eigenvalues */
+      double r0 = fabs(k->a[3]) + fabs(k->a[4]);
+      double r1 = fabs(k->a[3]) + fabs(k->a[5]);
+      double r2 = fabs(k->a[4]) + fabs(k->a[5]);
+      lmin = fmin(k->a[0] - r0, fmin(k->a[1] - r1, k->a[2] - r2));
+      lmax = fmax(k->a[0] + r0, fmax(k->a[1] + r1, k->a[2] + r2));
+      if (lmin < 0) lmin = 0;
+    }
+    /* s over the box lies in [smin, smax], widened for rounding */
+    double smin = lmin * dmin2 + k->k, smax = lmax * dmax2 + k->k;
+    smin -= 1e-12 * (fabs(smin) + 1);
+    smax += 1e-12 * (fabs(smax) + 1);
+    double cl = cfield(smax), ch = cfield(smin); /* C falls for s < 1 */
+    if (ch > k->cmax) ch = k->cmax;
+    if (k->w >= 0) {
+      fl += k->w * cl;
+      fh += k->w * ch;
+    } else {
+      fl += k->w * ch;
+      fh += k->w * cl;
+    }
+    mag += fabs(k->w) * k->cmax;
+  }
+  *flo = fl - 1e-12 * mag;
+  *fhi = fh + 1e-12 * mag;
+  return 0;
+}
+
 /* ---- field and gradient ---------------------------------------------- */
 
 /* ap = A p for the key's matrix A. */

@@ -86,6 +86,13 @@ int soft_bounds(const soft_obj *obj, double lo[3], double hi[3]);
  * empty. */
 int soft_surface_bounds(const soft_obj *obj, double lo[3], double hi[3]);
 
+/* Bounds [*flo, *fhi] on the field over the closed box [lo, hi] (interval
+ * arithmetic per key, widened for rounding): the mesher's proof that a
+ * cell is wholly inside or outside. Every key is visited (O(keys)).
+ * Returns 0. */
+int soft_field_box(const soft_obj *obj, const double lo[3], const double hi[3],
+                   double *flo, double *fhi);
+
 /* eq. (1) summed over the keys: the field at p. */
 double soft_field(const soft_obj *obj, const double p[3]);
 

@@ -1,0 +1,152 @@
+/* mesh_lang.c: mesh and meshWith (see mesh_lang.h). */
+#include "bind/mesh_lang.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "bind/compile.h"
+#include "bind/render_lang.h"
+#include "lang/builtins.h"
+#include "lang/eval.h"
+#include "render/mesh.h"
+#include "render/render.h"
+
+/* The default tolerance: this fraction of the object's largest side. */
+#define MESH_DEFAULT_REL 0.01
+#define MESH_DEFAULT_MAX_TRIANGLES 20000000
+
+static void report(FILE *f, const MeshReport *r, const char *path, double e) {
+  fprintf(f, "qcs: mesh %s: %zu triangles, %zu vertices in %.2f s\n", path,
+          r->triangles, r->vertices, r->seconds);
+  fprintf(f, "  octree: %ld cells visited, %ld proven empty, %ld proven "
+          "full, %ld finest cells meshed (depth %d, cell %.4g)\n", r->cells,
+          r->empty, r->full, r->leaves, r->depth, r->h);
+  fprintf(f, "  distance to the surface: certified <= %.4g (requested %.4g; vertices within "
+          "%.2g of the surface)\n", r->certified, e, r->vtol);
+  fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",
+          r->crossings - r->bisected, r->bisected);
+}
+
+static int do_mesh(const struct Scene *s, const MeshSettings *ms,
+                   const char *path, int quiet, int *bad, char *err,
+                   size_t errlen) {
+  Mesh *m;
+  MeshReport rep;
+  MeshSettings m2 = *ms;
+  if (m2.tol < 0) { /* the default: relative to the object's box */
+    double lo[3], hi[3], size = 0;
+    int bounded = render_node_box(s, s->root, lo, hi);
+    if (!bounded && m2.has_bounds) {
+      memcpy(lo, m2.lo, sizeof lo);
+      memcpy(hi, m2.hi, sizeof hi);
+      bounded = 1;
+    }
+    for (int i = 0; bounded && i < 3; i++)
+      if (isfinite(hi[i] - lo[i])) size = fmax(size, hi[i] - lo[i]);
+    m2.tol = size > 0 ? MESH_DEFAULT_REL * size : 1;
+  }
+  int rc = mesh_scene(s, s->root, &m2, &m, &rep, bad, err, errlen);
+  if (rc) return rc;
+  rc = mesh_write(m, path, err, errlen);
+  mesh_free(m);
+  if (rc) return -1;
+  if (!quiet) report(stderr, &rep, path, m2.tol);
+  return 0;
+}
+
+int mesh_lang_capture(void *ctx, const struct Scene *s,
+                      const struct RenderSettings *rs, const char *path,
+                      char *err, size_t errlen) {
+  MeshSettings ms = {0};
+  ms.tol = -1;
+  ms.max_triangles = MESH_DEFAULT_MAX_TRIANGLES;
+  int bad;
+  char e2[400];
+  if (do_mesh(s, &ms, path, 0, &bad, e2, sizeof e2) == 0) return 0;
+  if (bad >= 0) {
+    Pos p = compile_node_pos(s, bad);
+    if (p.src)
+      snprintf(err, errlen, "%s (the unbounded part: %s:%d:%d)", e2,
+               p.src->name, p.line, p.col);
+    else snprintf(err, errlen, "%s", e2);
+  } else {
+    snprintf(err, errlen, "%s", e2);
+  }
+  return -1;
+}
+
+static int con_is(Value *v, const char *name) {
+  return v->kind == V_CON && !strcmp(v->u.con.con->name, name);
+}
+
+/* meshWith settings file obj */
+static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
+  pos = eval_user_pos(I, pos); /* mesh is meshWith [] in the prelude */
+  const char *path = force_str(I, args[1], pos, "the output file name");
+  MeshSettings ms = {0};
+  ms.tol = -1;
+  ms.max_triangles = MESH_DEFAULT_MAX_TRIANGLES;
+  int quiet = 0;
+  for (Value *l = force(I, args[0]);; l = force(I, l->u.cons.tail)) {
+    if (l->kind == V_NIL) break;
+    if (l->kind != V_CONS)
+      qcs_error(pos, "the settings of meshWith are a list, not %s",
+                val_describe(l));
+    Value *s = force(I, l->u.cons.head);
+    Pos sp = s->kind == V_CON && s->u.con.pos ? *s->u.con.pos : pos;
+    if (con_is(s, "Tolerance")) {
+      double t = force_num(I, s->u.con.args[0], sp, "the mesh tolerance");
+      if (!(t > 0) || !isfinite(t))
+        qcs_error(sp, "the mesh tolerance must be finite and > 0, not %g", t);
+      ms.tol = t;
+    } else if (con_is(s, "Bounds")) {
+      force_vec3(I, s->u.con.args[0], sp, "the low corner", ms.lo);
+      force_vec3(I, s->u.con.args[1], sp, "the high corner", ms.hi);
+      for (int i = 0; i < 3; i++)
+        if (!isfinite(ms.lo[i]) || !isfinite(ms.hi[i]) || !(ms.lo[i] < ms.hi[i]))
+          qcs_error(sp, "Bounds lo hi needs finite corners with lo < hi on "
+                    "every axis");
+      ms.has_bounds = 1;
+    } else if (con_is(s, "MaxTriangles")) {
+      double n = force_num(I, s->u.con.args[0], sp, "the triangle limit");
+      if (!(n >= 1) || n > 1e9 || n != floor(n))
+        qcs_error(sp, "MaxTriangles needs a whole number from 1 to 10^9");
+      ms.max_triangles = (size_t)n;
+    } else if (con_is(s, "Quiet")) {
+      quiet = 1;
+    } else {
+      char buf[160];
+      val_brief(s, buf, sizeof buf);
+      qcs_error(sp, "not a mesh setting: %s (meshWith takes Tolerance, "
+                "Bounds, MaxTriangles, Quiet)", buf);
+    }
+  }
+  if (!mesh_is_mesh_path(path))
+    qcs_error(pos, "cannot write %s: a mesh is written as .stl or .obj", path);
+  char err[512];
+  if (render_writable(path, err, sizeof err) < 0) qcs_error(pos, "%s", err);
+  Scene *s = compile_scene(I, args[2], pos);
+  int bad = -1;
+  int rc = do_mesh(s, &ms, path, quiet, &bad, err, sizeof err);
+  Pos bp = bad >= 0 ? compile_node_pos(s, bad) : pos;
+  scene_free(s);
+  if (rc) {
+    if (bad >= 0 && bp.src)
+      qcs_error(bp, "%s: %s", path, err);
+    qcs_error(pos, "%s: %s", path, err);
+  }
+  return val_str(path);
+}
+
+static const Builtin mesh_builtins[] = {
+    {"meshWith", 3, bi_mesh_with,
+     "meshWith settings file object: a closed triangle mesh (.stl, .obj) "
+     "within Tolerance e; e.g. meshWith [Tolerance 0.05, Quiet] "
+     "\"cube.obj\" (Rounded 0.1 UnitCube)"},
+};
+
+void mesh_lang_install(Interp *I) {
+  for (size_t i = 0; i < sizeof mesh_builtins / sizeof *mesh_builtins; i++)
+    builtin_define(I, &mesh_builtins[i]);
+}

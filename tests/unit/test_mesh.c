@@ -1,0 +1,349 @@
+/* test_mesh.c: the mesher (render/mesh.h) on every object kind, checked
+ * independently of its own bookkeeping: closure and orientation by
+ * counting directed edges here (not with mesh_check), the Euler
+ * characteristic and the components against the known topology, the
+ * signed volume (outward orientation), the distance of triangle points
+ * from the surface by point classification at +-tol, and the distance of
+ * surface points (crossings of random rays, scene/ray.h) from the mesh by
+ * brute force over the triangles. Bad input: every error before the work,
+ * and no file left behind. */
+#include <gc.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "bind/bind.h"
+#include "bind/compile.h"
+#include "lang/eval.h"
+#include "lang/interp.h"
+#include "lang/parse.h"
+#include "render/mesh.h"
+#include "scene/ray.h"
+
+static Interp *I;
+
+static Scene *compile(const char *text) {
+  Src *src = malloc(sizeof *src);
+  size_t n = strlen(text) + 1;
+  char *copy = malloc(n);
+  memcpy(copy, text, n);
+  src->name = "<test>";
+  src->text = copy;
+  ErrFrame f;
+  Scene *volatile s = NULL;
+  if (ERR_TRY(f)) {
+    Expr *e = parse_expression(I, src);
+    Value *v = eval(I, e, NULL);
+    s = compile_scene(I, v, pos_none);
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    printf("# compile error: %s\n", err_info()->msg);
+  }
+  return s;
+}
+
+static unsigned long long rng = 88172645463325252ull;
+static double urand(void) {
+  rng ^= rng << 13;
+  rng ^= rng >> 7;
+  rng ^= rng << 17;
+  return (double)(rng >> 11) / 9007199254740992.0;
+}
+
+static int cmp(const void *x, const void *y) {
+  unsigned long long a = *(const unsigned long long *)x,
+                     b = *(const unsigned long long *)y;
+  return a < b ? -1 : a > b;
+}
+
+/* Independent edge counting: every directed edge once, its reverse once. */
+static int closed_oriented(const Mesh *m, long *euler) {
+  size_t ne = 3 * m->nt;
+  unsigned long long *e = malloc(ne * sizeof *e);
+  for (size_t i = 0; i < m->nt; i++)
+    for (int k = 0; k < 3; k++) {
+      unsigned long long a = (unsigned)m->t[3 * i + k],
+                         b = (unsigned)m->t[3 * i + (k + 1) % 3];
+      e[3 * i + k] = a << 32 | b;
+    }
+  qsort(e, ne, sizeof *e, cmp);
+  int ok = 1;
+  for (size_t i = 0; i + 1 < ne; i++)
+    if (e[i] == e[i + 1]) ok = 0; /* a directed edge twice */
+  for (size_t i = 0; i < ne && ok; i++) {
+    unsigned long long r = (e[i] & 0xffffffffull) << 32 | e[i] >> 32;
+    if (!bsearch(&r, e, ne, sizeof *e, cmp)) ok = 0;
+  }
+  char *used = calloc(m->nv, 1);
+  long nv = 0;
+  for (size_t i = 0; i < 3 * m->nt; i++)
+    if (!used[m->t[i]]) used[m->t[i]] = 1, nv++;
+  *euler = nv - (long)(ne / 2) + (long)m->nt;
+  free(used);
+  free(e);
+  return ok;
+}
+
+static double volume(const Mesh *m) {
+  double v = 0;
+  for (size_t i = 0; i < m->nt; i++) {
+    const double *a = m->v + 3 * m->t[3 * i], *b = m->v + 3 * m->t[3 * i + 1],
+                 *c = m->v + 3 * m->t[3 * i + 2];
+    v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+         a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  return v / 6;
+}
+
+/* Squared distance from p to triangle abc (Ericson's closest point). */
+static double d2_tri(const double p[3], const double *a, const double *b,
+                     const double *c) {
+  double ab[3], ac[3], ap[3], q[3];
+  for (int i = 0; i < 3; i++) ab[i] = b[i] - a[i], ac[i] = c[i] - a[i], ap[i] = p[i] - a[i];
+  double d1 = vec3_dot(ab, ap), d2 = vec3_dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) { memcpy(q, a, sizeof q); goto out; }
+  double bp[3];
+  for (int i = 0; i < 3; i++) bp[i] = p[i] - b[i];
+  double d3 = vec3_dot(ab, bp), d4 = vec3_dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) { memcpy(q, b, sizeof q); goto out; }
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    double v = d1 / (d1 - d3);
+    for (int i = 0; i < 3; i++) q[i] = a[i] + v * ab[i];
+    goto out;
+  }
+  double cp[3];
+  for (int i = 0; i < 3; i++) cp[i] = p[i] - c[i];
+  double d5 = vec3_dot(ab, cp), d6 = vec3_dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) { memcpy(q, c, sizeof q); goto out; }
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    double w = d2 / (d2 - d6);
+    for (int i = 0; i < 3; i++) q[i] = a[i] + w * ac[i];
+    goto out;
+  }
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    for (int i = 0; i < 3; i++) q[i] = b[i] + w * (c[i] - b[i]);
+    goto out;
+  }
+  {
+    double den = 1 / (va + vb + vc), v = vb * den, w = vc * den;
+    for (int i = 0; i < 3; i++) q[i] = a[i] + ab[i] * v + ac[i] * w;
+  }
+out:;
+  double d = 0;
+  for (int i = 0; i < 3; i++) d += (p[i] - q[i]) * (p[i] - q[i]);
+  return d;
+}
+
+/* Triangle points: is there a sign change within distance e (along the
+   triangle's normal and the axes)? Returns the number of failures. */
+static long mesh_to_surface(const Scene *s, const Mesh *m, double e, int n) {
+  long bad = 0;
+  for (int k = 0; k < n; k++) {
+    size_t i = (size_t)(urand() * (double)m->nt);
+    const double *a = m->v + 3 * m->t[3 * i], *b = m->v + 3 * m->t[3 * i + 1],
+                 *c = m->v + 3 * m->t[3 * i + 2];
+    double u = urand(), v = urand();
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    double p[3], nn[3], ab[3], ac[3];
+    for (int j = 0; j < 3; j++) {
+      p[j] = a[j] + u * (b[j] - a[j]) + v * (c[j] - a[j]);
+      ab[j] = b[j] - a[j];
+      ac[j] = c[j] - a[j];
+    }
+    vec3_cross(ab, ac, nn);
+    double l = sqrt(vec3_dot(nn, nn));
+    double dirs[7][3] = {{nn[0] / l, nn[1] / l, nn[2] / l}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    int in0 = scene_inside(s, s->root, p), change = 0;
+    for (int d = 0; d < 4 && !change && l > 0; d++)
+      for (int sg = -1; sg <= 1; sg += 2) {
+        double q[3];
+        for (int j = 0; j < 3; j++) q[j] = p[j] + sg * 0.999 * e * dirs[d][j];
+        if (scene_inside(s, s->root, q) != in0) change = 1;
+      }
+    if (!change && l > 0) bad++;
+  }
+  return bad;
+}
+
+/* Surface points (crossings of random rays through the box) against the
+   mesh: the largest distance found. */
+static double surface_to_mesh(const Scene *s, const Mesh *m, int nrays) {
+  RayCtx *c = ray_ctx_new(s, 1e-9);
+  double worst = 0, lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (size_t i = 0; i < 3 * m->nv; i++) {
+    if (m->v[i] < lo[i % 3]) lo[i % 3] = m->v[i];
+    if (m->v[i] > hi[i % 3]) hi[i % 3] = m->v[i];
+  }
+  for (int r = 0; r < nrays; r++) {
+    double o[3], t[3], d[3];
+    for (int j = 0; j < 3; j++) {
+      o[j] = lo[j] + (hi[j] - lo[j]) * (urand() * 3 - 1);
+      t[j] = lo[j] + (hi[j] - lo[j]) * urand();
+      d[j] = t[j] - o[j];
+    }
+    csg_span *sp;
+    ray_reset(c);
+    int n = ray_spans(s, s->root, o, d, 0, 4, c, &sp);
+    for (int q = 0; q < n; q++)
+      for (int e = 0; e < 2; e++) {
+        double tt = e ? sp[q].t1 : sp[q].t0, p[3], best = 1e300;
+        if (!(tt > 0 && tt < 4)) continue;
+        for (int j = 0; j < 3; j++) p[j] = o[j] + tt * d[j];
+        for (size_t i = 0; i < m->nt; i++) {
+          double dd = d2_tri(p, m->v + 3 * m->t[3 * i], m->v + 3 * m->t[3 * i + 1],
+                             m->v + 3 * m->t[3 * i + 2]);
+          if (dd < best) best = dd;
+        }
+        if (sqrt(best) > worst) worst = sqrt(best);
+      }
+  }
+  ray_ctx_free(c);
+  return worst;
+}
+
+static void one(const char *name, const char *src, double tol, long euler,
+                long comps, double vol, int check_surface) {
+  char buf[600];
+  Scene *s = compile(src);
+  CHECK(name, s != NULL);
+  if (!s) return;
+  MeshSettings ms = {0};
+  ms.tol = tol;
+  Mesh *m;
+  MeshReport rep;
+  char err[300];
+  int bad;
+  int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  snprintf(buf, sizeof buf, "%s: meshed (%s)", name, rc ? err : "ok");
+  CHECK(buf, rc == 0);
+  if (rc) {
+    scene_free(s);
+    return;
+  }
+  long eu;
+  snprintf(buf, sizeof buf, "%s: closed and consistently oriented by edge counting", name);
+  CHECK(buf, closed_oriented(m, &eu));
+  snprintf(buf, sizeof buf, "%s: Euler characteristic %ld", name, euler);
+  CHECK_NEAR(buf, (double)eu, (double)euler, 0);
+  MeshCheck ck;
+  snprintf(buf, sizeof buf, "%s: mesh_check agrees, %ld component(s)", name, comps);
+  CHECK(buf, mesh_check(m, &ck) == 0 && ck.components == comps && ck.euler == eu);
+  snprintf(buf, sizeof buf, "%s: certified error %.4g <= tolerance %.4g", name,
+           rep.certified, tol);
+  CHECK(buf, rep.certified <= tol);
+  double v = volume(m);
+  snprintf(buf, sizeof buf, "%s: outward (signed volume %.4f > 0)", name, v);
+  CHECK(buf, v > 0);
+  if (vol > 0) {
+    snprintf(buf, sizeof buf, "%s: volume %.4f near %.4f", name, v, vol);
+    CHECK_NEAR(buf, v, vol, 0.05 * vol);
+  }
+  long far = mesh_to_surface(s, m, tol, 3000);
+  snprintf(buf, sizeof buf, "%s: 3000 triangle points within tol of the surface", name);
+  CHECK_NEAR(buf, (double)far, 0, 0);
+  if (check_surface) {
+    double w = surface_to_mesh(s, m, 40);
+    snprintf(buf, sizeof buf, "%s: ray crossings within tol of the mesh (worst %.3g)", name, w);
+    CHECK(buf, w <= tol);
+  }
+  printf("# %s: %zu triangles, %ld cells (%ld empty, %ld full, %ld meshed), "
+         "certified %.4g, %.3f s\n", name, rep.triangles, rep.cells, rep.empty,
+         rep.full, rep.leaves, rep.certified, rep.seconds);
+  mesh_free(m);
+  scene_free(s);
+}
+
+static void bad_input(void) {
+  Scene *s = compile("UnitCube");
+  MeshSettings ms = {0};
+  Mesh *m = NULL;
+  MeshReport rep;
+  char err[300];
+  int bad;
+  double tols[] = {0, NAN, 1e-300, -1, INFINITY};
+  for (int i = 0; i < 5; i++) {
+    ms.tol = tols[i];
+    CHECK("bad tolerance refused", mesh_scene(s, s->root, &ms, &m, &rep, &bad, err,
+                                              sizeof err) == MESH_ETOL && !m);
+  }
+  ms.tol = 0.05;
+  ms.max_triangles = 100;
+  CHECK("max-triangles refused before the crossings",
+        mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err) == MESH_ELIMIT &&
+            rep.crossings == 0 && strstr(err, "max-triangles"));
+  ms.max_triangles = 0;
+  ms.max_cells = 10;
+  CHECK("max-cells refused", mesh_scene(s, s->root, &ms, &m, &rep, &bad, err,
+                                        sizeof err) == MESH_ELIMIT);
+  scene_free(s);
+  s = compile("Halfspace ((0, 1, 0), 0)");
+  ms.max_cells = 0;
+  CHECK("unbounded refused, naming the node",
+        mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err) ==
+                MESH_EUNBOUNDED && bad == s->root);
+  ms.has_bounds = 1;
+  double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+  memcpy(ms.lo, lo, sizeof lo);
+  memcpy(ms.hi, hi, sizeof hi);
+  int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  long eu;
+  CHECK("a floor with Bounds: a closed slab", rc == 0 && closed_oriented(m, &eu) && eu == 2);
+  if (!rc) CHECK_NEAR("the slab's volume", volume(m), 4, 0.05);
+  mesh_free(m);
+  scene_free(s);
+  s = compile("Intersection UnitCube (Shift (3, 0, 0) UnitCube)");
+  ms.has_bounds = 0;
+  rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  if (rc != MESH_EEMPTY) printf("# rc %d: %s\n", rc, err);
+  CHECK("an empty object refused", rc == MESH_EEMPTY);
+  scene_free(s);
+  /* written whole or not at all */
+  s = compile("UnitCube");
+  ms.tol = 0.1;
+  rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  CHECK("no file for a bad folder",
+        rc == 0 && mesh_write(m, "/nonexistent/x.stl", err, sizeof err) < 0 &&
+            access("/nonexistent/x.stl", F_OK) != 0);
+  char path[] = "/tmp/qcs-mesh-test.stl";
+  CHECK("binary STL size", mesh_write(m, path, err, sizeof err) == 0);
+  FILE *f = fopen(path, "rb");
+  fseek(f, 0, SEEK_END);
+  CHECK_NEAR("binary STL is 84 + 50 n bytes", (double)ftell(f),
+             84.0 + 50.0 * (double)m->nt, 0);
+  fclose(f);
+  unlink(path);
+  mesh_free(m);
+  scene_free(s);
+}
+
+int main(void) {
+  check_prefix = "mesh";
+  I = bind_interp_new();
+  char probe;
+  interp_set_stack(I, &probe, 4u << 20);
+  const char *hole = "(Shift (0.25, -0.5, 0.25) (Scale (0.5, 2, 0.5) UnitCube))";
+  const char *pocket = "(Shift (0.25, 0.8, 0.25) (Scale (0.5, 0.5, 0.5) UnitCube))";
+  char src[600];
+  one("UnitCube", "UnitCube", 0.04, 2, 1, 1, 1);
+  one("Rounded 0.2 UnitCube", "Rounded 0.2 UnitCube", 0.04, 2, 1, 0, 1);
+  snprintf(src, sizeof src, "Rounded 0.07 (Difference UnitCube %s)", pocket);
+  one("obj4 (a pocket)", src, 0.04, 2, 1, 0.95, 0);
+  snprintf(src, sizeof src, "Rounded 0.07 (Difference UnitCube %s)", hole);
+  one("rounded cube with a hole (genus 1)", src, 0.04, 0, 1, 0, 1);
+  snprintf(src, sizeof src, "SetDifference UnitCube %s", hole);
+  one("sharp cube with a hole (genus 1)", src, 0.04, 0, 1, 0.75, 1);
+  one("two cubes", "Union UnitCube (Shift (2, 0, 0) UnitCube)", 0.05, 4, 2, 2, 0);
+  one("soft, a negative key", "SoftObject 0.5 [Key (0, 0, 0) 1 1, "
+      "Key (0.5, 0, 0) 0.5 (-1)]", 0.04, 2, 1, 0, 1);
+  one("soft, a quadric key", "SoftObject 0.5 [QuadricKey ((1, 0, 0, 0), "
+      "(0, 4, 0, 0), (0, 0, 1, 0), (0, 0, 0, 0)) 1 1]", 0.04, 2, 1, 0, 1);
+  snprintf(src, sizeof src, "SetDifference (Rounded 0.1 UnitCube) "
+           "(SoftObject 0.5 [Key (1, 1, 1) 0.8 1])");
+  one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
+  bad_input();
+  CHECK_DONE();
+}
