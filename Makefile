@@ -31,7 +31,9 @@ PKG_LIBS   = $(shell pkg-config --libs $(PC_PKGS) 2>/dev/null)
 # The front end alone draws pictures in the terminal (libchafa).
 APP_PC     := chafa libmicrohttpd
 APP_CFLAGS = $(shell pkg-config --cflags $(APP_PC) 2>/dev/null)
-APP_LIBS   = $(shell pkg-config --libs $(APP_PC) 2>/dev/null)
+# Their libraries are loaded when first used (src/app/dynlib.h), not linked:
+# a script does not pay for them at start-up.
+APP_LIBS   = -ldl
 CFLAGS  ?= $(OPT) -g
 ALL_CFLAGS = -std=c11 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -DGC_THREADS \
              $(WARN) $(CFLAGS) $(PKG_CFLAGS) -MMD -MP -Isrc -I$(BUILD)

@@ -11,6 +11,76 @@
 #include <unistd.h>
 
 #include "render/progressive.h"
+#include "app/dynlib.h"
+
+/* libchafa (and glib, which it brings) is loaded the first time a picture
+   is drawn or a terminal asked about (app/dynlib.h): the functions this
+   file calls, through a table of their own types. */
+#define CHAFA_FUNCS(X) \
+  X(chafa_term_db_get_default) X(chafa_term_db_detect) \
+  X(chafa_term_db_get_fallback_info) X(chafa_term_info_have_seq) \
+  X(chafa_term_info_unref) X(chafa_set_n_threads) X(chafa_canvas_config_new) \
+  X(chafa_canvas_config_unref) X(chafa_canvas_config_set_geometry) \
+  X(chafa_canvas_config_set_canvas_mode) \
+  X(chafa_canvas_config_set_pixel_mode) \
+  X(chafa_canvas_config_set_cell_geometry) \
+  X(chafa_canvas_config_set_symbol_map) X(chafa_symbol_map_new) \
+  X(chafa_symbol_map_add_by_tags) X(chafa_symbol_map_remove_by_tags) \
+  X(chafa_symbol_map_unref) X(chafa_canvas_new) X(chafa_canvas_unref) \
+  X(chafa_canvas_draw_all_pixels) X(chafa_canvas_print) X(g_string_free)
+static struct {
+#define X(f) __typeof__(f) *f;
+  CHAFA_FUNCS(X)
+#undef X
+} cf;
+static int cf_state; /* 0: not tried, 1: loaded, -1: failed */
+
+/* 0 once chafa is loaded; -1 (said once on stderr) if it cannot be. */
+static int chafa_load(void) {
+  if (cf_state) return cf_state > 0 ? 0 : -1;
+  static const char *const sonames[] = {"libchafa.so.0", "libchafa.so", NULL};
+  static const char *const names[] = {
+#define X(f) #f,
+      CHAFA_FUNCS(X)
+#undef X
+  };
+  void *fns[sizeof names / sizeof *names];
+  char err[300];
+  if (dynlib_load(sonames, "libchafa0", names, fns,
+                  sizeof names / sizeof *names, err, sizeof err)) {
+    fprintf(stderr, "qcs: no pictures: %s\n", err);
+    cf_state = -1;
+    return -1;
+  }
+  size_t k = 0;
+#define X(f) memcpy(&cf.f, &fns[k++], sizeof cf.f);
+  CHAFA_FUNCS(X)
+#undef X
+  cf_state = 1;
+  return 0;
+}
+#define chafa_term_db_get_default (cf.chafa_term_db_get_default)
+#define chafa_term_db_detect (cf.chafa_term_db_detect)
+#define chafa_term_db_get_fallback_info (cf.chafa_term_db_get_fallback_info)
+#define chafa_term_info_have_seq (cf.chafa_term_info_have_seq)
+#define chafa_term_info_unref (cf.chafa_term_info_unref)
+#define chafa_set_n_threads (cf.chafa_set_n_threads)
+#define chafa_canvas_config_new (cf.chafa_canvas_config_new)
+#define chafa_canvas_config_unref (cf.chafa_canvas_config_unref)
+#define chafa_canvas_config_set_geometry (cf.chafa_canvas_config_set_geometry)
+#define chafa_canvas_config_set_canvas_mode (cf.chafa_canvas_config_set_canvas_mode)
+#define chafa_canvas_config_set_pixel_mode (cf.chafa_canvas_config_set_pixel_mode)
+#define chafa_canvas_config_set_cell_geometry (cf.chafa_canvas_config_set_cell_geometry)
+#define chafa_canvas_config_set_symbol_map (cf.chafa_canvas_config_set_symbol_map)
+#define chafa_symbol_map_new (cf.chafa_symbol_map_new)
+#define chafa_symbol_map_add_by_tags (cf.chafa_symbol_map_add_by_tags)
+#define chafa_symbol_map_remove_by_tags (cf.chafa_symbol_map_remove_by_tags)
+#define chafa_symbol_map_unref (cf.chafa_symbol_map_unref)
+#define chafa_canvas_new (cf.chafa_canvas_new)
+#define chafa_canvas_unref (cf.chafa_canvas_unref)
+#define chafa_canvas_draw_all_pixels (cf.chafa_canvas_draw_all_pixels)
+#define chafa_canvas_print (cf.chafa_canvas_print)
+#define g_string_free (cf.g_string_free)
 
 extern char **environ;
 
@@ -32,6 +102,7 @@ int preview_mode_parse(const char *s, PreviewMode *m) {
 
 /* What chafa's terminal database makes of the environment. */
 static ChafaTermInfo *term_info(void) {
+  if (chafa_load()) return NULL;
   return chafa_term_db_detect(chafa_term_db_get_default(), environ);
 }
 
@@ -45,6 +116,7 @@ PreviewMode preview_resolve(PreviewMode m, int fd) {
     return PREVIEW_SYMBOLS;
   if (term && !strcmp(term, "dumb")) return PREVIEW_OFF;
   ChafaTermInfo *ti = term_info();
+  if (!ti) return PREVIEW_OFF; /* no libchafa: values are printed */
   PreviewMode r = PREVIEW_SYMBOLS;
   if (chafa_term_info_have_seq(ti, CHAFA_TERM_SEQ_BEGIN_KITTY_IMMEDIATE_IMAGE_V1))
     r = PREVIEW_KITTY;
@@ -145,6 +217,7 @@ typedef struct Drawer {
 static int drawer_init(Drawer *d, FILE *out, PreviewMode m, int cols,
                        int rows, int out_fd) {
   memset(d, 0, sizeof *d);
+  if (chafa_load()) return -1;
   d->out = out;
   d->cols = cols;
   d->rows = rows;

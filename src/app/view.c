@@ -32,6 +32,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "app/dynlib.h"
 #include "bind/bind.h"
 #include "bind/compile.h"
 #include "bind/render_lang.h"
@@ -44,6 +45,49 @@
 #include "scene/ray.h"
 
 #include "view_page.inc"
+
+/* libmicrohttpd is loaded when a viewer starts (app/dynlib.h): the
+   functions this file calls, through a table of their own types. */
+#define MHD_FUNCS(X)                                                          \
+  X(MHD_start_daemon) X(MHD_stop_daemon) X(MHD_get_daemon_info)               \
+  X(MHD_lookup_connection_value) X(MHD_create_response_from_buffer)           \
+  X(MHD_add_response_header) X(MHD_queue_response) X(MHD_destroy_response)
+static struct {
+#define X(f) __typeof__(f) *f;
+  MHD_FUNCS(X)
+#undef X
+} mhd;
+static int mhd_loaded;
+static int mhd_load(void) {
+  static const char *const sonames[] = {"libmicrohttpd.so.12",
+                                        "libmicrohttpd.so", NULL};
+  static const char *const names[] = {
+#define X(f) #f,
+      MHD_FUNCS(X)
+#undef X
+  };
+  void *fns[sizeof names / sizeof *names];
+  char err[300];
+  if (dynlib_load(sonames, "libmicrohttpd12", names, fns,
+                  sizeof names / sizeof *names, err, sizeof err)) {
+    fprintf(stderr, "qcs: error: view: %s\n", err);
+    return -1;
+  }
+  size_t k = 0;
+#define X(f) memcpy(&mhd.f, &fns[k++], sizeof mhd.f);
+  MHD_FUNCS(X)
+#undef X
+  mhd_loaded = 1;
+  return 0;
+}
+#define MHD_start_daemon (mhd.MHD_start_daemon)
+#define MHD_stop_daemon (mhd.MHD_stop_daemon)
+#define MHD_get_daemon_info (mhd.MHD_get_daemon_info)
+#define MHD_lookup_connection_value (mhd.MHD_lookup_connection_value)
+#define MHD_create_response_from_buffer (mhd.MHD_create_response_from_buffer)
+#define MHD_add_response_header (mhd.MHD_add_response_header)
+#define MHD_queue_response (mhd.MHD_queue_response)
+#define MHD_destroy_response (mhd.MHD_destroy_response)
 
 #define VIEW_CONN_MEMORY ((size_t)64 << 10)
 #define RUNGS 4
@@ -1040,6 +1084,7 @@ static void on_signal(int sig) {
 }
 
 static struct MHD_Daemon *start(View *v, const ViewOptions *o) {
+  if (!mhd_loaded && mhd_load()) return NULL;
   struct sockaddr_in sa;
   memset(&sa, 0, sizeof sa);
   sa.sin_family = AF_INET;

@@ -82,7 +82,7 @@ int soft_bounds(const soft_obj *obj, double lo[3], double hi[3]);
  * positive keys of where w_i C(s) >= magic / n_i. A lone key of weight 1
  * and magic 0.5: radius R / 2, not R. Negative keys only subtract and
  * are left out. A key met by more than 32 others keeps its whole bound,
- * and past 200000 keys this is soft_bounds. Returns 0 (and lo > hi) if
+ * and past 20000 keys this is soft_bounds. Returns 0 (and lo > hi) if
  * empty. */
 int soft_surface_bounds(const soft_obj *obj, double lo[3], double hi[3]);
 

@@ -150,15 +150,34 @@ static char *gc_strndup(const char *s, size_t n) {
   return p;
 }
 
+/* The start of each line of the source last asked about (the items of a
+   run come from one source, in order): found once per source instead of
+   once per definition. The static pointers are roots for the collector. */
+static const Src *lines_src;
+static const char **lines_at;
+static int lines_n;
+
+static const char *line_at(const Src *src, int line) {
+  if (src != lines_src) {
+    int n = 1;
+    for (const char *p = src->text; *p; p++) n += *p == '\n';
+    const char **at = GC_MALLOC(sizeof(char *) * (size_t)(n + 1));
+    int k = 0;
+    at[k++] = src->text;
+    for (const char *p = src->text; *p; p++)
+      if (*p == '\n') at[k++] = p + 1;
+    lines_src = src;
+    lines_at = at;
+    lines_n = k;
+  }
+  return line >= 1 && line <= lines_n ? lines_at[line - 1] : NULL;
+}
+
 static void read_doc(Sym *s, Pos pos) {
   s->doc = s->example = NULL;
   if (!pos.src || !pos.src->text || pos.line < 2) return;
-  const char *text = pos.src->text, *cur = text;
-  for (int l = 1; l < pos.line; l++) {
-    cur = strchr(cur, '\n');
-    if (!cur) return;
-    cur++;
-  }
+  const char *text = pos.src->text, *cur = line_at(pos.src, pos.line);
+  if (!cur) return;
   size_t nlen = strlen(s->name);
   while (cur > text) {
     const char *end = cur - 1; /* the '\n' ending the line above */

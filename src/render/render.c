@@ -773,8 +773,11 @@ static int setup_camera(Tracer *T, char *err, size_t errlen) {
     const ScNode *nd = &T->s->nodes[T->prims[i].node];
     Box b = T->prims[i].box;
     /* a soft object is framed by where its surface can be (as
-       camera_scene_box does), not by its keys' reach */
-    if (nd->kind == SC_SOFT && !soft_surface_bounds(nd->soft, b.lo, b.hi))
+       camera_scene_box does), not by its keys' reach; with the camera
+       given there is nothing to frame, and the keys' reach (known
+       already) scales the shadow offset as it always did */
+    if (nd->kind == SC_SOFT && !rs->camera_set &&
+        !soft_surface_bounds(nd->soft, b.lo, b.hi))
       continue;
     all = box_union(all, b);
   }

@@ -1,0 +1,29 @@
+/* dynlib.h: libraries a feature loads when it is first used.
+ *
+ * qcs links at start-up only what every run needs (the interpreter, the
+ * tracer, the image writers). The terminal pictures (libchafa, with glib)
+ * and the viewer's web server (libmicrohttpd, with GnuTLS and its
+ * friends) are loaded by dlopen the first time a picture is drawn or a
+ * viewer starts: a script, a farm task or an animation frame does not pay
+ * for their thirteen libraries (about 4 million instructions of dynamic
+ * linking a process).
+ *
+ * A module that uses such a library lists the functions it calls in an
+ * X-macro and declares, after the library's own header, a table of
+ * pointers of the functions' own types (__typeof__), so every call keeps
+ * the header's prototype. dynlib_load fills the table.
+ *
+ * Threads: call dynlib_load from one thread before others use the table
+ * (the REPL's thread, the viewer's start). */
+#ifndef QCS_DYNLIB_H
+#define QCS_DYNLIB_H
+
+#include <stddef.h>
+
+/* Open the first of the sonames that loads (NULL-terminated) and look up
+   each of the n names into fns[0..n). 0, or -1 with a message in err
+   naming the library and the Debian package that has it. */
+int dynlib_load(const char *const *sonames, const char *package,
+                const char *const *names, void **fns, size_t n, char *err,
+                size_t errlen);
+#endif
