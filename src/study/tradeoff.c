@@ -451,8 +451,8 @@ int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
                "<text x=\"%.1f\" y=\"%.1f\">RMS RGB error</text>\n"
                "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\">points "
                "labelled with samples per pixel</text>\n",
-            L + pw - 150, T + 16, colour[0], L + pw - 140, T + 20,
-            L + pw - 150, T + 38);
+            L + pw - 200, T + 16, colour[0], L + pw - 190, T + 20,
+            L + pw - 200, T + 38);
   } else {
   fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>"
              "<text x=\"%.1f\" y=\"%.1f\">maximum error</text>\n",
