@@ -45,3 +45,28 @@ if "$QCS" tradeoff --size 30x20 --repeats 1 -o "$tmp/m.svg" examples/mould.qcs \
      >"$tmp/out2" 2>"$tmp/err2" && grep -q 'no Rounded object' "$tmp/out2"; then
   echo "ok tradeoff-says-tolerance-unused"
 else echo "FAIL tradeoff-says-tolerance-unused: $(head -c 200 "$tmp/err2")"; fi
+# the cost line: the spread of times over the ladder against the noise
+grep -Eq '^time varies by [0-9]+% over the ladder.*(within|beyond) run-to-run' "$tmp/out" &&
+  echo "ok tradeoff-says-cost-against-noise" ||
+  echo "FAIL tradeoff-says-cost-against-noise: $(grep 'time varies' "$tmp/out")"
+# the samples-per-pixel ladder: 1, 4, 16, 64 against a 256-sample reference
+if "$QCS" tradeoff --spp --size 48x30 --repeats 1 -o "$tmp/s.svg" \
+     examples/figure12.qcs >"$tmp/out3" 2>"$tmp/err3"; then
+  echo "ok tradeoff-spp-runs"
+else echo "FAIL tradeoff-spp-runs: $(head -c 300 "$tmp/err3")"; fi
+# columns: | spp | time | rgb |
+awk -F'|' '/^\| [0-9]+ \|/ { s = $2 + 0; e[s] = $4; t[s] = $3 + 0; n++ }
+  END {
+    if (n != 5 || e[256] !~ /ref/) { print "FAIL tradeoff-spp-errors-fall: " n " rows"; exit }
+    if (!(e[1] + 0 > e[4] + 0 && e[4] + 0 > e[16] + 0 && e[1] + 0 > e[64] + 0 && e[64] + 0 > 0))
+      { print "FAIL tradeoff-spp-errors-fall: " e[1] e[4] e[16] e[64]; exit }
+    if (!(t[64] > t[1])) { print "FAIL tradeoff-spp-errors-fall: 64 spp not slower than 1"; exit }
+    print "ok tradeoff-spp-errors-fall"
+  }' "$tmp/out3"
+if grep -q '<svg' "$tmp/s.svg" 2>/dev/null && grep -q '</svg>' "$tmp/s.svg" &&
+   grep -q 'RMS RGB error against 256 samples' "$tmp/s.svg" &&
+   grep -q '>64 spp<' "$tmp/s.svg" &&
+   { ! command -v python3 >/dev/null ||
+     python3 -c 'import sys, xml.dom.minidom as m; m.parse(sys.argv[1])' "$tmp/s.svg"; }; then
+  echo "ok tradeoff-spp-plot"
+else echo "FAIL tradeoff-spp-plot: no well-formed labelled SVG"; fi

@@ -339,14 +339,17 @@ static void *run(void *arg) {
 /* ---- qcs tradeoff / qcs convolution (issue 6) ---- */
 
 static void tradeoff_usage(FILE *out) {
-  fputs("usage: qcs tradeoff [--size WxH] [--threads N] [--repeats N] "
+  fputs("usage: qcs tradeoff [--spp] [--size WxH] [--threads N] [--repeats N] "
         "[-o PLOT.svg] FILE.qcs\n"
         "       qcs convolution\n"
         "\n"
         "tradeoff: render what FILE renders (or its `scene`) at root "
         "tolerances\n1e-2 ... 1e-12, best of --repeats runs (default 3) "
         "each; print time,\nevaluations and error against the 1e-12 rung; "
-        "plot error against time\n(default tradeoff.svg).\n"
+        "plot error against time\n(default tradeoff.svg). With --spp: "
+        "render it at 1, 4, 16, 64 samples per pixel\nagainst a 256-sample "
+        "reference (the script's size capped to 160 wide unless\n--size) "
+        "and plot RMS RGB error against time.\n"
         "convolution: the quasi-convolutional surface against the true\n"
         "convolution of the polyhedron with the ball, on canonical "
         "objects.\n", out);
@@ -364,6 +367,8 @@ static int tradeoff_args(int argc, char **argv, Options *o) {
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
       tradeoff_usage(stdout);
       return 1;
+    } else if (!strcmp(a, "--spp")) {
+      o->topt.spp_ladder = 1;
     } else if (!strcmp(a, "--size") && i + 1 < argc &&
                sscanf(argv[i + 1], "%dx%d%c", &w, &h, &c) == 2 && w > 0 &&
                h > 0) {

@@ -35,6 +35,8 @@ static Image *render_rung(const Scene *s, const RenderSettings *base,
   Image *im = NULL;
   row->tol = tol;
   row->seconds = INFINITY;
+  row->worst = 0;
+  row->spp = 0;
   for (int k = 0; k < reps; k++) {
     RenderReport rep;
     img_free(im);
@@ -44,6 +46,7 @@ static Image *render_rung(const Scene *s, const RenderSettings *base,
       return NULL;
     }
     if (rep.seconds < row->seconds) row->seconds = rep.seconds;
+    if (rep.seconds > row->worst) row->worst = rep.seconds;
     row->evals = rep.evals;
     row->steps = rep.steps;
   }
@@ -133,6 +136,38 @@ static void compare_rung(const Image *a, const Image *ref, TradeoffRow *row) {
   img_compare(a, ref, &row->rms_rgb, &share, 1.0 / 255.0);
 }
 
+/* The truth about cost: the spread of the best times over the ladder
+   against the run-to-run noise, the largest spread between the repeats of
+   one rung. */
+static void cost_line(FILE *out, const TradeoffRow *rows, int n, int reps) {
+  double lo = INFINITY, hi = 0, noise = 0;
+  int ilo = 0, ihi = 0;
+  for (int i = 0; i < n; i++) {
+    if (rows[i].seconds < lo) lo = rows[i].seconds, ilo = i;
+    if (rows[i].seconds > hi) hi = rows[i].seconds, ihi = i;
+    if (rows[i].seconds > 0)
+      noise = fmax(noise, (rows[i].worst - rows[i].seconds) / rows[i].seconds);
+  }
+  if (!(lo > 0)) return;
+  double spread = 100.0 * (hi - lo) / lo;
+  noise *= 100.0;
+  if (reps < 2)
+    fprintf(out, "\ntime varies by %.0f%% over the ladder; with one run per "
+            "rung the run-to-run noise\nis not measured (--repeats 3 "
+            "measures it).\n", spread);
+  else if (spread <= noise)
+    fprintf(out, "\ntime varies by %.0f%% over the ladder, within run-to-run "
+            "noise of %.0f%% (the largest\nspread between the %d repeats of "
+            "one rung): the tolerance costs almost nothing here.\n",
+            spread, noise, reps);
+  else
+    fprintf(out, "\ntime varies by %.0f%% over the ladder (fastest %.0e, "
+            "slowest %.0e), beyond run-to-run\nnoise of %.0f%% (the largest "
+            "spread between the %d repeats of one rung): the tolerance\n"
+            "costs measurable time here.\n", spread, rows[ilo].tol,
+            rows[ihi].tol, noise, reps);
+}
+
 int tradeoff_scene(const Scene *s, const RenderSettings *base_in,
                    const TradeoffOptions *o, const char *name,
                    TradeoffRow *rows, char *err, size_t errlen) {
@@ -212,12 +247,84 @@ int tradeoff_scene(const Scene *s, const RenderSettings *base_in,
               w->tol, w->seconds, w->evals, w->steps, w->max_dz, w->rms_dz,
               w->rms_rgb, w->changed);
   }
+  cost_line(out, rows, TRADEOFF_RUNGS, reps);
   if (svg[0]) {
     char title[300];
     snprintf(title, sizeof title, "%s, %dx%d: hit-distance error against time",
              name, base.width, base.height);
     if (tradeoff_svg(rows, TRADEOFF_RUNGS - 1, title, svg, err, errlen))
       return -1;
+    fprintf(out, "\nplot written to %s\n", svg);
+  }
+  fflush(out);
+  return 0;
+}
+
+/* ---- the samples-per-pixel ladder ---- */
+
+int tradeoff_spp(const Scene *s, const RenderSettings *base_in,
+                 const TradeoffOptions *o, const char *name,
+                 TradeoffRow *rows, char *err, size_t errlen) {
+  RenderSettings base = *base_in;
+  int capped = 0, sw = base.width, sh = base.height;
+  if (o->width) base.width = o->width, base.height = o->height;
+  else if (base.width > TRADEOFF_SPP_WIDTH) {
+    capped = 1;
+    base.height = (int)lround((double)base.height * TRADEOFF_SPP_WIDTH /
+                              (double)base.width);
+    if (base.height < 1) base.height = 1;
+    base.width = TRADEOFF_SPP_WIDTH;
+  }
+  if (o->threads) base.threads = o->threads;
+  base.progress = NULL;
+  int reps = o->repeats > 0 ? o->repeats : 3;
+  FILE *out = o->out ? o->out : stdout;
+  const char *svg = o->svg ? o->svg : "tradeoff.svg";
+  const int n = TRADEOFF_SPP_RUNGS;
+
+  base.spp = TRADEOFF_SPP_REF;
+  Image *ref = render_rung(s, &base, base.tol, 1, &rows[n], err, errlen);
+  if (!ref) return -1;
+  rows[n].spp = TRADEOFF_SPP_REF;
+  rows[n].rms_rgb = 0;
+  for (int i = 0; i < n; i++) {
+    base.spp = 1 << (2 * i); /* 1, 4, 16, 64 */
+    Image *im = render_rung(s, &base, base.tol, reps, &rows[i], err, errlen);
+    if (!im) {
+      img_free(ref);
+      return -1;
+    }
+    rows[i].spp = base.spp;
+    double share;
+    img_compare(im, ref, &rows[i].rms_rgb, &share, 1.0 / 255.0);
+    img_free(im);
+  }
+  img_free(ref);
+
+  fprintf(out,
+          "samples-per-pixel tradeoff of %s: %dx%d", name, base.width,
+          base.height);
+  if (capped)
+    fprintf(out, " (the script's %dx%d capped to %d wide: the %d-sample "
+            "reference is costly;\n--size WxH to change)", sw, sh,
+            TRADEOFF_SPP_WIDTH, TRADEOFF_SPP_REF);
+  fprintf(out, ", root tolerance %.0e.\neach rung rendered %d times (best "
+          "wall time kept), the %d-sample reference once.\nRMS RGB: linear "
+          "RGB difference from the reference over all pixels and channels."
+          "\n\n| samples/px | time s | RMS RGB |\n|---|---|---|\n",
+          base.tol, reps, TRADEOFF_SPP_REF);
+  for (int i = 0; i <= n; i++) {
+    if (i == n)
+      fprintf(out, "| %d | %.4f | ref |\n", rows[i].spp, rows[i].seconds);
+    else
+      fprintf(out, "| %d | %.4f | %.2e |\n", rows[i].spp, rows[i].seconds,
+              rows[i].rms_rgb);
+  }
+  if (svg[0]) {
+    char title[300];
+    snprintf(title, sizeof title, "%s, %dx%d: image error against time",
+             name, base.width, base.height);
+    if (tradeoff_svg(rows, n, title, svg, err, errlen)) return -1;
     fprintf(out, "\nplot written to %s\n", svg);
   }
   fflush(out);
@@ -238,12 +345,15 @@ static void svg_escape(FILE *f, const char *s) {
 int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
                  const char *path, char *err, size_t errlen) {
   double tmin = INFINITY, tmax = 0, emin = INFINITY, emax = 0;
+  const int spp = n > 0 && rows[0].spp > 0;
+#define ERR(i, k) (spp ? (k ? 0.0 : rows[i].rms_rgb) : \
+                   (k ? rows[i].rms_dz : rows[i].max_dz))
   for (int i = 0; i < n; i++) {
     if (rows[i].seconds > 0) {
       tmin = fmin(tmin, rows[i].seconds);
       tmax = fmax(tmax, rows[i].seconds);
     }
-    double e[2] = {rows[i].max_dz, rows[i].rms_dz};
+    double e[2] = {ERR(i, 0), ERR(i, 1)};
     for (int k = 0; k < 2; k++)
       if (e[k] > 0) emin = fmin(emin, e[k]), emax = fmax(emax, e[k]);
   }
@@ -297,21 +407,26 @@ int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
              "fill=\"none\" stroke=\"black\"/>\n", L, T, pw, ph);
   fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">wall time "
              "of the render, seconds (log)</text>\n", L + pw / 2, H - 18);
-  fprintf(f, "<text transform=\"translate(22 %.1f) rotate(-90)\" "
-             "text-anchor=\"middle\">hit-distance error against tol 1e-12, "
-             "scene units (log)</text>\n", T + ph / 2);
+  if (spp)
+    fprintf(f, "<text transform=\"translate(22 %.1f) rotate(-90)\" "
+               "text-anchor=\"middle\">RMS RGB error against %d samples/"
+               "pixel (log)</text>\n", T + ph / 2, TRADEOFF_SPP_REF);
+  else
+    fprintf(f, "<text transform=\"translate(22 %.1f) rotate(-90)\" "
+               "text-anchor=\"middle\">hit-distance error against tol "
+               "1e-12, scene units (log)</text>\n", T + ph / 2);
   /* The two series. */
   const char *colour[2] = {"#c0392b", "#2e6db4"};
-  for (int k = 0; k < 2; k++) {
+  for (int k = 0; k < (spp ? 1 : 2); k++) {
     fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" points=\"", colour[k]);
     for (int i = 0; i < n; i++) {
-      double e = k ? rows[i].rms_dz : rows[i].max_dz;
+      double e = ERR(i, k);
       if (e > 0 && rows[i].seconds > 0)
         fprintf(f, "%.1f,%.1f ", PX(rows[i].seconds), PY(e));
     }
     fputs("\"/>\n", f);
     for (int i = 0; i < n; i++) {
-      double e = k ? rows[i].rms_dz : rows[i].max_dz;
+      double e = ERR(i, k);
       if (!(e > 0 && rows[i].seconds > 0)) continue;
       double x = PX(rows[i].seconds), y = PY(e);
       if (k == 0)
@@ -320,12 +435,25 @@ int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
       else
         fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"7\" height=\"7\" "
                    "fill=\"%s\"/>\n", x - 3.5, y - 3.5, colour[k]);
-      fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" fill=\"%s\">"
-                 "%.0e</text>\n", x + 6, y + (k ? 12 : -5), colour[k],
-              rows[i].tol);
+      if (spp)
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" "
+                   "fill=\"%s\">%d spp</text>\n", x + 6, y - 5, colour[k],
+                rows[i].spp);
+      else
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" "
+                   "fill=\"%s\">%.0e</text>\n", x + 6, y + (k ? 12 : -5),
+                colour[k], rows[i].tol);
     }
   }
   /* Legend. */
+  if (spp) {
+    fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>"
+               "<text x=\"%.1f\" y=\"%.1f\">RMS RGB error</text>\n"
+               "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\">points "
+               "labelled with samples per pixel</text>\n",
+            L + pw - 200, T + 16, colour[0], L + pw - 190, T + 20,
+            L + pw - 200, T + 38);
+  } else {
   fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>"
              "<text x=\"%.1f\" y=\"%.1f\">maximum error</text>\n",
           L + pw - 150, T + 16, colour[0], L + pw - 140, T + 20);
@@ -334,9 +462,11 @@ int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
           L + pw - 153.5, T + 32.5, colour[1], L + pw - 140, T + 40);
   fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\">points labelled "
              "with the root tolerance</text>\n", L + pw - 150, T + 58);
+  }
   fputs("</svg>\n", f);
 #undef PX
 #undef PY
+#undef ERR
   if (fclose(f) != 0 || rename(tmp, path) != 0) {
     remove(tmp);
     snprintf(err, errlen, "cannot write %s", path);
@@ -359,7 +489,9 @@ static int capture(void *ctx, const Scene *s, const RenderSettings *rs,
   if (j->done) return 0; /* only the first render */
   j->done = 1;
   TradeoffRow rows[TRADEOFF_RUNGS];
-  if (tradeoff_scene(s, rs, j->opt, j->name, rows, err, errlen)) {
+  if (j->opt->spp_ladder
+          ? tradeoff_spp(s, rs, j->opt, j->name, rows, err, errlen)
+          : tradeoff_scene(s, rs, j->opt, j->name, rows, err, errlen)) {
     j->failed = 1;
     return -1;
   }

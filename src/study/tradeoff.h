@@ -42,11 +42,14 @@ typedef struct TradeoffOptions {
   int repeats;          /* timing runs per rung, best kept (0: 3) */
   const char *svg;      /* plot file (NULL: tradeoff.svg; "" for none) */
   FILE *out;            /* the table (NULL: stdout) */
+  int spp_ladder;       /* 1: the samples-per-pixel ladder instead */
 } TradeoffOptions;
 
 typedef struct TradeoffRow {
   double tol;
   double seconds;       /* best wall time of the repeats */
+  double worst;         /* slowest of the repeats (run-to-run noise) */
+  int spp;              /* samples per pixel (the spp ladder; else 0) */
   long evals, steps;    /* density evaluations, root-search steps */
   double max_dz, rms_dz;/* hit-distance error against the reference, over
                            pixels hit on the same surface in both */
@@ -62,13 +65,28 @@ int tradeoff_scene(const struct Scene *s, const struct RenderSettings *base,
                    const TradeoffOptions *o, const char *name,
                    TradeoffRow *rows, char *err, size_t errlen);
 
+/* 3. The samples-per-pixel ladder (qcs tradeoff --spp FILE): s rendered
+   at 1, 4, 16 and 64 samples per pixel (best wall time of the repeats)
+   and once at 256, the reference; RMS RGB error of each rung against it.
+   Without o->width the script's size is capped to TRADEOFF_SPP_WIDTH
+   pixels wide (the 256-sample reference is costly); the report says so.
+   Fills rows[TRADEOFF_SPP_RUNGS + 1] (the last, the reference, error 0).
+   Table to o->out, plot to o->svg (NULL: tradeoff.svg). 0, or -1. */
+#define TRADEOFF_SPP_RUNGS 4 /* 1, 4, 16, 64; then the 256 reference */
+#define TRADEOFF_SPP_REF 256
+#define TRADEOFF_SPP_WIDTH 160
+int tradeoff_spp(const struct Scene *s, const struct RenderSettings *base,
+                 const TradeoffOptions *o, const char *name,
+                 TradeoffRow *rows, char *err, size_t errlen);
+
 /* Run the script path in I with its first render captured (or, if it
    renders nothing, its `scene`) and report its tradeoff. The other
    renders of the script are skipped. 0 on success, 1 on an error (already
    reported on stderr). */
 int tradeoff_file(struct Interp *I, const char *path, const TradeoffOptions *o);
 
-/* Write the plot of rows to path (log-log: error against time). */
+/* Write the plot of rows to path (log-log: error against time). Rows
+   with spp > 0 are plotted as the spp ladder (RMS RGB error). */
 int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
                  const char *path, char *err, size_t errlen);
 
