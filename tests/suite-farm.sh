@@ -164,6 +164,15 @@ if command -v parallel >/dev/null 2>&1; then
       cmp -s "$tmp/par/figure12.exr" "$tmp/t160.exr"; then
     ok "template parallel.sh (this machine as the host): tiles and merge"
   else fail "template parallel.sh"; fi
+  # its animation variant: 2 frames x 16 tiles, merged per frame
+  "$QCS" -o "$tmp/pad.####.exr" --size 80x50 --frames 1-3:2 "$top/examples/lid.qcs" \
+    >/dev/null 2>&1
+  if (cd "$tmp/par" && FRAMES=1-3:2 SIZE=80x50 SCENE=examples/lid.qcs \
+        sh parallel.sh : >/dev/null 2>&1) &&
+      cmp -s "$tmp/par/frames/f0001.exr" "$tmp/pad.0001.exr" &&
+      cmp -s "$tmp/par/frames/f0003.exr" "$tmp/pad.0003.exr"; then
+    ok "template parallel.sh, animation: 2 frames x 16 tiles, merged per frame"
+  else fail "template parallel.sh animation: $(ls "$tmp/par/frames" 2>&1 | head -3 | tr '\n' ' ')"; fi
 fi
 
 # --index-env: each engine's variable picks the tile.
