@@ -12,7 +12,9 @@
 # Environment: QCS (default ./qcs), THREADS (2), SIZE (600x380),
 #   OUT (/tmp/qcs-bench), POVDIR (bench/povray),
 #   POV_ISO (1: render POV-Ray's exact Wyvill isosurface soft-cloud-iso-100
-#   once, for the "exact field at N = 100" target; 0 to skip).
+#   once, for the "exact field at N = 100" target; 0 to skip),
+#   FRAMES_BENCH (1: bench/frames.sh, a 100-frame animation in one process
+#   against 100 processes; 0 to skip).
 # Writes bench/results.csv and bench/README.md (the summary of this run).
 #
 # Each repetition renders the scene with qcs, then at once with POV-Ray, so
@@ -284,6 +286,16 @@ echo
 echo "pictures at the prompt (from process start; medians of $PV_REPS):"
 echo "$PREVIEW" | tail -n +3 | sed 's/^| //; s/ |$//; s/ | /: /; s/ | / /g'
 
+# An animation in one process against one process a frame (issue 17):
+# bench/frames.sh, examples/lid.qcs at 160x100, frames 1-100.
+FRAMES_SUMMARY=""
+if [ "${FRAMES_BENCH:-1}" = 1 ]; then
+  FRAMES_SUMMARY=$(QCS="$QCS" sh bench/frames.sh "$THREADS" 2>&1)
+  echo
+  echo "animation, one process against one a frame (bench/frames.sh):"
+  echo "$FRAMES_SUMMARY"
+fi
+
 # Issue 7's targets.
 verdict() { if [ "$1" = "-" ] || [ -z "$1" ]; then echo "not measured"; elif awk "BEGIN { exit !($2) }"; then echo "met"; else echo "NOT met"; fi; }
 ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "-" && a != "" && a + 0 >= b) }'; }
@@ -391,6 +403,17 @@ EOF
   echo "process start, medians of $PV_REPS runs."
   echo
   echo "$PREVIEW"
+  if [ -n "$FRAMES_SUMMARY" ]; then
+    echo
+    echo "## Animation: one process against one a frame (issue 17)"
+    echo
+    echo "\`sh bench/frames.sh $THREADS\`: examples/lid.qcs at 160x100, frames 1-100, as one"
+    echo "\`qcs --frames 1-100\` and as 100 runs of \`qcs --frames k-k --animation 1-100\`."
+    echo
+    echo '```'
+    echo "$FRAMES_SUMMARY"
+    echo '```'
+  fi
   if [ -f bench/callgrind.csv ]; then
     echo
     echo "## Callgrind instruction counts (150x95, 1 thread)"

@@ -3,6 +3,8 @@
 # rendered as 16 processes by GNU parallel and merged is the one-shot
 # render byte for byte (PNG, and EXR with Z, N, cost and alpha); each
 # template of examples/farm/ runs locally with its index variable set;
+# --index-env with --frames (and --tiles) gives each task the frame (and
+# tile) that rendering it directly gives, byte for byte;
 # alpha and the EXR header are read back by readers that are not qcs's
 # (tests/exr_pixels.py, OpenEXR's exrheader); bad input is refused with
 # status 1 and no file touched. Prints "ok NAME" or "FAIL NAME: why".
@@ -162,6 +164,15 @@ if command -v parallel >/dev/null 2>&1; then
       cmp -s "$tmp/par/figure12.exr" "$tmp/t160.exr"; then
     ok "template parallel.sh (this machine as the host): tiles and merge"
   else fail "template parallel.sh"; fi
+  # its animation variant: 2 frames x 16 tiles, merged per frame
+  "$QCS" -o "$tmp/pad.####.exr" --size 80x50 --frames 1-3:2 "$top/examples/lid.qcs" \
+    >/dev/null 2>&1
+  if (cd "$tmp/par" && FRAMES=1-3:2 SIZE=80x50 SCENE=examples/lid.qcs \
+        sh parallel.sh : >/dev/null 2>&1) &&
+      cmp -s "$tmp/par/frames/f0001.exr" "$tmp/pad.0001.exr" &&
+      cmp -s "$tmp/par/frames/f0003.exr" "$tmp/pad.0003.exr"; then
+    ok "template parallel.sh, animation: 2 frames x 16 tiles, merged per frame"
+  else fail "template parallel.sh animation: $(ls "$tmp/par/frames" 2>&1 | head -3 | tr '\n' ' ')"; fi
 fi
 
 # --index-env: each engine's variable picks the tile.
@@ -174,6 +185,51 @@ for v in SLURM_ARRAY_TASK_ID=2 JOB_COMPLETION_INDEX=2 \
   cmp -s "$tmp/ie.exr" "$tmp/i3.exr" && ok "--index-env with $v is tile 3" \
     || fail "--index-env with $v"
 done
+
+# --index-env with --frames: task k is the k-th frame of the range; with
+# --tiles N too, frame k / N and tile k % N + 1. Each task's file is the
+# same frame (and tile) rendered directly, byte for byte.
+LID=$top/examples/lid.qcs
+mkdir -p "$tmp/fr" "$tmp/frd"
+for k in 0 1 2; do
+  f=$((1 + 3 * k))
+  SLURM_ARRAY_TASK_ID=$k "$QCS" -o "$tmp/fr/f####.exr" --size 80x50 \
+    --frames 1-7:3 --index-env "$LID" >/dev/null 2>&1
+  "$QCS" -o "$tmp/frd/f####.exr" --size 80x50 --frames $f-$f --animation 1-7 \
+    "$LID" >/dev/null 2>&1
+done
+n=$(ls "$tmp/fr" | tr '\n' ' ')
+if [ "$n" = "f0001.exr f0004.exr f0007.exr " ] &&
+    (for f in 0001 0004 0007; do cmp -s "$tmp/fr/f$f.exr" "$tmp/frd/f$f.exr" || exit 1; done); then
+  ok "--frames 1-7:3 --index-env: tasks 0-2 are frames 1, 4, 7 rendered directly"
+else fail "--frames --index-env: wrote $n, or a frame differs"; fi
+mkdir -p "$tmp/ft"
+bad=0
+for k in $(seq 0 11); do
+  f=$((k / 4 + 1)) t=$((k % 4 + 1))
+  JOB_COMPLETION_INDEX=$k "$QCS" -o "$tmp/ft/k$k.####.exr" --size 80x50 \
+    --frames 1-3 --tiles 4 --index-env "$LID" >/dev/null 2>&1
+  "$QCS" -o "$tmp/ft/d$k.####.exr" --size 80x50 --frames $f-$f --animation 1-3 \
+    --tile $t/4 "$LID" >/dev/null 2>&1
+  cmp -s "$tmp/ft/k$k.000$f.exr" "$tmp/ft/d$k.000$f.exr" || bad=$((bad + 1))
+done
+[ $bad = 0 ] && [ "$(ls "$tmp/ft" | wc -l)" = 24 ] &&
+  ok "--frames 1-3 --tiles 4 --index-env: task k is frame k / 4 + 1, tile k % 4 + 1" ||
+  fail "--frames --tiles --index-env: $bad of 12 tasks differ ($(ls "$tmp/ft" | wc -l) files)"
+# The Slurm template's animation variant: 3 frames x 4 tiles, 12 array
+# tasks from 0, its merge step; each merged frame is the frame rendered
+# whole in one process.
+mkdir -p "$tmp/sa" "$tmp/sad"
+for i in $(seq 0 11); do
+  SLURM_ARRAY_TASK_ID=$i SLURM_ARRAY_TASK_MIN=0 FRAMES=1-3 TILES=4 SIZE=80x50 \
+    SCENE="$LID" OUT="$tmp/sa" sh examples/farm/slurm.sh >/dev/null 2>&1
+done
+FRAMES=1-3 TILES=4 SIZE=80x50 OUT="$tmp/sa" sh examples/farm/slurm.sh merge \
+  >/dev/null 2>&1
+"$QCS" -o "$tmp/sad/f####.exr" --size 80x50 --frames 1-3 "$LID" >/dev/null 2>&1
+if (for f in 0001 0002 0003; do cmp -s "$tmp/sa/f$f.exr" "$tmp/sad/f$f.exr" || exit 1; done); then
+  ok "template slurm.sh, animation: 3 frames x 4 tiles, merged per frame"
+else fail "template slurm.sh animation: $(ls "$tmp/sa" | tr '\n' ' ')"; fi
 
 # Bad input: status 1, a clear message, the output untouched.
 echo keep > "$tmp/keep.exr"
@@ -190,6 +246,13 @@ bad "--tile 0/4" "1 <= I <= N" "$QCS" -o "$tmp/keep.exr" --tile 0/4 "$SCENE"
 bad "--tile 5/4" "1 <= I <= N" "$QCS" -o "$tmp/keep.exr" --tile 5/4 "$SCENE"
 bad "an index past the tiles" "past the last" env PARALLEL_SEQ=17 \
   "$QCS" -o "$tmp/keep.exr" --tiles 16 --index-env "$SCENE"
+bad "a task past the frames" "past the last of 3 frames" env SLURM_ARRAY_TASK_ID=3 \
+  "$QCS" -o "$tmp/keep.exr" --frames 1-7:3 --index-env "$LID"
+bad "a task past frames x tiles" "past the last of 12 tasks (3 frames x 4 tiles" \
+  env PARALLEL_SEQ=13 "$QCS" -o "$tmp/keep.exr" --frames 1-3 --tiles 4 \
+  --index-env "$LID"
+bad "--index-env alone" "needs --tiles N" env PARALLEL_SEQ=1 \
+  "$QCS" -o "$tmp/keep.exr" --index-env "$SCENE"
 bad "--index-env with no index" "none of" env -u SLURM_ARRAY_TASK_ID \
   -u JOB_COMPLETION_INDEX -u AWS_BATCH_JOB_ARRAY_INDEX -u PARALLEL_SEQ \
   "$QCS" -o "$tmp/keep.exr" --tiles 16 --index-env "$SCENE"

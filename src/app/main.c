@@ -143,6 +143,8 @@ static void usage(FILE *out) {
           "  --tiles N --index-env  the tile from the job array's index\n"
           "                      (SLURM_ARRAY_TASK_ID, JOB_COMPLETION_INDEX,\n"
           "                      AWS_BATCH_JOB_ARRAY_INDEX, PARALLEL_SEQ)\n"
+          "  --frames A-B --index-env  task k renders the k-th frame (from 0);\n"
+          "                      with --tiles N too: frame k / N, tile k %% N + 1\n"
           "  --skip-existing     do not render a file that exists (retries)\n"
           "  --show              draw what the scripts render in the terminal,\n"
           "                      coarse first, instead of writing files\n"
@@ -564,8 +566,10 @@ static long farm_task_index(const char **from) {
   return -1;
 }
 
-/* --tiles N with --index-env: task k renders tile k + 1 of N. (With
-   frames, task k would be frame k / N, tile k % N + 1.) 0 or -1. */
+/* --index-env: the job array's task k renders, with --tiles N alone,
+   tile k + 1 of N; with --frames A-B[:STEP] alone, the k-th frame of the
+   range (from 0); with both, frame k / N of the range and tile k % N + 1.
+   The animation (clock) stays the whole range, or --animation. 0 or -1. */
 static int farm_resolve(Options *o) {
   if (o->tiles && o->render.tile_count) {
     fprintf(stderr, "qcs: error: give --tile I/N or --tiles N, not both\n");
@@ -580,22 +584,43 @@ static int farm_resolve(Options *o) {
             "index: add --index-env (or give --tile I/N)\n");
     return -1;
   }
-  if (o->index_env && !o->tiles) {
+  if (o->index_env && !o->tiles && !o->frames) {
     fprintf(stderr, "qcs: error: --index-env needs --tiles N (how many "
-            "tasks share the picture)\n");
+            "tasks share the picture), --frames A-B[:STEP] (one frame a "
+            "task), or both\n");
     return -1;
   }
   if (!o->index_env) return 0;
   const char *from = NULL;
   long k = farm_task_index(&from);
   if (k < 0) return -1;
-  if (k >= o->tiles) {
-    fprintf(stderr, "qcs: error: --index-env: task %ld (from %s) is past the "
-            "last of %d tiles (tasks count from 0)\n", k, from, o->tiles);
+  long tiles = o->tiles ? o->tiles : 1;
+  long nframes = o->frames ? (o->f_last - o->f_first) / o->f_step + 1 : 1;
+  if (k >= tiles * nframes) {
+    if (o->frames && o->tiles)
+      fprintf(stderr, "qcs: error: --index-env: task %ld (from %s) is past "
+              "the last of %ld tasks (%ld frames x %d tiles; tasks count "
+              "from 0)\n", k, from, tiles * nframes, nframes, o->tiles);
+    else if (o->frames)
+      fprintf(stderr, "qcs: error: --index-env: task %ld (from %s) is past "
+              "the last of %ld frames of --frames %d-%d:%d (tasks count "
+              "from 0)\n", k, from, nframes, o->f_first, o->f_last,
+              o->f_step);
+    else
+      fprintf(stderr, "qcs: error: --index-env: task %ld (from %s) is past "
+              "the last of %d tiles (tasks count from 0)\n", k, from,
+              o->tiles);
     return -1;
   }
-  o->render.tile_index = (int)k + 1;
-  o->render.tile_count = o->tiles;
+  if (o->frames) {
+    int f = o->f_first + (int)(k / tiles) * o->f_step;
+    o->f_first = o->f_last = f;
+    o->f_step = 1;
+  }
+  if (o->tiles) {
+    o->render.tile_index = (int)(k % tiles) + 1;
+    o->render.tile_count = o->tiles;
+  }
   return 0;
 }
 
