@@ -292,6 +292,52 @@ def browser_tests(host, port, token, scene, defs):
         shutil.rmtree(prof, ignore_errors=True)
 
 
+# ---- imports are followed ----
+def imports_test():
+    d = os.path.join(WORK, "imp")
+    os.makedirs(os.path.join(d, "parts"), exist_ok=True)
+    part = os.path.join(d, "parts", "part.qcs")
+    def save(path, text):
+        open(path + ".swp", "w").write(text)
+        os.rename(path + ".swp", path)
+    save(part, "part = Scale (1, 1, 1) UnitCube;\n")
+    main = os.path.join(d, "main.qcs")
+    save(main, 'import "parts/part.qcs"\nscene = Union part (Halfspace ((0, 1, 0), 0));\n'
+         'renderWith [Size 120 80, Camera (2, 3, 5) (0.5, 0.5, 0.5) 35, Light (-3, 8, 6)] "main.png" scene\n')
+    p, url = start_view(main)
+    if not url:
+        report("view-import-start", False, "no URL printed")
+        p.kill()
+        return
+    m = re.match(r"http://([\d.]+):(\d+)/\?t=(\w+)", url)
+    host, port, token = m.group(1), int(m.group(2)), m.group(3)
+    hdr = {"Host": "%s:%d" % (host, port)}
+    def state():
+        return json.loads(http_get(host, port, "/state?t=" + token, hdr)[2])
+    def frame():
+        st, h, body = http_get(host, port, "/frame?t=%s&own=1&step=2" % token, hdr)
+        return body if st == 200 and h.get("X-Step") == "1" else None
+    try:
+        v0 = wait_for(lambda: state().get("version"), 5)
+        pic0 = wait_for(frame, 10)
+        save(part, "part = Scale (1, 2, 1) UnitCube;\n")
+        ok = wait_for(lambda: state().get("version", 0) > v0 and not state().get("error"), 10)
+        pic1 = wait_for(frame, 10)
+        report("view-import-follow", bool(ok) and pic0 is not None and pic1 is not None and pic0 != pic1,
+               "version %r, pictures %s" % (state(), "same" if pic0 == pic1 else "missing"))
+        save(part, "part = Scale (1, 2, 1) +;\n")
+        err = wait_for(lambda: state().get("error"), 5)
+        report("view-import-error", bool(err) and re.search(r"part\.qcs:1:\d+: error:", err) is not None
+               and frame() == pic1, "error %r" % err)
+        save(part, "part = Scale (1, 1, 1) UnitCube;\n")
+        back = wait_for(lambda: state().get("error") is None and frame() == pic0, 10)
+        report("view-import-back", bool(back), "state %r" % state())
+    finally:
+        p.send_signal(2)
+        try: p.wait(10)
+        except subprocess.TimeoutExpired: p.kill()
+
+
 # ---- the load test ----
 def load_test(host, port, token, total=10000, clients=50):
     good_host = "%s:%d" % (host, port)
@@ -357,6 +403,7 @@ def main():
     shutil.copy(os.path.join(here, "..", "..", "examples", "figure12.qcs"), scene)
     defs = os.path.join(WORK, "defs.qcs")
     open(defs, "w").write("".join(l for l in open(scene) if not l.startswith("renderWith")))
+    imports_test()
     p, url = start_view(scene)
     if not url:
         report("view-start", False, "no URL printed")
