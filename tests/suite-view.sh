@@ -18,4 +18,6 @@ if "$QCS" view --listen nowhere x.qcs 2>"$work/e" || ! grep -q "ADDR:PORT" "$wor
 else
   echo "ok view-args"
 fi
-timeout 150 python3 tests/view/viewtest.py "$QCS" "$work/t"
+timeout 150 python3 tests/view/viewtest.py "$QCS" "$work/t"; rc=$?
+sh tests/view/repl_view.sh "$QCS" "$work/r"
+exit $rc
