@@ -1,8 +1,11 @@
 #!/bin/sh
 # suite-view.sh: qcs view in headless Chromium (load and compare with
-# qcs -o, follow the file, an error, a deleted file, click to probe against
-# the prompt's Density/Gradient/Trace, orbit, reset) and a load test of
-# 10,000 requests from 50 clients with hostile ones mixed in. Loopback only.
+# qcs -o, follow the file and an imported file, an error, a deleted file,
+# click to probe against the prompt's Density/Gradient/Trace, orbit, copy
+# camera rendered by qcs -o, reset, save PNG and EXR, shadows, channels), a
+# load test of 10,000 requests from 50 clients with hostile ones mixed in,
+# and :view at the prompt under tmux (tests/view/repl_view.sh). Loopback
+# only.
 cd "$(dirname "$0")/.." || exit 1
 QCS=${QCS:-./qcs}
 if ! "$QCS" view --help >/dev/null 2>&1; then
@@ -18,4 +21,6 @@ if "$QCS" view --listen nowhere x.qcs 2>"$work/e" || ! grep -q "ADDR:PORT" "$wor
 else
   echo "ok view-args"
 fi
-timeout 150 python3 tests/view/viewtest.py "$QCS" "$work/t"
+timeout 150 python3 tests/view/viewtest.py "$QCS" "$work/t"; rc=$?
+sh tests/view/repl_view.sh "$QCS" "$work/r"
+exit $rc

@@ -214,6 +214,8 @@ typedef struct View {
   char file[4096];         /* the file followed ("" for :view) */
   char dir[4096];          /* its folder: where saves go */
   char stem[256];
+  char **deps;             /* the files the last evaluation imported */
+  int ndeps;
   Key want;                /* what the render thread should render */
   int have_want;
   Key cur;                 /* what frames[] hold ... */
@@ -523,6 +525,21 @@ static int capture(void *ctx, const Scene *s, const RenderSettings *rs,
 
 /* Run FILE in a fresh interpreter with stderr into a temporary file;
    publish the scene it renders (or its `scene`), or the error text. */
+static void add_dep(const char *path, void *ud) {
+  View *v = ud;
+  char **d = realloc(v->deps, (size_t)(v->ndeps + 1) * sizeof *d);
+  if (!d) return;
+  v->deps = d;
+  if ((d[v->ndeps] = strdup(path))) v->ndeps++;
+}
+
+static void deps_clear(View *v) {
+  for (int i = 0; i < v->ndeps; i++) free(v->deps[i]);
+  free(v->deps);
+  v->deps = NULL;
+  v->ndeps = 0;
+}
+
 static void evaluate(View *v, const ViewOptions *o) {
   Interp *I = o->new_interp ? o->new_interp(o->ud) : bind_interp_new();
   Capture cap = {0};
@@ -558,6 +575,8 @@ static void evaluate(View *v, const ViewOptions *o) {
   }
   if (text[0] && !o->quiet) fputs(text, stderr);
   render_set_overrides(I, NULL);
+  deps_clear(v);
+  interp_files_read(I, add_dep, v);
   if (st == RUN_OK && ov.kept && cap.got) {
     publish(v, ov.kept, &cap.rs);
     printf("qcs view: %s: shown (version %u)\n", v->file, v->version);
@@ -1155,12 +1174,47 @@ static void view_finish(View *v, struct MHD_Daemon *d, pthread_t *rt) {
   if (d) MHD_stop_daemon(d);
   if (rt) pthread_join(*rt, NULL);
   frames_clear(v);
+  deps_clear(v);
   if (v->snap) snap_free(v->snap);
   free(v->error);
   pthread_mutex_destroy(&v->mu);
   pthread_mutex_destroy(&v->save_mu);
   pthread_cond_destroy(&v->cv);
   pthread_cond_destroy(&v->work);
+}
+
+/* The files followed besides the main one: the imports of the last
+   evaluation, by their folder's watch and their name in it. */
+typedef struct Watched {
+  int wd;
+  char name[256];
+} Watched;
+
+#define MAX_WATCHED 256
+#define WATCH_MASK (IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_DELETE | \
+                    IN_MOVED_FROM | IN_ATTRIB)
+
+/* Watch the folders of the files the last evaluation imported (a folder
+   already watched gives its old descriptor back). */
+static int watch_deps(View *v, int ino, Watched *w) {
+  int n = 0;
+  for (int i = 0; i < v->ndeps && n < MAX_WATCHED; i++) {
+    const char *p = v->deps[i], *slash = strrchr(p, '/');
+    char dir[4096];
+    if (slash) snprintf(dir, sizeof dir, "%.*s", (int)(slash - p), p);
+    else snprintf(dir, sizeof dir, ".");
+    if (!dir[0]) snprintf(dir, sizeof dir, "/");
+    int wd = inotify_add_watch(ino, dir, WATCH_MASK);
+    if (wd < 0) {
+      fprintf(stderr, "qcs: warning: view: cannot watch %s: %s\n", dir,
+              strerror(errno));
+      continue;
+    }
+    w[n].wd = wd;
+    snprintf(w[n].name, sizeof w[n].name, "%s", slash ? slash + 1 : p);
+    n++;
+  }
+  return n;
 }
 
 int view_file(const char *file, const ViewOptions *o) {
@@ -1176,9 +1230,8 @@ int view_file(const char *file, const ViewOptions *o) {
   char *dot = strrchr(v.stem, '.');
   if (dot && dot != v.stem) *dot = 0;
   int ino = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
-  if (ino < 0 || inotify_add_watch(ino, v.dir, IN_CLOSE_WRITE | IN_MOVED_TO |
-                                   IN_CREATE | IN_DELETE | IN_MOVED_FROM |
-                                   IN_ATTRIB) < 0) {
+  int main_wd = ino < 0 ? -1 : inotify_add_watch(ino, v.dir, WATCH_MASK);
+  if (ino < 0 || main_wd < 0) {
     fprintf(stderr, "qcs: error: view: cannot watch %s: %s\n", v.dir,
             strerror(errno));
     if (ino >= 0) close(ino);
@@ -1203,7 +1256,9 @@ int view_file(const char *file, const ViewOptions *o) {
     close(ino);
     return 1;
   }
+  static Watched watched[MAX_WATCHED];
   evaluate(&v, o);
+  int nwatched = watch_deps(&v, ino, watched);
   double pending = 0; /* when a change was seen, 0: none */
   int gone = 0;
   while (!stop_flag) {
@@ -1214,8 +1269,13 @@ int view_file(const char *file, const ViewOptions *o) {
     while ((n = read(ino, buf, sizeof buf)) > 0) {
       for (char *p = buf; p < buf + n;) {
         struct inotify_event *e = (struct inotify_event *)(void *)p;
-        if (e->len && !strcmp(e->name, base)) pending = now();
-        if (e->mask & IN_IGNORED) {
+        if (e->len && e->wd == main_wd && !strcmp(e->name, base))
+          pending = now();
+        for (int i = 0; i < nwatched; i++)
+          if (e->len && e->wd == watched[i].wd &&
+              !strcmp(e->name, watched[i].name))
+            pending = now();
+        if ((e->mask & IN_IGNORED) && e->wd == main_wd) {
           publish_error(&v, "the file's folder is gone: nothing to follow");
           gone = 1;
         }
@@ -1233,6 +1293,7 @@ int view_file(const char *file, const ViewOptions *o) {
         publish_error(&v, msg);
       } else {
         evaluate(&v, o);
+        nwatched = watch_deps(&v, ino, watched);
       }
     }
     (void)gone;

@@ -428,6 +428,14 @@ static void run_import(Interp *I, Item *it, const char *runname) {
     }
   for (int i = 0; i < I->nimported; i++)
     if (!strcmp(I->imported[i], r)) return;
+  int seen = 0;
+  for (int i = 0; i < I->nreadfiles; i++)
+    if (!strcmp(I->readfiles[i], path)) seen = 1;
+  if (!seen) {
+    I->readfiles = grow(I->readfiles, I->nreadfiles, &I->capreadfiles,
+                        sizeof(char *));
+    I->readfiles[I->nreadfiles++] = gc_strdup(path);
+  }
   size_t len;
   char *text = read_file(path, &len);
   if (!text) qcs_error(it->pos, "cannot read %s: %s", path, strerror(errno));
@@ -1382,3 +1390,8 @@ void interp_list_limits(Interp *I, FILE *out) {
 }
 
 const char *interp_version(void) { return QCS_VERSION; }
+
+void interp_files_read(Interp *I, void (*emit)(const char *path, void *ud),
+                       void *ud) {
+  for (int i = 0; i < I->nreadfiles; i++) emit(I->readfiles[i], ud);
+}

@@ -87,6 +87,14 @@ RunStatus interp_set_override(Interp *I, const char *name, const char *expr);
    parameters (`param`): name, default, range, doc. */
 RunStatus interp_params(Interp *I, const char *path, FILE *out);
 
+/* Every file the runs so far imported (the path as found, relative to the
+   working directory or absolute), each once, in the order they were read;
+   an import that failed (unreadable, an error inside) is listed too. The
+   file given to interp_run_file itself is not. For qcs view, which
+   follows them. */
+void interp_files_read(Interp *I, void (*emit)(const char *path, void *ud),
+                       void *ud);
+
 /* Animation: binds the globals frame and clock and re-evaluates the
    top-level definitions that depend on them (through any chain of
    globals); the others keep their values. Before the scripts run, it only

@@ -186,6 +186,9 @@ struct Interp {
   int nfiles, capfiles;
   const char **imported;     /* files imported so far (real paths) */
   int nimported, capimported;
+  const char **readfiles;    /* every file an import read, as the importer
+                                named it, in order, a failed one too */
+  int nreadfiles, capreadfiles;
   int declare_only;          /* qcs params: top-level expressions not run */
   Item **anim;               /* the scripts' top-level expressions, run */
   int nanim, capanim;        /* again for each frame of an animation */

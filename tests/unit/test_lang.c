@@ -2,6 +2,10 @@
  * printer, through their C interfaces. */
 #include <gc.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "lang/eval.h"
@@ -230,6 +234,63 @@ static void test_print(void) {
   CHECK("print: -2.5", !strcmp(buf, "-2.5"));
 }
 
+static void count_file(const char *path, void *ud) {
+  char *names = ud;
+  const char *slash = strrchr(path, '/');
+  strncat(names, slash ? slash + 1 : path, 200);
+  strncat(names, " ", 2);
+}
+
+/* interp_files_read: every file the runs imported, once, a failed one too */
+static void test_files_read(void) {
+  char dir[] = "/tmp/qcs-test-files-XXXXXX";
+  if (!mkdtemp(dir)) {
+    CHECK("files read: a temporary folder", 0);
+    return;
+  }
+  const char *files[][2] = {
+      {"main.qcs", "import \"b.qcs\"\nimport \"c.qcs\"\nm = b + c;\n"},
+      {"b.qcs", "import \"c.qcs\"\nb = c + 1;\n"},
+      {"c.qcs", "c = 1;\n"},
+      {"bad.qcs", "import \"d.qcs\"\n"},
+      {"d.qcs", "d = 1 +;\n"}};
+  char path[256];
+  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+    snprintf(path, sizeof path, "%s/%s", dir, files[i][0]);
+    FILE *f = fopen(path, "w");
+    if (f) {
+      fputs(files[i][1], f);
+      fclose(f);
+    }
+  }
+  Interp *J = bind_interp_new();
+  char probe;
+  interp_set_stack(J, &probe, 4u << 20);
+  snprintf(path, sizeof path, "%s/main.qcs", dir);
+  RunStatus st = interp_run_file(J, path);
+  char names[1024] = "";
+  interp_files_read(J, count_file, names);
+  CHECK("files read: the imports, each once, in order",
+        st == RUN_OK && !strcmp(names, "b.qcs c.qcs "));
+  Interp *K = bind_interp_new();
+  interp_set_stack(K, &probe, 4u << 20);
+  snprintf(path, sizeof path, "%s/bad.qcs", dir);
+  FILE *saved = stderr;
+  stderr = fopen("/dev/null", "w");
+  st = interp_run_file(K, path);
+  fclose(stderr);
+  stderr = saved;
+  names[0] = 0;
+  interp_files_read(K, count_file, names);
+  CHECK("files read: an import with an error is listed",
+        st == RUN_ERROR && !strcmp(names, "d.qcs "));
+  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+    snprintf(path, sizeof path, "%s/%s", dir, files[i][0]);
+    remove(path);
+  }
+  rmdir(dir);
+}
+
 int main(void) {
   check_prefix = "lang";
   I = bind_interp_new();
@@ -239,5 +300,6 @@ int main(void) {
   test_parser();
   test_eval();
   test_print();
+  test_files_read();
   CHECK_DONE();
 }

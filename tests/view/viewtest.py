@@ -240,10 +240,35 @@ def browser_tests(host, port, token, scene, defs):
         for i in range(1, 11):
             ws.call("Input.dispatchMouseEvent", type="mouseMoved", x=box["x"] + 300 + 6 * i, y=box["y"] + 200 + 2 * i, button="left")
         ws.call("Input.dispatchMouseEvent", type="mouseReleased", x=box["x"] + 360, y=box["y"] + 220, button="left", clickCount=1)
-        ok = wait_for(lambda: (qv() or {}).get("frames", 0) > n0 and qv()["lastStep"] == 1, 5)
+        ok = wait_for(lambda: (qv() or {}).get("frames", 0) > n0 and qv()["lastStep"] == 1, 10)
         cam = ws.js("document.getElementById('camtext').value")
         report("view-orbit", bool(ok) and canvas_png() != before and cam.startswith("Camera ("),
                "frames %s, camera %r" % (state(), cam))
+        # copy camera: the text, pasted into the renderWith, renders the view
+        ws.call("Browser.grantPermissions", permissions=["clipboardReadWrite", "clipboardSanitizedWrite"])
+        ws.js("document.getElementById('copycam').click()")
+        time.sleep(0.3)
+        status = ws.js("document.getElementById('status').textContent")
+        copied = cam
+        try:
+            r = ws.call("Runtime.evaluate", expression="navigator.clipboard.readText()", awaitPromise=True,
+                        userGesture=True)
+            got = r.get("result", {}).get("value")
+            if got: copied = got
+        except Exception:
+            pass
+        print("# view: copy camera: status %r, copied %r" % (status, copied))
+        pasted = os.path.join(WORK, "pasted.qcs")
+        open(pasted, "w").write(re.sub(r"Camera \([^)]*\) \([^)]*\) [\d.]+", lambda m: copied, open(scene).read()))
+        ref2 = os.path.join(WORK, "pasted.png")
+        subprocess.run([QCS, "-o", ref2, pasted], capture_output=True, timeout=60)
+        wait_for(lambda: (qv() or {}).get("lastStep") == 1, 10)
+        w1, h1, a2 = png_pixels(canvas_png())
+        try: w2, h2, b2 = png_pixels(open(ref2, "rb").read())
+        except Exception: w2, h2, b2 = 0, 0, b""
+        diff = sum(1 for i in range(0, min(len(a2), len(b2)), 3) if a2[i:i + 3] != b2[i:i + 3])
+        report("view-copy-camera", copied == cam and (w1, h1) == (w2, h2) and diff == 0 and a2 != b,
+               "copied %r (shown %r), %d pixels differ from qcs -o" % (copied, cam, diff))
         # reset key: back to the scene's own camera, identical to qcs -o again
         ws.call("Input.dispatchKeyEvent", type="keyDown", key="r", text="r")
         ws.call("Input.dispatchKeyEvent", type="keyUp", key="r")
@@ -252,6 +277,63 @@ def browser_tests(host, port, token, scene, defs):
         time.sleep(0.2)
         w1, h1, a = png_pixels(canvas_png())
         report("view-reset-identical", a == b, "after r the picture differs from qcs -o")
+        # save PNG and save EXR: whole files in the scene's folder, the PNG
+        # equal to qcs -o at the scene's camera
+        def saved_files(ext):
+            return sorted(f for f in os.listdir(WORK) if f.startswith("figure12-view-") and f.endswith(ext))
+        def press_save(button, ext):
+            before_files = saved_files(ext)
+            ws.js("document.getElementById('%s').click()" % button)
+            new = wait_for(lambda: [f for f in saved_files(ext) if f not in before_files], 20)
+            ok_status = wait_for(lambda: (ws.js("document.getElementById('status').textContent") or "").startswith("saved"), 10)
+            return (new or [None])[0], ok_status
+        f, st = press_save("savepng", ".png")
+        try: w3, h3, c = png_pixels(open(os.path.join(WORK, f), "rb").read())
+        except Exception as e: w3, h3, c = 0, 0, repr(e)
+        report("view-save-png", bool(f) and bool(st) and c == b, "file %r, status %r, equal to qcs -o: %s" % (f, st, c == b))
+        f, st = press_save("saveexr", ".exr")
+        data = open(os.path.join(WORK, f), "rb").read() if f else b""
+        # the pixel chunks equal qcs --cost -o's (the view saves the cost
+        # channel too); only the header differs (no qcs.render attribute)
+        refexr = os.path.join(WORK, "ref.exr")
+        subprocess.run([QCS, "--cost", "-o", refexr, scene], capture_output=True, timeout=60)
+        ref_data = open(refexr, "rb").read()
+        tail = max(0, len(ref_data) - 4096)
+        same_pixels = len(data) > 4096 and abs(len(data) - len(ref_data)) < 64 and data[-tail:] == ref_data[-tail:]
+        readable = True
+        if shutil.which("exrheader"):
+            readable = subprocess.run(["exrheader", os.path.join(WORK, f or "none")], capture_output=True).returncode == 0
+        leftovers = [x for x in os.listdir(WORK) if x.startswith(".") or x.endswith(".tmp")]
+        report("view-save-exr", bool(f) and bool(st) and data[:4] == b"\x76\x2f\x31\x01" and not leftovers
+               and same_pixels and readable, "file %r, status %r, %d bytes (qcs -o: %d), same pixel data %s, "
+               "exrheader reads it %s, leftovers %r" % (f, st, len(data), len(ref_data), same_pixels, readable, leftovers))
+        # shadows toggle: the picture changes, and comes back
+        def settle(n0):
+            return wait_for(lambda: (qv() or {}).get("frames", 0) > n0 and qv()["lastStep"] == 1, 10)
+        n0 = qv()["frames"]
+        ws.js("document.getElementById('shadows').click()")
+        ok = settle(n0)
+        time.sleep(0.2)
+        noshadow = png_pixels(canvas_png())[2]
+        n0 = qv()["frames"]
+        ws.js("document.getElementById('shadows').click()")
+        ok2 = settle(n0)
+        time.sleep(0.2)
+        report("view-shadows", bool(ok) and bool(ok2) and noshadow != b and png_pixels(canvas_png())[2] == b,
+               "off differs %s, on again equal %s" % (noshadow != b, png_pixels(canvas_png())[2] == b))
+        # the channels: each a different picture, no error
+        seen = {}
+        for ch in ("depth", "normal", "cost", "colour"):
+            n0 = qv()["frames"]
+            ws.js("(s => { s.value = '%s'; s.dispatchEvent(new Event('change')); })(document.getElementById('ch'))" % ch)
+            ok = settle(n0)
+            time.sleep(0.2)
+            st = ws.js("document.getElementById('status').textContent")
+            seen[ch] = png_pixels(canvas_png())[2]
+            report("view-channel-" + ch, bool(ok) and st == "full picture" and
+                   (seen[ch] == b if ch == "colour" else seen[ch] != b),
+                   "settled %r, status %r" % (ok, st))
+        report("view-channels-distinct", len(set(seen.values())) == 4, "%d distinct pictures" % len(set(seen.values())))
         # follow the file: an editor's save (write a temporary, rename over)
         v0 = qv()["version"]
         src = open(scene).read()
@@ -290,6 +372,52 @@ def browser_tests(host, port, token, scene, defs):
         try: br.wait(10)
         except Exception: br.kill()
         shutil.rmtree(prof, ignore_errors=True)
+
+
+# ---- imports are followed ----
+def imports_test():
+    d = os.path.join(WORK, "imp")
+    os.makedirs(os.path.join(d, "parts"), exist_ok=True)
+    part = os.path.join(d, "parts", "part.qcs")
+    def save(path, text):
+        open(path + ".swp", "w").write(text)
+        os.rename(path + ".swp", path)
+    save(part, "part = Scale (1, 1, 1) UnitCube;\n")
+    main = os.path.join(d, "main.qcs")
+    save(main, 'import "parts/part.qcs"\nscene = Union part (Halfspace ((0, 1, 0), 0));\n'
+         'renderWith [Size 120 80, Camera (2, 3, 5) (0.5, 0.5, 0.5) 35, Light (-3, 8, 6)] "main.png" scene\n')
+    p, url = start_view(main)
+    if not url:
+        report("view-import-start", False, "no URL printed")
+        p.kill()
+        return
+    m = re.match(r"http://([\d.]+):(\d+)/\?t=(\w+)", url)
+    host, port, token = m.group(1), int(m.group(2)), m.group(3)
+    hdr = {"Host": "%s:%d" % (host, port)}
+    def state():
+        return json.loads(http_get(host, port, "/state?t=" + token, hdr)[2])
+    def frame():
+        st, h, body = http_get(host, port, "/frame?t=%s&own=1&step=2" % token, hdr)
+        return body if st == 200 and h.get("X-Step") == "1" else None
+    try:
+        v0 = wait_for(lambda: state().get("version"), 5)
+        pic0 = wait_for(frame, 10)
+        save(part, "part = Scale (1, 2, 1) UnitCube;\n")
+        ok = wait_for(lambda: state().get("version", 0) > v0 and not state().get("error"), 10)
+        pic1 = wait_for(frame, 10)
+        report("view-import-follow", bool(ok) and pic0 is not None and pic1 is not None and pic0 != pic1,
+               "version %r, pictures %s" % (state(), "same" if pic0 == pic1 else "missing"))
+        save(part, "part = Scale (1, 2, 1) +;\n")
+        err = wait_for(lambda: state().get("error"), 5)
+        report("view-import-error", bool(err) and re.search(r"part\.qcs:1:\d+: error:", err) is not None
+               and frame() == pic1, "error %r" % err)
+        save(part, "part = Scale (1, 1, 1) UnitCube;\n")
+        back = wait_for(lambda: state().get("error") is None and frame() == pic0, 10)
+        report("view-import-back", bool(back), "state %r" % state())
+    finally:
+        p.send_signal(2)
+        try: p.wait(10)
+        except subprocess.TimeoutExpired: p.kill()
 
 
 # ---- the load test ----
@@ -357,6 +485,7 @@ def main():
     shutil.copy(os.path.join(here, "..", "..", "examples", "figure12.qcs"), scene)
     defs = os.path.join(WORK, "defs.qcs")
     open(defs, "w").write("".join(l for l in open(scene) if not l.startswith("renderWith")))
+    imports_test()
     p, url = start_view(scene)
     if not url:
         report("view-start", False, "no URL printed")
