@@ -114,7 +114,13 @@ run_tiles() { # run_tiles NAME: merge $tmp/NAME/tile-*.exr, compare
   else fail "template $1: $(head -c 300 "$tmp/err")"; fi
 }
 "$QCS" -o "$tmp/t160.exr" --size $SZ "$SCENE" >/dev/null 2>&1
-cd "$top" || exit 1
+# The templates run ./qcs from the qcs folder: give them a folder whose
+# ./qcs is the binary under test (a sanitizer build's pictures may differ
+# from the plain build's in the last bits, so the two must not be mixed).
+mkdir -p "$tmp/tpl"
+ln -s "$QCS" "$tmp/tpl/qcs"
+ln -s "$top/examples" "$tmp/tpl/examples"
+cd "$tmp/tpl" || exit 1
 mkdir -p "$tmp/slurm"
 for i in $(seq 1 16); do
   SLURM_ARRAY_TASK_ID=$i SLURM_ARRAY_TASK_MIN=1 SIZE=$SZ OUT="$tmp/slurm" \
