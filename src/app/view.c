@@ -28,6 +28,7 @@
 #include <string.h>
 #include <sys/inotify.h>
 #include <sys/random.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -1123,10 +1124,31 @@ static struct MHD_Daemon *start(View *v, const ViewOptions *o) {
     return NULL;
   }
   for (int i = 0; i < 16; i++) snprintf(v->token + 2 * i, 3, "%02x", rnd[i]);
+  /* The socket is bound here, not by the daemon, so that the port, the
+     token and the Host names accepted are written before the first server
+     thread exists (they are read by every request without a lock). */
+  int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  int one = 1;
+  if (fd < 0 || setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) ||
+      bind(fd, (struct sockaddr *)&sa, sizeof sa) || listen(fd, 64)) {
+    fprintf(stderr, "qcs: error: view: cannot listen on %s:%d: %s\n", addr,
+            port, strerror(errno));
+    if (fd >= 0) close(fd);
+    return NULL;
+  }
+  struct sockaddr_in bound;
+  socklen_t blen = sizeof bound;
+  v->port = getsockname(fd, (struct sockaddr *)&bound, &blen) == 0
+                ? ntohs(bound.sin_port)
+                : port;
+  snprintf(v->host_ok[0], sizeof v->host_ok[0], "%s:%d", addr, v->port);
+  snprintf(v->host_ok[1], sizeof v->host_ok[1], "localhost:%d", v->port);
+  if (strcmp(addr, "127.0.0.1"))
+    snprintf(v->host_ok[2], sizeof v->host_ok[2], "127.0.0.1:%d", v->port);
   struct MHD_Daemon *d = MHD_start_daemon(
       MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD |
           MHD_USE_ERROR_LOG,
-      0, NULL, NULL, handle, v, MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&sa,
+      0, NULL, NULL, handle, v, MHD_OPTION_LISTEN_SOCKET, fd,
       MHD_OPTION_CONNECTION_LIMIT, (unsigned)VIEW_MAX_CLIENTS,
       MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)VIEW_MAX_CLIENTS,
       MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)30,
@@ -1134,17 +1156,11 @@ static struct MHD_Daemon *start(View *v, const ViewOptions *o) {
       MHD_OPTION_THREAD_STACK_SIZE, (size_t)(512 << 10),
       MHD_OPTION_EXTERNAL_LOGGER, mhd_log, NULL, MHD_OPTION_END);
   if (!d) {
-    fprintf(stderr, "qcs: error: view: cannot listen on %s:%d: %s\n", addr,
-            port, strerror(errno));
+    fprintf(stderr, "qcs: error: view: cannot serve on %s:%d: %s\n", addr,
+            v->port, strerror(errno));
+    close(fd);
     return NULL;
   }
-  const union MHD_DaemonInfo *info =
-      MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
-  v->port = info ? info->port : port;
-  snprintf(v->host_ok[0], sizeof v->host_ok[0], "%s:%d", addr, v->port);
-  snprintf(v->host_ok[1], sizeof v->host_ok[1], "localhost:%d", v->port);
-  if (strcmp(addr, "127.0.0.1"))
-    snprintf(v->host_ok[2], sizeof v->host_ok[2], "127.0.0.1:%d", v->port);
   if (strcmp(addr, "127.0.0.1"))
     fprintf(stderr, "qcs: warning: view: listening on %s, not only on this "
             "machine: anyone who can reach it and has the URL can look at "
