@@ -8,6 +8,10 @@
 #   sh tools/check-layers.sh [SRC]    (default: src)
 src=${1:-src}
 status=0
+# The C library's and libm's headers (C11 and POSIX) that core/ may use.
+CORE_SYSTEM="assert.h complex.h ctype.h errno.h fenv.h float.h inttypes.h \
+limits.h math.h setjmp.h stdalign.h stdatomic.h stdbool.h stddef.h stdint.h \
+stdlib.h string.h strings.h time.h"
 allowed() {
   case $1 in
   core)   echo "core" ;;
@@ -46,9 +50,20 @@ for dir in "$src"/*/; do
       *) echo "$f:$n: layer '$layer' may not include \"$inc\" (it may use: $ok)" ;;
       esac
     done
+    # angle-bracket includes of the project's own headers obey the same rule
+    grep -n '^[[:space:]]*#[[:space:]]*include[[:space:]]*<\(core\|scene\|render\|lang\|bind\|study\|app\)/' "$f" |
+    while IFS= read -r line; do
+      n=${line%%:*}
+      inc=$(printf '%s\n' "$line" | sed 's/.*include[[:space:]]*<\([^>]*\)>.*/\1/')
+      target=${inc%%/*}
+      case " $ok " in
+      *" $target "*) ;;
+      *) echo "$f:$n: layer '$layer' may not include <$inc> (it may use: $ok)" ;;
+      esac
+    done
     case $layer in
     core|scene|render)
-      grep -n '^[[:space:]]*#[[:space:]]*include[[:space:]]*<gc\.h>' "$f" |
+      grep -n '^[[:space:]]*#[[:space:]]*include[[:space:]]*<\(gc\.h\|gc/[^>]*\)>' "$f" |
         sed "s|^\([0-9]*\):.*|$f:\1: layer '$layer' may not use the garbage collector|"
       grep -n '\<\(stderr\|stdout\)\>' "$f" |
         sed "s|^\([0-9]*\):.*|$f:\1: layer '$layer' prints nothing (return a code and a message)|" ;;
@@ -56,7 +71,17 @@ for dir in "$src"/*/; do
     case $layer in
     core)
       grep -n '^[[:space:]]*#[[:space:]]*include[[:space:]]*<stdio\.h>' "$f" |
-        sed "s|^\([0-9]*\):.*|$f:\1: layer 'core' uses libc and libm only, no stdio|" ;;
+        sed "s|^\([0-9]*\):.*|$f:\1: layer 'core' uses libc and libm only, no stdio|"
+      # and no other library: its system headers are the C library's
+      grep -n '^[[:space:]]*#[[:space:]]*include[[:space:]]*<' "$f" |
+      while IFS= read -r line; do
+        n=${line%%:*}
+        inc=$(printf '%s\n' "$line" | sed 's/.*include[[:space:]]*<\([^>]*\)>.*/\1/')
+        case " $CORE_SYSTEM " in
+        *" $inc "*) ;;
+        *) echo "$f:$n: layer 'core' uses libc and libm only: <$inc> is not one of their headers" ;;
+        esac
+      done ;;
     esac
   done
 done > "${TMPDIR:-/tmp}/qcs-layers.$$"

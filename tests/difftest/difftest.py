@@ -162,6 +162,7 @@ q_truncate = q_whole truncate
 q_round = q_whole (\x -> let t = truncate x
                              d = x - fromInteger t
                          in if d >= 0.5 then t + 1 else if d <= -0.5 then t - 1 else t)
+-- abs is C's fabs: abs (-0) is 0 (Haskell 98's abs keeps the -0).
 q_abs :: Double -> Double
 q_abs x = if x == 0 then 0 else abs x
 -- Hugs's sqrt stops with an error on a negative number or NaN; C's

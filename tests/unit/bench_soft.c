@@ -3,8 +3,9 @@
  * sequence; 600 x 380 primary rays from the scene's camera, plus one shadow
  * ray towards the light from every hit. Not part of the test suite (it is
  * not named test_*). Build and run:
+ *   make build/libqcscore.a
  *   cc -std=c11 -D_DEFAULT_SOURCE -O2 -Isrc tests/unit/bench_soft.c \
- *      src/soft.c src/poly.c -lm -lpthread -o /tmp/bench && /tmp/bench [N...]
+ *      build/libqcscore.a -lm -lpthread -o /tmp/bench && /tmp/bench [N...]
  * Options: -t THREADS (default 2), -m MAXOUT for primary rays (default 1;
  * 0 = all crossings, 64). */
 #include "core/soft.h"

@@ -1,5 +1,5 @@
 /* ref_density.h: test-only reference density trees, independent of
- * src/density.c.  A tree is an array of nodes with child indices (not a
+ * src/core/density.c.  A tree is an array of nodes with child indices (not a
  * tape); a leaf's density is the spherical-cap volume fraction
  * V = pi h^2 (3r - h)/3 over 4/3 pi r^3 with h = r - s, evaluated either
  * in MPFR (REF_PREC bits) or in long double.  Also a fixed-seed RNG and a

@@ -1,6 +1,6 @@
 /* test_density.c: density tapes (eq. 2, Figure 4, Section 2.4, eq. 5)
  * against MPFR and long double references from ref_density.h, which share
- * no code with src/density.c. */
+ * no code with src/core/density.c. */
 #include <float.h>
 
 #include "check.h"
