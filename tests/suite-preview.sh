@@ -11,7 +11,7 @@ case $QCS in /*) ;; *) QCS=$PWD/$QCS ;; esac
 
 TMUX_CHECKS="preview-auto preview-summary preview-show-with preview-ctrl-c
 preview-key-stops preview-nothing-hit preview-off preview-size-bad
-preview-show-not-object preview-list"
+preview-show-not-object preview-list preview-resize"
 
 tmp=$(mktemp -d) || exit 1
 sock=qcs-preview-$$
@@ -55,6 +55,21 @@ else
   echo "skip preview-kitty-well-formed: python3 is not installed"
   echo "skip preview-sixel-well-formed: python3 is not installed"
 fi
+
+# ---- a terminal asked what it is (DA1), on a pseudo-terminal ----
+# It answers with sixels, without, or not at all; and an output redirected
+# to a file gets values only, the prompt staying on the terminal.
+if command -v python3 >/dev/null 2>&1; then
+  for c in sixel nosixel silent redirect; do
+    $lim python3 tests/preview/pty_term.py "$QCS" $c # prints its ok/FAIL line
+    rc=$?; [ $rc -gt 1 ] && fail pty-$c "the pseudo-terminal run ended with status $rc"
+  done
+else
+  for c in sixel nosixel silent redirect; do echo "skip pty-$c: python3 is not installed"; done
+fi
+v=$("$QCS" --version 2>&1); rc=$?
+if [ $rc -eq 0 ] && printf '%s\n' "$v" | grep -qE '^qcs [0-9]+\.[0-9]+'; then ok version
+else fail version "status $rc, '$v'"; fi
 
 # ---- the terminal, through tmux ----
 
@@ -161,6 +176,17 @@ else fail preview-show-not-object "$(why ':show 1 + 2 gave no clear error')"; fi
 if enter 'sharp CSG, 12 leaves, box \(0, 0, 0\) \.\. \(5, 1, 1\)' \
   '[UnitCube, Shift (4, 0, 0) UnitCube]'; then ok preview-list
 else fail preview-list "$(why 'a list of objects was not shown as one picture')"; fi
+
+# The window resized while a picture is drawn: the picture ends or stops,
+# the prompt comes back and works.
+T send-keys -t qcs -l ':show Rounded 0.3 (Sum UnitCube b) with [Samples 16, Size 800 500]'
+T send-keys -t qcs Enter
+sleep 0.3
+T resize-window -t qcs -x 70 -y 30 2>/dev/null || T resize-pane -t qcs -x 70 -y 30
+sleep 0.2
+T resize-window -t qcs -x 100 -y 40 2>/dev/null || T resize-pane -t qcs -x 100 -y 40
+if enter '^6\.5$' '13 / 2'; then ok preview-resize
+else fail preview-resize "$(why 'after a resize during a picture the prompt did not answer')"; fi
 
 T send-keys -t qcs -l ':quit'
 T send-keys -t qcs Enter

@@ -45,6 +45,27 @@ expect type-kinds out '^a Real$' '^a String$' '^a 3-tuple$' \
   '^a SceneObject, made by the constructor Rounded$' \
   '^a scene object: rounded, 6 leaves, box \(0, 0, 0\) \.\. \(1, 1, 1\)$' \
   '^a built-in function of 1 argument \(sqrt\)$'
+# a soft object's box is where its surface is (Wyvill's C(r) = magic, solved
+# here by bisection), not the keys' reach R
+q ':t SoftObject 0.3 [Key (1, 2, 3) 2 1.5]'
+why=$(python3 - "$tmp/out" <<'PY'
+import re, sys
+txt = open(sys.argv[1]).read()
+m = re.search(r"soft, 1 key, box \(([^)]*)\) \.\. \(([^)]*)\)", txt)
+if not m: print("no box in %r" % txt); sys.exit()
+lo = [float(x) for x in m.group(1).split(",")]
+hi = [float(x) for x in m.group(2).split(",")]
+C = lambda s: 1.5 * (1 - 22/9*s + 17/9*s*s - 4/9*s**3)  # s = (r/R)^2
+a, b = 0.0, 2.0
+for _ in range(200):
+    r = (a + b) / 2
+    a, b = (r, b) if C((r / 2) ** 2) > 0.3 else (a, r)
+for c, l, h in zip((1, 2, 3), lo, hi):
+    if abs((c - l) - r) > 2e-3 or abs((h - c) - r) > 2e-3:
+        print("box %s .. %s, surface radius %.6f" % (lo, hi, r))
+PY
+)
+if [ "$rc" = 0 ] && [ -z "$why" ]; then ok type-soft-box; else fail type-soft-box "status $rc: $why"; fi
 q ':t nosuchname' '1 + 1'
 if [ "$rc" = 1 ] && grep -q "unknown name 'nosuchname'" "$tmp/err" && [ "$(cat "$tmp/out")" = 2 ]
 then ok type-error; else fail type-error "status $rc: $(cat "$tmp/out" "$tmp/err")"; fi
@@ -147,7 +168,8 @@ if [ "$rc" = 1 ] && grep -q '^<stdin>:1:5: error: the second argument of dot' "$
 then ok error-at-user-prompt; else fail error-at-user-prompt "status $rc: $(cat "$tmp/err")"; fi
 
 # ---- the terminal, through tmux: the ...> prompt of a continued definition ----
-TMUX_CHECKS="prompt-tmux-where prompt-tmux-guards prompt-tmux-type"
+TMUX_CHECKS="prompt-tmux-where prompt-tmux-guards prompt-tmux-type
+prompt-tmux-doc prompt-tmux-shadow prompt-tmux-reload"
 if ! command -v tmux >/dev/null 2>&1; then
   for c in $TMUX_CHECKS; do echo "skip $c: tmux is not installed"; done
   exit 0
@@ -188,3 +210,14 @@ if enter '^qcs> ' 'g x' && enter '^qcs> ' '  | x < 0 = 0' && enter '^qcs> ' '  |
 then ok prompt-tmux-guards; else fail prompt-tmux-guards "$(why 'g x / guards / g 5 / g (-3)')"; fi
 if enter '^a function of 1 argument \(f\)$' ':t f' && enter '^  e\.g\. Shift ' ':i Shift'
 then ok prompt-tmux-type; else fail prompt-tmux-type "$(why ':t f / :i Shift')"; fi
+if enter '^e\.g\. map ' ':doc map' && [ "$(count '^map f xs: f applied to every element')" -ge 1 ]
+then ok prompt-tmux-doc; else fail prompt-tmux-doc "$(why ':doc map showed no doc and example')"; fi
+if enter "warning: map shadows the prelude" 'map f xs = 42' && enter '^qcs> ' 'map f xs = 43' &&
+   enter '^43$' 'map 1 2' && [ "$(count 'warning: map shadows the prelude')" -eq 1 ]
+then ok prompt-tmux-shadow; else fail prompt-tmux-shadow "$(why 'one shadowing warning for two definitions of map')"; fi
+printf 'h x = x + 1\nrender "%s/tr.png" (Rounded 0.1 UnitCube)\n' "$tmp" >"$tmp/tr.qcs"
+rm -f "$tmp/tr.png"
+if enter 'tr\.png: 600x380' ":load $tmp/tr.qcs" && [ -f "$tmp/tr.png" ] && rm -f "$tmp/tr.png" &&
+   enter '^\(1 render in .*tr\.qcs not run again; :reload! runs them\)$' ':reload' &&
+   enter '^6$' 'h 5' && [ ! -f "$tmp/tr.png" ] && [ "$(count 'tr\.png: 600x380')" -eq 1 ]
+then ok prompt-tmux-reload; else fail prompt-tmux-reload "$(why ':reload ran the render again, or lost h')"; fi

@@ -80,6 +80,9 @@ static double now(void) {
 static int show_capture(void *ctx, const Scene *s, const RenderSettings *rs,
                         const char *path, char *err, size_t errlen) {
   Options *o = ctx;
+  static int asked;
+  if (o->preview == PREVIEW_AUTO && !asked++)
+    preview_query_terminal(STDIN_FILENO, STDOUT_FILENO, 150);
   PreviewMode m = preview_resolve(o->preview, STDOUT_FILENO);
   char line[512];
   report_scene(line, sizeof line, s, path);

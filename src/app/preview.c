@@ -6,7 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/ioctl.h>
+#include <poll.h>
 #include <sys/select.h>
+#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -106,6 +108,83 @@ static ChafaTermInfo *term_info(void) {
   return chafa_term_db_detect(chafa_term_db_get_default(), environ);
 }
 
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* What the terminal said of itself when asked (preview_query_terminal):
+   0 not asked or no answer, 1 answered without sixels, 2 with sixels. */
+static int queried;
+
+/* The reply to DA1 (ESC [ c), "ESC [ ? P1 ; P2 ; ... c", in buf: 1 if
+   found, with *sixel set when one of its attributes is 4 (sixel graphics,
+   as xterm, mlterm, foot, WezTerm and contour report it). */
+int preview_parse_da1(const char *buf, size_t n, int *sixel) {
+  for (size_t i = 0; i + 2 < n; i++) {
+    if (buf[i] != '\033' || buf[i + 1] != '[' || buf[i + 2] != '?') continue;
+    size_t j = i + 3;
+    long v = -1;
+    int four = 0;
+    for (; j < n; j++) {
+      char c = buf[j];
+      if (c >= '0' && c <= '9') {
+        v = (v < 0 ? 0 : v * 10) + (c - '0');
+        if (v > 100000) break;
+      } else if (c == ';' || c == 'c') {
+        if (v == 4) four = 1;
+        v = -1;
+        if (c == 'c') {
+          *sixel = four;
+          return 1;
+        }
+      } else {
+        break;
+      }
+    }
+  }
+  return 0;
+}
+
+int preview_query_terminal(int in_fd, int out_fd, int timeout_ms) {
+  if (!isatty(in_fd) || !isatty(out_fd)) return 0;
+  const char *term = getenv("TERM");
+  /* Only where the question is safe and useful: a terminal that answers
+     DA1, not one the environment already names (tmux and screen answer
+     for themselves, and draw symbols anyway), not a dumb one. */
+  if (!term || !*term || !strcmp(term, "dumb") || getenv("TMUX") ||
+      getenv("STY") || !strncmp(term, "screen", 6) || !strncmp(term, "tmux", 4))
+    return 0;
+  struct termios old, raw;
+  if (tcgetattr(in_fd, &old)) return 0;
+  raw = old;
+  raw.c_lflag &= (tcflag_t) ~(ICANON | ECHO);
+  raw.c_cc[VMIN] = 0;
+  raw.c_cc[VTIME] = 0;
+  if (tcsetattr(in_fd, TCSANOW, &raw)) return 0;
+  static const char q[] = "\033[c";
+  char buf[256];
+  size_t n = 0;
+  int sixel = 0, got = 0;
+  if (write(out_fd, q, sizeof q - 1) == (ssize_t)(sizeof q - 1)) {
+    double end = now() + timeout_ms * 1e-3;
+    while (!got && n < sizeof buf) {
+      int left = (int)((end - now()) * 1e3);
+      if (left <= 0) break;
+      struct pollfd pf = {in_fd, POLLIN, 0};
+      if (poll(&pf, 1, left) <= 0) break;
+      ssize_t k = read(in_fd, buf + n, sizeof buf - n);
+      if (k <= 0) break;
+      n += (size_t)k;
+      got = preview_parse_da1(buf, n, &sixel);
+    }
+  }
+  tcsetattr(in_fd, TCSANOW, &old);
+  queried = got ? 1 + sixel : 0;
+  return queried;
+}
+
 PreviewMode preview_resolve(PreviewMode m, int fd) {
   if (m != PREVIEW_AUTO) return m; /* asked for by name: as chafa -f does */
   if (!isatty(fd)) return PREVIEW_OFF;
@@ -124,14 +203,10 @@ PreviewMode preview_resolve(PreviewMode m, int fd) {
     r = PREVIEW_ITERM;
   else if (chafa_term_info_have_seq(ti, CHAFA_TERM_SEQ_BEGIN_SIXELS))
     r = PREVIEW_SIXEL;
+  else if (queried == 2) /* not in the database, but it said so itself */
+    r = PREVIEW_SIXEL;
   chafa_term_info_unref(ti);
   return r;
-}
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
 void preview_geometry(PreviewMode m, int out_fd, int cols, int rows,

@@ -9,8 +9,10 @@
  *
  * Detection. PREVIEW_AUTO asks chafa's terminal database what the
  * terminal is, from the environment (TERM, TERM_PROGRAM, KITTY_WINDOW_ID,
- * VTE_VERSION, TMUX, ...), as `chafa` does; inside tmux or screen, which
- * do not pass graphics through by default, it uses symbols. Nothing is
+ * VTE_VERSION, TMUX, ...), as `chafa` does, and, where that leaves the
+ * terminal unnamed, what the terminal answers to DA1 at start-up
+ * (preview_query_terminal); inside tmux or screen, which do not pass
+ * graphics through by default, it uses symbols. Nothing is
  * drawn automatically when the output is not a terminal: for PREVIEW_AUTO
  * preview_resolve answers PREVIEW_OFF for a pipe or a file. A mode asked
  * for by name is drawn wherever the output goes, as `chafa -f` does.
@@ -47,6 +49,20 @@ int preview_mode_parse(const char *s, PreviewMode *m);
 /* The mode to draw with on fd: for PREVIEW_AUTO, PREVIEW_OFF if fd is not
    a terminal, else the detected one; any other m as it is. */
 PreviewMode preview_resolve(PreviewMode m, int fd);
+
+/* Ask the terminal on in_fd/out_fd what it is, as chafa does where the
+   environment leaves it unsaid: DA1 (ESC [ c), which every VT100-like
+   terminal answers, and whose attribute 4 means sixels. Only when both are
+   terminals and the terminal is not tmux, screen or dumb; the input is
+   read raw for at most timeout_ms and restored. Meant for start-up, before
+   the first prompt (a key typed meanwhile would be read with the answer).
+   Remembered for preview_resolve's PREVIEW_AUTO. Returns 0 (not asked, or
+   no answer in time), 1 (no sixels) or 2 (sixels). */
+int preview_query_terminal(int in_fd, int out_fd, int timeout_ms);
+
+/* The DA1 reply "ESC [ ? P1 ; ... c" within buf: 1 if there is one, with
+   *sixel = 1 when an attribute is 4; 0 if none is complete. */
+int preview_parse_da1(const char *buf, size_t n, int *sixel);
 
 /* The largest preview, in character cells. */
 #define PREVIEW_MAX_COLS 400

@@ -1280,12 +1280,23 @@ static int run_terminal(Repl *R) {
     perror("qcs: pipe");
     return 1;
   }
+  /* With the output redirected (qcs > file), the prompt, the echo of what
+     is typed and readline's escape codes belong on the terminal, not in
+     the file: only values go to standard output. */
+  FILE *tty_out = NULL;
+  if (!isatty(STDOUT_FILENO)) {
+    tty_out = isatty(STDERR_FILENO) ? NULL : fopen("/dev/tty", "w");
+    rl_outstream = tty_out ? tty_out : stderr;
+  }
   history_open(R);
   repl_install_sigint();
   set_handler(SIGWINCH, on_sigwinch);
   set_handler(SIGCONT, on_sigcont);
   /* One line, on a terminal only (run_terminal runs only on one). */
   if (isatty(STDOUT_FILENO)) {
+    /* what the terminal is, where its name does not say (sixels) */
+    if (R->preview == PREVIEW_AUTO)
+      preview_query_terminal(STDIN_FILENO, STDOUT_FILENO, 150);
     printf("qcs %s: type an expression or a definition; :help for help, "
            ":quit to leave\n", interp_version());
     fflush(stdout);
@@ -1300,7 +1311,7 @@ static int run_terminal(Repl *R) {
       continue;
     }
     if (r == READ_EOF) {
-      if (!bracketed_paste()) putchar('\n');
+      if (!bracketed_paste()) fputc('\n', rl_outstream ? rl_outstream : stdout);
       break;
     }
     history_note(R, line);
@@ -1309,6 +1320,9 @@ static int run_terminal(Repl *R) {
   }
   feed_eof(R);
   history_close(R);
+  if (rl_outstream) fflush(rl_outstream);
+  if (tty_out) fclose(tty_out);
+  rl_outstream = NULL;
   names_clear(&name_matches);
   free(name_matches.names);
   name_matches = (NameList){0};

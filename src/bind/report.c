@@ -4,6 +4,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "render/camera.h"
+
 void report_render(FILE *out, const RenderReport *r, const char *path) {
   long rays = r->primary + r->shadow;
   fprintf(out, "%s: %dx%d, %d sample%s/pixel, %.3f s on %d thread%s\n", path,
@@ -78,6 +80,14 @@ void report_scene(char *buf, size_t n, const Scene *s, const char *what) {
   double lo[3], hi[3];
   char box[160];
   if (s->n && render_node_box(s, s->root, lo, hi)) {
+    /* Soft objects by where their surface can be, as the camera frames
+       them, not by their keys' reach: the tighter of the two true boxes. */
+    double flo[3], fhi[3];
+    if (camera_scene_box(s, flo, fhi) == 1)
+      for (int i = 0; i < 3; i++) {
+        lo[i] = fmax(lo[i], flo[i]);
+        hi[i] = fmin(hi[i], fhi[i]);
+      }
     /* The box is conservative by a hair (the bounds' padding): show it to
        4 digits of its own size, so that the unit cube reads 0 .. 1. */
     double ext = 0;
