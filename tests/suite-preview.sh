@@ -41,6 +41,11 @@ if [ $rc -eq 1 ] && grep -q 'not a terminal' "$tmp/err" &&
    ! printf '%s' "$out" | grep -q "$ESC"; then ok show-pipe-refused
 else fail show-pipe-refused "status $rc, stderr '$(head -c 200 "$tmp/err")'"; fi
 
+# graphics asked for by name inside tmux: said to need passing through
+printf ':set preview sixel\n:set preview symbols\n' | TMUX=/tmp/x,1,0 HOME=$tmp $lim "$QCS" >/dev/null 2>"$tmp/err"
+if [ "$(grep -c 'tmux and screen do not pass sixel graphics through' "$tmp/err")" = 1 ]; then ok preview-tmux-graphics-note
+else fail preview-tmux-graphics-note "stderr '$(head -c 200 "$tmp/err")'"; fi
+
 # ---- kitty and sixel, parsed back ----
 
 if command -v python3 >/dev/null 2>&1; then

@@ -396,6 +396,14 @@ static int set_preview(Repl *R, const char *name, const char *val) {
       return -1;
     }
     R->preview = m;
+    const char *term = getenv("TERM");
+    if ((m == PREVIEW_KITTY || m == PREVIEW_ITERM || m == PREVIEW_SIXEL) &&
+        (getenv("TMUX") || getenv("STY") ||
+         (term && (!strncmp(term, "screen", 6) || !strncmp(term, "tmux", 4)))))
+      fprintf(stderr, "note: tmux and screen do not pass %s graphics through "
+              "to the terminal unless told to (tmux: allow-passthrough); if "
+              "no picture appears, :set preview symbols\n",
+              preview_mode_name(m));
     return 0;
   }
   if (!strcmp(val, "auto")) {
