@@ -14,7 +14,9 @@
 #   POV_ISO (1: render POV-Ray's exact Wyvill isosurface soft-cloud-iso-100
 #   once, for the "exact field at N = 100" target; 0 to skip),
 #   FRAMES_BENCH (1: bench/frames.sh, a 100-frame animation in one process
-#   against 100 processes; 0 to skip).
+#   against 100 processes; 0 to skip),
+#   TILES_BENCH (1: bench/tiles.sh, 16 tiles of a 1920x1080 figure12 as
+#   processes of their own against the whole; 0 to skip).
 # Writes bench/results.csv and bench/README.md (the summary of this run).
 #
 # Each repetition renders the scene with qcs, then at once with POV-Ray, so
@@ -296,6 +298,15 @@ if [ "${FRAMES_BENCH:-1}" = 1 ]; then
   echo "$FRAMES_SUMMARY"
 fi
 
+# A farm's tiles against the whole picture (issue 17): bench/tiles.sh.
+TILES_SUMMARY=""
+if [ "${TILES_BENCH:-1}" = 1 ]; then
+  TILES_SUMMARY=$(QCS="$QCS" sh bench/tiles.sh "$THREADS" 2>&1)
+  echo
+  echo "tiles as separate processes against the whole (bench/tiles.sh):"
+  echo "$TILES_SUMMARY"
+fi
+
 # Issue 7's targets.
 verdict() { if [ "$1" = "-" ] || [ -z "$1" ]; then echo "not measured"; elif awk "BEGIN { exit !($2) }"; then echo "met"; else echo "NOT met"; fi; }
 ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "-" && a != "" && a + 0 >= b) }'; }
@@ -412,6 +423,17 @@ EOF
     echo
     echo '```'
     echo "$FRAMES_SUMMARY"
+    echo '```'
+  fi
+  if [ -n "$TILES_SUMMARY" ]; then
+    echo
+    echo "## Tiles as separate processes against the whole (issue 17)"
+    echo
+    echo "\`sh bench/tiles.sh $THREADS\`: figure12 at 1920x1080 once, then as 16 tiles"
+    echo "(\`--tile I/16\`), each a process of its own, merged by \`qcs merge\`."
+    echo
+    echo '```'
+    echo "$TILES_SUMMARY"
     echo '```'
   fi
   if [ -f bench/callgrind.csv ]; then

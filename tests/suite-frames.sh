@@ -81,3 +81,22 @@ for a in 'n=300 examples/soft-cloud.qcs' 'side=0 examples/figure15a.qcs' 'lidAng
     echo "ok params: --set ${a%% *} ${a#* }"
   else echo "FAIL params: --set $a"; fi
 done
+
+# Imports: beside the importing file first, then each folder of QCS_PATH in
+# order; not found anywhere is an error that says where it looked.
+mkdir -p "$tmp/lib1" "$tmp/lib2" "$tmp/w" "$tmp/w2"
+printf 'teeth = 12\n' > "$tmp/lib2/gear.qcs"
+printf 'teeth = 16\n' > "$tmp/lib1/gear.qcs"
+printf 'import "gear.qcs"\nteeth * 2\n' > "$tmp/w/main.qcs"
+cp "$tmp/w/main.qcs" "$tmp/w2/main.qcs"
+printf 'teeth = 7\n' > "$tmp/w2/gear.qcs"
+out=$(cd / && QCS_PATH="$tmp/nowhere:$tmp/lib2:$tmp/lib1" "$QCS" "$tmp/w/main.qcs" 2>&1)
+if [ "$out" = 24 ]; then echo "ok import-qcs-path: the first folder of QCS_PATH that has the file"
+else echo "FAIL import-qcs-path: got '$out', want 24"; fi
+out=$(cd / && QCS_PATH="$tmp/lib1" "$QCS" "$tmp/w2/main.qcs" 2>&1)
+if [ "$out" = 14 ]; then echo "ok import-beside-first: the file beside the importer wins over QCS_PATH"
+else echo "FAIL import-beside-first: got '$out', want 14"; fi
+out=$(cd / && QCS_PATH="$tmp/nowhere" "$QCS" "$tmp/w/main.qcs" 2>&1); rc=$?
+if [ $rc = 1 ] && printf '%s' "$out" | grep -q 'main.qcs:1:1: error: cannot find "gear.qcs" to import' &&
+   printf '%s' "$out" | grep -q "$tmp/nowhere"; then echo "ok import-not-found: says where it looked"
+else echo "FAIL import-not-found: status $rc, '$out'"; fi
