@@ -147,6 +147,7 @@ typedef struct Item {
   const char *sigtext;
   Param *param;       /* ITEM_DEF made by `param` */
   const char *import; /* ITEM_IMPORT: the path as written */
+  Sym *import_as;     /* ITEM_IMPORT: `as Name`, or NULL */
 } Item;
 
 #endif

@@ -402,6 +402,96 @@ static void push_file(Interp *I, const char *real, const char *shown) {
   I->shown[I->nfiles++] = gc_strdup(shown);
 }
 
+/* The Syms an imported file's definitions hold (its own names, or the
+   qualified ones it was given where another import had the name). */
+struct ImportedDefs {
+  const char *path;   /* as found (what Sym.imported holds) */
+  Sym *qual;          /* its first qualifier, or NULL */
+  Sym **syms;
+  int n, cap;
+};
+
+/* The qualifier of an import: `as Name`, else the file's stem with a
+   capital (parts.qcs: Parts), or NULL if the stem is not a name
+   (soft-cloud.qcs). */
+static Sym *import_qualifier(Interp *I, const Item *it) {
+  if (it->import_as) return it->import_as;
+  const char *b = strrchr(it->import, '/');
+  b = b ? b + 1 : it->import;
+  size_t n = strlen(b);
+  if (n > 4 && !strcmp(b + n - 4, ".qcs")) n -= 4;
+  if (n == 0 || n > 200 || !((b[0] >= 'a' && b[0] <= 'z') ||
+                              (b[0] >= 'A' && b[0] <= 'Z')))
+    return NULL;
+  char name[208];
+  for (size_t i = 0; i < n; i++) {
+    char c = b[i];
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+          (c >= '0' && c <= '9') || c == '_'))
+      return NULL;
+    name[i] = c;
+  }
+  if (name[0] >= 'a' && name[0] <= 'z') name[0] = (char)(name[0] - 'a' + 'A');
+  return sym_intern(I, name, (int)n);
+}
+
+/* Q.x for the plain name of t (t may itself be qualified). */
+static Sym *qualified_sym(Interp *I, Sym *q, const Sym *t) {
+  const char *plain = strchr(t->name, '.');
+  plain = plain ? plain + 1 : t->name;
+  char buf[512];
+  int n = snprintf(buf, sizeof buf, "%s.%s", q->name, plain);
+  if (n < 0 || n >= (int)sizeof buf) return NULL;
+  return sym_intern(I, buf, n);
+}
+
+/* Make Q.x name each definition x of the imported file k. */
+static void alias_defs(Interp *I, Sym *q, int k, Pos pos) {
+  struct ImportedDefs *d = &I->importdefs[k];
+  for (int i = 0; i < d->n; i++) {
+    Sym *t = d->syms[i];
+    Sym *a = qualified_sym(I, q, t);
+    if (!a || a == t) continue;
+    if (a->global && a->imported && a->imported != t->imported)
+      qcs_error(pos, "%s names two imports (%s is also from %s)", q->name,
+                a->name, a->imported);
+    a->global = t->global;
+    a->def = t->def;
+    a->sig = t->sig;
+    a->doc = t->doc;
+    a->example = t->example;
+    a->def_pos = t->def_pos;
+    a->def_file = t->def_file;
+    a->imported = t->imported;
+    a->user = 1;
+    a->alias_of = t;
+  }
+}
+
+/* 1 if q already names the import of r; an error if it names another. */
+static int check_qualifier(Interp *I, Sym *q, const char *r, Pos pos) {
+  for (int i = 0; q && i < I->nquals; i++)
+    if (I->quals[i] == q) {
+      if (strcmp(I->qual_files[i], r))
+        qcs_error(pos, "%s already names the import of %s (give this one "
+                  "another: import \"...\" as Name)", q->name,
+                  I->qual_files[i]);
+      return 1;
+    }
+  return 0;
+}
+
+/* Register qualifier q for the imported file k (real path r). */
+static void add_qualifier(Interp *I, Sym *q, const char *r, int k, Pos pos) {
+  if (!q || check_qualifier(I, q, r, pos)) return;
+  int cap = I->capquals;
+  I->quals = grow(I->quals, I->nquals, &cap, sizeof(Sym *));
+  I->qual_files = grow(I->qual_files, I->nquals, &I->capquals, sizeof(char *));
+  I->quals[I->nquals] = q;
+  I->qual_files[I->nquals++] = r;
+  alias_defs(I, q, k, pos);
+}
+
 /* import "NAME": runs the file once (its definitions, types and
    parameters; its top-level expressions are checked, not run). */
 static void run_import(Interp *I, Item *it, const char *runname) {
@@ -426,8 +516,13 @@ static void run_import(Interp *I, Item *it, const char *runname) {
       if (k < sizeof chain) snprintf(chain + k, sizeof chain - k, "%s", path);
       qcs_error(it->pos, "import cycle: %s", chain);
     }
+  Sym *qual = import_qualifier(I, it);
+  check_qualifier(I, qual, r, it->pos);
   for (int i = 0; i < I->nimported; i++)
-    if (!strcmp(I->imported[i], r)) return;
+    if (!strcmp(I->imported[i], r)) {
+      add_qualifier(I, qual, r, i, it->pos);
+      return;
+    }
   int seen = 0;
   for (int i = 0; i < I->nreadfiles; i++)
     if (!strcmp(I->readfiles[i], path)) seen = 1;
@@ -450,11 +545,27 @@ static void run_import(Interp *I, Item *it, const char *runname) {
   push_file(I, r, path);
   int n;
   Item **items = parse_program(I, src, MODE_SCRIPT, &n);
+  Sym *saved = I->cur_qual;
+  I->cur_qual = qual;
   run_items(I, items, n, MODE_SCRIPT, path, 1);
+  I->cur_qual = saved;
   I->nfiles--;
+  int cap = I->capimported;
   I->imported = grow(I->imported, I->nimported, &I->capimported,
                      sizeof(char *));
+  I->importdefs = grow(I->importdefs, I->nimported, &cap,
+                       sizeof(struct ImportedDefs));
+  struct ImportedDefs *d = &I->importdefs[I->nimported];
+  memset(d, 0, sizeof *d);
+  d->path = path;
+  d->qual = qual;
+  for (int i = 0; i < n; i++)
+    if (items[i]->kind == ITEM_DEF) {
+      d->syms = grow(d->syms, d->n, &d->cap, sizeof(Sym *));
+      d->syms[d->n++] = items[i]->def->name;
+    }
   I->imported[I->nimported++] = r;
+  add_qualifier(I, qual, r, I->nimported - 1, it->pos);
 }
 
 /* ---- running items ---- */
@@ -480,8 +591,16 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
     if (items[i]->kind == ITEM_DEF && items[i]->def->name->con_arity >= 0)
       qcs_error(items[i]->def->pos, "'%s' is a constructor; a function needs "
                 "another name", items[i]->def->name->name);
-  /* An imported definition may not clash with another file's: the
-     importer's own, or another import's. */
+  for (int i = 0; i < n; i++)
+    if (items[i]->kind == ITEM_DEF && strchr(items[i]->def->name->name, '.'))
+      qcs_error(items[i]->def->pos, "%s is a qualified name (an import's "
+                "definition): it cannot be defined", items[i]->def->name->name);
+  /* A definition may not clash with another file's, but for two imports:
+     the later one's takes its qualified name (Parts.x), inside that file
+     its own name still means it, and the bare name, used anywhere else,
+     is an error that lists both. The importer's own definitions and
+     parameters may clash with none. */
+  int nrename0 = I->nrename;
   if (mode == MODE_SCRIPT && !I->loading_prelude)
     for (int i = 0; i < n; i++) {
       if (items[i]->kind != ITEM_DEF) continue;
@@ -489,13 +608,49 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
       Sym *s = d->name;
       if (!s->def || !s->user || s->overridden) continue;
       if ((s->imported && s->imported != runname) ||
-          (imported && s->def_file != runname))
-        qcs_error(d->pos, "%s is defined here and at %s:%d:%d%s; rename one "
-                  "of them", s->name, s->def_pos.src ? s->def_pos.src->name
-                  : "?", s->def_pos.line, s->def_pos.col,
-                  s->imported ? " (imported)" : "");
+          (imported && s->def_file != runname)) {
+        Sym *q = imported && s->imported && !items[i]->param &&
+                         !s->param && I->cur_qual
+                     ? qualified_sym(I, I->cur_qual, s)
+                     : NULL;
+        if (!q || q->global)
+          qcs_error(d->pos, "%s is defined here and at %s:%d:%d%s; rename "
+                    "one of them%s", s->name, s->def_pos.src ?
+                    s->def_pos.src->name : "?", s->def_pos.line,
+                    s->def_pos.col, s->imported ? " (imported)" : "",
+                    imported && s->imported && !items[i]->param && !s->param
+                        ? ", or import this file with `as Name`"
+                        : "");
+        /* what to write instead: the first import's Q.x, then this one's */
+        char both[1000];
+        if (!s->ambiguous) {
+          Sym *fq = NULL;
+          for (int k = 0; k < I->nimported; k++)
+            if (I->importdefs[k].path == s->imported) fq = I->importdefs[k].qual;
+          Sym *f = fq ? qualified_sym(I, fq, s) : NULL;
+          snprintf(both, sizeof both, "%s (%s:%d:%d) and %s (%s:%d:%d)",
+                   f ? f->name : s->name,
+                   s->def_pos.src ? s->def_pos.src->name : "?",
+                   s->def_pos.line, s->def_pos.col, q->name,
+                   d->pos.src ? d->pos.src->name : "?", d->pos.line,
+                   d->pos.col);
+        } else {
+          snprintf(both, sizeof both, "%s and %s (%s:%d:%d)", s->ambiguous,
+                   q->name, d->pos.src ? d->pos.src->name : "?", d->pos.line,
+                   d->pos.col);
+        }
+        s->ambiguous = gc_strdup(both);
+        int cap = I->caprename;
+        I->rename_from = grow(I->rename_from, I->nrename, &cap, sizeof(Sym *));
+        I->rename_to = grow(I->rename_to, I->nrename, &I->caprename,
+                            sizeof(Sym *));
+        I->rename_from[I->nrename] = s;
+        I->rename_to[I->nrename++] = q;
+        d->name = q;
+      }
     }
   resolve_items(I, items, n);
+  I->nrename = nrename0;
   int redefined = 0;
   for (int i = 0; i < n; i++) {
     Item *it = items[i];

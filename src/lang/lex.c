@@ -259,6 +259,14 @@ Token *lex_all(const Src *src, int *ntokens) {
         if ((int)strlen(keywords[i].text) == len &&
             !memcmp(keywords[i].text, start, (size_t)len))
           k = keywords[i].kind;
+      /* A qualified name, Parts.bolt (no spaces): a definition of the
+         import named Parts (interp.c). `F . g`, with spaces, composes. */
+      if (k == T_CNAME && L.p[0] == '.' &&
+          ((L.p[1] >= 'a' && L.p[1] <= 'z') || L.p[1] == '_')) {
+        advance(&L);
+        while (is_ident(*L.p)) advance(&L);
+        k = T_NAME;
+      }
       push(&L, k, pos, start);
       continue;
     }

@@ -1226,6 +1226,15 @@ static Item *item(Parser *P) {
     it->kind = ITEM_IMPORT;
     it->pos = pos;
     it->import = next(P)->str;
+    /* import "FILE" as Name: its definitions are also Name.def */
+    if (peek(P) == T_NAME && cur(P)->len == 2 && !memcmp(cur(P)->start, "as", 2)) {
+      next(P);
+      if (peek(P) != T_CNAME)
+        error_at_token(P, "expected a name with a capital letter after "
+                       "'as' (import \"FILE\" as Parts), found %s",
+                       describe(P));
+      it->import_as = tok_sym(P, next(P));
+    }
     return it;
   }
   if (peek(P) == T_COLONCOLON) return type_decl(P, pos);

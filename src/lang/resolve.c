@@ -181,6 +181,20 @@ static void set_var(Expr *e, int depth, int slot) {
 /* The innermost binding of e's name: the frame `depth` up, the latest
    binding of the name in it (a where binding over a pattern variable of
    the same clause, as the evaluator's scan from the end finds). */
+/* Parts.x where Parts names no import, or its file defines no x. */
+static _Noreturn void unknown_qualified(Interp *I, Sym *s, Pos pos) {
+  const char *dot = strchr(s->name, '.');
+  int ql = (int)(dot - s->name);
+  for (int i = 0; i < I->nquals; i++)
+    if ((int)strlen(I->quals[i]->name) == ql &&
+        !strncmp(I->quals[i]->name, s->name, (size_t)ql))
+      qcs_error(pos, "unknown name '%s': %s defines no %s", s->name,
+                I->qual_files[i], dot + 1);
+  qcs_error(pos, "unknown name '%s': no import is named %.*s (import "
+            "\"FILE\" as %.*s; for composition write '%.*s . %s')",
+            s->name, ql, s->name, ql, s->name, ql, s->name, dot + 1);
+}
+
 static void resolve_var(Resolver *R, Expr *e, Scope *sc) {
   Sym *s = e->u.var;
   int depth = 0;
@@ -190,6 +204,19 @@ static void resolve_var(Resolver *R, Expr *e, Scope *sc) {
         set_var(e, depth, i + 1);
         return;
       }
+  /* an import's own name that another import took: its qualified one */
+  for (int i = 0; i < R->I->nrename; i++)
+    if (R->I->rename_from[i] == s) {
+      e->u.var = s = R->I->rename_to[i];
+      break;
+    }
+  if (s->ambiguous && !defined_in_batch(R, s))
+    qcs_error(e->pos, "'%s' is defined by two imports, %s: write which",
+              s->name, s->ambiguous);
+  if (s->alias_of) e->u.var = s = s->alias_of;
+  if (!s->global && !defined_in_batch(R, s) && s->con_arity < 0 &&
+      strchr(s->name, '.'))
+    unknown_qualified(R->I, s, e->pos);
   if (s->con_arity >= 0 || s->global || defined_in_batch(R, s)) {
     if (s->con_arity < 0) note_use(R, s);
     set_var(e, 0, RES_GLOBAL);

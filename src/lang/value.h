@@ -62,6 +62,11 @@ struct Sym {
   Expr *set_expr;      /* --set NAME=EXPR: the expression */
   int set_checked;     /* --set NAME matched a declared parameter */
   int anim_mark;       /* interp_set_frame's walk: epoch * 2 + depends */
+  const char *ambiguous; /* defined by two imports: "A.x (a.qcs:1:1) and
+                          B.x (b.qcs:2:1)"; a use of the bare name is an
+                          error that lists them */
+  Sym *alias_of;       /* Parts.x: the Sym holding that import's x (the
+                          resolver puts it in the code's place) */
 };
 
 typedef enum {
@@ -186,6 +191,15 @@ struct Interp {
   int nfiles, capfiles;
   const char **imported;     /* files imported so far (real paths) */
   int nimported, capimported;
+  struct ImportedDefs *importdefs; /* per imported file (parallel to
+                                imported): the Syms its definitions hold */
+  Sym **quals;               /* qualifiers in use (Parts of Parts.x) ... */
+  const char **qual_files;   /* ... and the file (real path) each names */
+  int nquals, capquals;
+  Sym *cur_qual;              /* the qualifier of the import being run */
+  Sym **rename_from, **rename_to; /* while an import is resolved: its own */
+  int nrename, caprename;    /* names taken by another import, renamed to
+                                its qualified ones (resolve.c) */
   const char **readfiles;    /* every file an import read, as the importer
                                 named it, in order, a failed one too */
   int nreadfiles, capreadfiles;
