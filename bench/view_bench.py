@@ -42,7 +42,10 @@ print("qcs view, %s, 600x380 on 2 threads, 20 camera changes: first frame median
 # a save: time from the rename to the first and the full frame of the new version
 get("/state?t=%s" % tok)
 conn.request("GET", "/state?t=%s" % tok); import json; v0 = json.loads(conn.getresponse().read())["version"]
-text = open(scene).read().replace("r    = 0.07;", "r    = 0.08;")
+orig = open(scene).read()
+text = orig.replace("param r = 0.07 in", "param r = 0.08 in")
+if text == orig:
+    sys.exit("view_bench.py: the edit of %s matched nothing" % scene)
 t0 = time.perf_counter()
 open(scene + ".tmp", "w").write(text); os.rename(scene + ".tmp", scene)
 first = full = None

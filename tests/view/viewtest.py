@@ -338,12 +338,15 @@ def browser_tests(host, port, token, scene, defs):
         v0 = qv()["version"]
         src = open(scene).read()
         def save(text):
+            # an edit that changed nothing would test nothing
+            if text == src and os.path.exists(scene):
+                raise RuntimeError("the test's edit of %s matched nothing" % scene)
             tmp = scene + ".swp"
             open(tmp, "w").write(text)
             os.rename(tmp, scene)
         png_before_save = canvas_png()
         t0 = time.time()
-        save(src.replace("r    = 0.07;", "r    = 0.2;"))
+        save(src.replace("param r = 0.07 in", "param r = 0.2 in"))
         # A test asserts the picture, not the speed: the latency budget (a
         # first frame within 50 ms, the full one within 0.2 s) is measured
         # by make bench (bench/view_bench.py); here the new full picture
@@ -355,7 +358,7 @@ def browser_tests(host, port, token, scene, defs):
                "no new full picture %.2f s after the save, or the same one" % dt)
         print("# view: new full picture %.3f s after the save" % dt)
         # an error: the message and the last good picture
-        save(src.replace("r    = 0.07;", "r    = 0.07 +;"))
+        save(src.replace("param r = 0.07 in", "param r = 0.07 + in"))
         err = wait_for(lambda: (qv() or {}).get("error"), 5)
         shown = ws.js("getComputedStyle(document.getElementById('err')).display")
         report("view-error", bool(err) and re.search(r"figure12\.qcs:\d+:\d+: error:", err) is not None
