@@ -94,7 +94,7 @@ units: $(UNIT_BINS) $(REPLAY_BINS)
 # tests and fuzz targets are not held to it.
 $(OBJS): ALL_CFLAGS += -Wconversion
 
-$(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc
+$(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc $(BUILD)/kit.inc
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -c -o $@ $<
 
@@ -109,6 +109,11 @@ $(BUILD)/app/view.o: $(BUILD)/view_page.inc
 $(BUILD)/prelude.inc: stdlib/prelude.qcs tools/embed.sh
 	@mkdir -p $(BUILD)
 	sh tools/embed.sh qcs_prelude_source < $< > $@.tmp && mv $@.tmp $@
+
+# The modeller's kit (solids, transforms, patterns), loaded after it.
+$(BUILD)/kit.inc: stdlib/kit.qcs tools/embed.sh
+	@mkdir -p $(BUILD)
+	sh tools/embed.sh qcs_kit_source stdlib/kit.qcs < $< > $@.tmp && mv $@.tmp $@
 
 $(KERNEL_BINS): $(BUILD)/tests/%: tests/unit/%.c $(CORE_LIB) tests/unit/check.h
 	@mkdir -p $(BUILD)/tests
@@ -277,6 +282,7 @@ install: qcs
 	  $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 755 qcs $(DESTDIR)$(PREFIX)/bin/qcs
 	install -m 644 stdlib/prelude.qcs $(DESTDIR)$(PREFIX)/share/qcs/prelude.qcs
+	install -m 644 stdlib/kit.qcs $(DESTDIR)$(PREFIX)/share/qcs/kit.qcs
 	install -m 644 examples/parts/*.qcs $(DESTDIR)$(PREFIX)/share/qcs/
 	install -m 644 doc/qcs.1 $(DESTDIR)$(PREFIX)/share/man/man1/qcs.1
 
