@@ -285,9 +285,31 @@ install: qcs
 	install -m 644 stdlib/kit.qcs $(DESTDIR)$(PREFIX)/share/qcs/kit.qcs
 	install -m 644 examples/parts/*.qcs $(DESTDIR)$(PREFIX)/share/qcs/
 	install -m 644 doc/qcs.1 $(DESTDIR)$(PREFIX)/share/man/man1/qcs.1
+	@# Editor support (editors/README.md): where Vim and Emacs look, and a
+	@# copy of every file in share/qcs/editors for the rest.
+	install -d $(DESTDIR)$(PREFIX)/share/vim/vimfiles/syntax \
+	  $(DESTDIR)$(PREFIX)/share/vim/vimfiles/ftdetect \
+	  $(DESTDIR)$(PREFIX)/share/emacs/site-lisp \
+	  $(DESTDIR)$(PREFIX)/share/qcs/editors/vim/syntax \
+	  $(DESTDIR)$(PREFIX)/share/qcs/editors/vim/ftdetect \
+	  $(DESTDIR)$(PREFIX)/share/qcs/editors/textmate $(DESTDIR)$(PREFIX)/share/qcs/editors/emacs
+	install -m 644 editors/vim/syntax/qcs.vim $(DESTDIR)$(PREFIX)/share/vim/vimfiles/syntax/qcs.vim
+	install -m 644 editors/vim/ftdetect/qcs.vim $(DESTDIR)$(PREFIX)/share/vim/vimfiles/ftdetect/qcs.vim
+	install -m 644 editors/emacs/qcs-mode.el $(DESTDIR)$(PREFIX)/share/emacs/site-lisp/qcs-mode.el
+	install -m 644 editors/README.md $(DESTDIR)$(PREFIX)/share/qcs/editors/README.md
+	install -m 644 editors/vim/syntax/qcs.vim $(DESTDIR)$(PREFIX)/share/qcs/editors/vim/syntax/qcs.vim
+	install -m 644 editors/vim/ftdetect/qcs.vim $(DESTDIR)$(PREFIX)/share/qcs/editors/vim/ftdetect/qcs.vim
+	install -m 644 editors/textmate/*.json $(DESTDIR)$(PREFIX)/share/qcs/editors/textmate/
+	install -m 644 editors/emacs/qcs-mode.el $(DESTDIR)$(PREFIX)/share/qcs/editors/emacs/qcs-mode.el
+	@echo "editors: Vim syntax in $(PREFIX)/share/vim/vimfiles$(if $(filter /usr,$(PREFIX)),, (add it to Vim's runtimepath: set rtp+=$(PREFIX)/share/vim/vimfiles))"
+	@echo "editors: Emacs qcs-mode.el in $(PREFIX)/share/emacs/site-lisp ((require 'qcs-mode))"
+	@echo "editors: VS Code: cp -r $(PREFIX)/share/qcs/editors/textmate ~/.vscode/extensions/qcs"
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/qcs $(DESTDIR)$(PREFIX)/share/man/man1/qcs.1
+	rm -f $(DESTDIR)$(PREFIX)/share/vim/vimfiles/syntax/qcs.vim \
+	  $(DESTDIR)$(PREFIX)/share/vim/vimfiles/ftdetect/qcs.vim \
+	  $(DESTDIR)$(PREFIX)/share/emacs/site-lisp/qcs-mode.el
 	rm -rf $(DESTDIR)$(PREFIX)/share/qcs
 
 clean:
