@@ -94,7 +94,7 @@ units: $(UNIT_BINS) $(REPLAY_BINS)
 # tests and fuzz targets are not held to it.
 $(OBJS): ALL_CFLAGS += -Wconversion
 
-$(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc
+$(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc $(BUILD)/kit.inc
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -c -o $@ $<
 
@@ -109,6 +109,11 @@ $(BUILD)/app/view.o: $(BUILD)/view_page.inc
 $(BUILD)/prelude.inc: stdlib/prelude.qcs tools/embed.sh
 	@mkdir -p $(BUILD)
 	sh tools/embed.sh qcs_prelude_source < $< > $@.tmp && mv $@.tmp $@
+
+# The modeller's kit (solids, transforms, patterns), loaded after it.
+$(BUILD)/kit.inc: stdlib/kit.qcs tools/embed.sh
+	@mkdir -p $(BUILD)
+	sh tools/embed.sh qcs_kit_source stdlib/kit.qcs < $< > $@.tmp && mv $@.tmp $@
 
 $(KERNEL_BINS): $(BUILD)/tests/%: tests/unit/%.c $(CORE_LIB) tests/unit/check.h
 	@mkdir -p $(BUILD)/tests
@@ -277,11 +282,34 @@ install: qcs
 	  $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 755 qcs $(DESTDIR)$(PREFIX)/bin/qcs
 	install -m 644 stdlib/prelude.qcs $(DESTDIR)$(PREFIX)/share/qcs/prelude.qcs
+	install -m 644 stdlib/kit.qcs $(DESTDIR)$(PREFIX)/share/qcs/kit.qcs
 	install -m 644 examples/parts/*.qcs $(DESTDIR)$(PREFIX)/share/qcs/
 	install -m 644 doc/qcs.1 $(DESTDIR)$(PREFIX)/share/man/man1/qcs.1
+	@# Editor support (editors/README.md): where Vim and Emacs look, and a
+	@# copy of every file in share/qcs/editors for the rest.
+	install -d $(DESTDIR)$(PREFIX)/share/vim/vimfiles/syntax \
+	  $(DESTDIR)$(PREFIX)/share/vim/vimfiles/ftdetect \
+	  $(DESTDIR)$(PREFIX)/share/emacs/site-lisp \
+	  $(DESTDIR)$(PREFIX)/share/qcs/editors/vim/syntax \
+	  $(DESTDIR)$(PREFIX)/share/qcs/editors/vim/ftdetect \
+	  $(DESTDIR)$(PREFIX)/share/qcs/editors/textmate $(DESTDIR)$(PREFIX)/share/qcs/editors/emacs
+	install -m 644 editors/vim/syntax/qcs.vim $(DESTDIR)$(PREFIX)/share/vim/vimfiles/syntax/qcs.vim
+	install -m 644 editors/vim/ftdetect/qcs.vim $(DESTDIR)$(PREFIX)/share/vim/vimfiles/ftdetect/qcs.vim
+	install -m 644 editors/emacs/qcs-mode.el $(DESTDIR)$(PREFIX)/share/emacs/site-lisp/qcs-mode.el
+	install -m 644 editors/README.md $(DESTDIR)$(PREFIX)/share/qcs/editors/README.md
+	install -m 644 editors/vim/syntax/qcs.vim $(DESTDIR)$(PREFIX)/share/qcs/editors/vim/syntax/qcs.vim
+	install -m 644 editors/vim/ftdetect/qcs.vim $(DESTDIR)$(PREFIX)/share/qcs/editors/vim/ftdetect/qcs.vim
+	install -m 644 editors/textmate/*.json $(DESTDIR)$(PREFIX)/share/qcs/editors/textmate/
+	install -m 644 editors/emacs/qcs-mode.el $(DESTDIR)$(PREFIX)/share/qcs/editors/emacs/qcs-mode.el
+	@echo "editors: Vim syntax in $(PREFIX)/share/vim/vimfiles$(if $(filter /usr,$(PREFIX)),, (add it to Vim's runtimepath: set rtp+=$(PREFIX)/share/vim/vimfiles))"
+	@echo "editors: Emacs qcs-mode.el in $(PREFIX)/share/emacs/site-lisp ((require 'qcs-mode))"
+	@echo "editors: VS Code: cp -r $(PREFIX)/share/qcs/editors/textmate ~/.vscode/extensions/qcs"
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/qcs $(DESTDIR)$(PREFIX)/share/man/man1/qcs.1
+	rm -f $(DESTDIR)$(PREFIX)/share/vim/vimfiles/syntax/qcs.vim \
+	  $(DESTDIR)$(PREFIX)/share/vim/vimfiles/ftdetect/qcs.vim \
+	  $(DESTDIR)$(PREFIX)/share/emacs/site-lisp/qcs-mode.el
 	rm -rf $(DESTDIR)$(PREFIX)/share/qcs
 
 clean:

@@ -16,7 +16,8 @@
 #   FRAMES_BENCH (1: bench/frames.sh, a 100-frame animation in one process
 #   against 100 processes; 0 to skip),
 #   TILES_BENCH (1: bench/tiles.sh, 16 tiles of a 1920x1080 figure12 as
-#   processes of their own against the whole; 0 to skip).
+#   processes of their own against the whole; 0 to skip),
+#   KIT_BENCH (1: bench/kit.sh, a 10x10x10 grid of rounded cubes; 0 to skip).
 # Writes bench/results.csv and bench/README.md (the summary of this run).
 #
 # Each repetition renders the scene with qcs, then at once with POV-Ray, so
@@ -307,6 +308,15 @@ if [ "${TILES_BENCH:-1}" = 1 ]; then
   echo "$TILES_SUMMARY"
 fi
 
+# The kit's patterns at scale (issue 19): bench/kit.sh, bench/grid1000.qcs.
+KIT_SUMMARY=""
+if [ "${KIT_BENCH:-1}" = 1 ]; then
+  KIT_SUMMARY=$(QCS="$QCS" SIZE="$SIZE" sh bench/kit.sh "$THREADS" 2>&1)
+  echo
+  echo "a 10x10x10 grid of rounded cubes (bench/kit.sh):"
+  echo "$KIT_SUMMARY"
+fi
+
 # Issue 7's targets.
 verdict() { if [ "$1" = "-" ] || [ -z "$1" ]; then echo "not measured"; elif awk "BEGIN { exit !($2) }"; then echo "met"; else echo "NOT met"; fi; }
 ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "-" && a != "" && a + 0 >= b) }'; }
@@ -434,6 +444,17 @@ EOF
     echo
     echo '```'
     echo "$TILES_SUMMARY"
+    echo '```'
+  fi
+  if [ -n "$KIT_SUMMARY" ]; then
+    echo
+    echo "## Patterns at scale (issue 19)"
+    echo
+    echo "\`sh bench/kit.sh $THREADS\`: \`bench/grid1000.qcs\`, \`UnionAll (Grid (10, 10, 10) ...)\` of"
+    echo "rounded unit cubes, 1000 objects in the BVH, at $SIZE; whole-process wall times."
+    echo
+    echo '```'
+    echo "$KIT_SUMMARY"
     echo '```'
   fi
   if [ -f bench/callgrind.csv ]; then

@@ -32,6 +32,7 @@
 typedef struct Src {
   const char *name;
   const char *text;
+  int prelude;  /* one of the prelude's sources (stdlib/prelude.qcs, kit.qcs) */
 } Src;
 
 typedef struct Pos {

@@ -127,7 +127,7 @@ static Value *lookup(Interp *I, Expr *e, Env *env) {
   if (s->con_arity >= 0) return eval_con_value(I, s);
   /* The prelude's code sees the prelude's definitions, so a user's own
      `floor` (the scenes' name for the ground plane) cannot break fract. */
-  if (e->pos.src == I->prelude_src && e->pos.src && s->prelude_value)
+  if (e->pos.src && e->pos.src->prelude && s->prelude_value)
     return s->prelude_value;
   if (s->global) return s->global;
   unknown_name(I, s, env, e->pos);
@@ -143,7 +143,7 @@ static Value *mk_thunk(Interp *I, Expr *e, Env *env) {
   v->kind = V_THUNK;
   v->u.thunk.e = e;
   v->u.thunk.env = env;
-  if (I->origin && e->pos.src == I->prelude_src) v->u.thunk.origin = I->origin;
+  if (I->origin && e->pos.src && e->pos.src->prelude) v->u.thunk.origin = I->origin;
   return v;
 }
 
@@ -266,7 +266,7 @@ static _Noreturn void cycle_error(Interp *I, Value *v) {
     Pos p = forcing_pos(&I->forcing[i]);
     if (!p.line) continue;
     if (!any.line) any = p;
-    if (p.src != I->prelude_src) pos = p;
+    if (!p.src || !p.src->prelude) pos = p;
   }
   if (!pos.line) pos = any.line ? any : I->item_pos;
   qcs_error(pos, "this value depends on itself (an infinite loop)");
@@ -550,12 +550,12 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
    innermost call from outside the prelude (a Rounded rebuilt by Shift is
    reported where the user wrote Shift). */
 Pos eval_user_pos(Interp *I, Pos pos) {
-  if (!pos.src || strcmp(pos.src->name, "<prelude>")) return pos;
+  if (!pos.src || !pos.src->prelude) return pos;
   if (I->origin) return *I->origin;
   int n = I->ntrace < TRACE_MAX ? I->ntrace : TRACE_MAX;
   for (int i = n - 1; i >= 0; i--) {
     const Pos *t = &I->trace[i].pos;
-    if (t->src && strcmp(t->src->name, "<prelude>")) return *t;
+    if (t->src && !t->src->prelude) return *t;
   }
   return pos;
 }
@@ -626,8 +626,8 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
       trace_set(I, depth, d->name ? d->name->name : "a lambda", pos);
       /* the user's code calls the prelude: errors in there are reported
          here (eval() puts the origin back when it returns) */
-      if (pos.src && pos.src != I->prelude_src &&
-          d->pos.src == I->prelude_src) {
+      if (pos.src && !pos.src->prelude && d->pos.src &&
+          d->pos.src->prelude) {
         Pos *o = GC_MALLOC(sizeof *o);
         *o = pos;
         I->origin = o;

@@ -21,6 +21,7 @@
 #include "lang/resolve.h"
 
 #include "prelude.inc"
+#include "kit.inc"
 
 #ifndef QCS_VERSION
 #define QCS_VERSION "0.1"
@@ -31,7 +32,8 @@ static int run_counter;
 /* ---- error display ---- */
 
 static int in_prelude(Interp *I, Pos p) {
-  return p.src && I->prelude_src && p.src == I->prelude_src;
+  (void)I;
+  return p.src && p.src->prelude;
 }
 
 /* A call made by the prelude's code to a prelude function or a built-in
@@ -54,8 +56,8 @@ static void report_error(Interp *I) {
   if (from_prelude && I->origin && I->origin->src && I->origin->line &&
       !in_prelude(I, *I->origin)) {
     err_report(stderr, "error", *I->origin, e->msg);
-    fprintf(stderr, "  (raised inside the prelude, at <prelude>:%d:%d)\n",
-            e->pos.line, e->pos.col);
+    fprintf(stderr, "  (raised inside the prelude, at %s:%d:%d)\n",
+            e->pos.src->name, e->pos.line, e->pos.col);
   } else {
     err_report(stderr, "error", e->pos, e->msg);
   }
@@ -722,7 +724,7 @@ RunStatus interp_run_string(Interp *I, const char *name, const char *text,
   memcpy(tx, text, len + 1);
   src->name = nm;
   src->text = tx;
-  if (I->loading_prelude) I->prelude_src = src;
+  src->prelude = I->loading_prelude;
   I->item_pos = pos_none;
   int nforcing = I->nforcing, nfiles = I->nfiles;
   ErrFrame f;
@@ -1320,8 +1322,12 @@ Interp *interp_new(void (*install)(Interp *I)) {
   sc->example = "360 * clock";
   if (install) install(I);
   I->loading_prelude = 1;
+  /* The prelude proper, then the modeller's kit (stdlib/kit.qcs) written
+     on it: both are the prelude's code, reported at the user's calls. */
   RunStatus st = interp_run_string(I, "<prelude>", qcs_prelude_source,
                                    MODE_SCRIPT);
+  if (st == RUN_OK)
+    st = interp_run_string(I, "<kit>", qcs_kit_source, MODE_SCRIPT);
   I->loading_prelude = 0;
   if (st != RUN_OK) {
     fprintf(stderr, "qcs: internal error: the prelude does not load\n");

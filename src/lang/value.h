@@ -176,7 +176,6 @@ struct Interp {
   const char *run_name;      /* the file currently being run */
   int warn_shadow;           /* warn of definitions that shadow a
                                 built-in or prelude name (the REPL) */
-  const Src *prelude_src;    /* the prelude's source, for its own scope */
   int loading_prelude;
   Value *v_true, *v_false, *v_nil;
   /* Parameters, imports and animation (interp.c). */

@@ -17,7 +17,7 @@
 
 static Interp *I;
 
-static Src mksrc(const char *text) { return (Src){"<test>", text}; }
+static Src mksrc(const char *text) { return (Src){"<test>", text, 0}; }
 
 /* Lexes text; returns the token count or -1 on a lexical error. */
 static int lex(const char *text, Token **toks) {

@@ -1,0 +1,2 @@
+" qcs scene scripts (editors/vim/syntax/qcs.vim)
+autocmd BufRead,BufNewFile *.qcs setfiletype qcs
