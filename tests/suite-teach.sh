@@ -1,6 +1,7 @@
 #!/bin/sh
 # suite-teach.sh: what a student reads. No line of the tour's or a
-# lesson's output is wider than 80 columns; :set digits N rounds what the
+# lesson's output is wider than 80 columns, nor prints a number with more
+# than 6 significant digits (their `:set digits 6`); :set digits N rounds what the
 # REPL prints (piped, so no terminal is needed); every lesson runs and
 # writes the pictures it names. Prints "ok NAME" or "FAIL NAME: why".
 QCS=${QCS:-./qcs}
@@ -11,10 +12,15 @@ width() { # width NAME FILE: run FILE in $tmp, every line <= 80 columns
   (cd "$tmp" && timeout 120 "$top/$QCS" "$top/$2" > out 2> err < /dev/null)
   st=$?
   wide=$(awk 'length($0) > 80 { print NR ": " length($0) }' "$tmp/out" "$tmp/err" | head -3 | tr '\n' ' ')
+  # rounding noise: a number printed with more than 6 significant digits
+  noise=$(grep -oE '[0-9]+(\.[0-9]+)?' "$tmp/out" | awk '{ m = $0; sub(/\./, "", m);
+    sub(/^0+/, "", m); sub(/0+$/, "", m); if (length(m) > 6) print }' | head -3 | tr '\n' ' ')
   if [ $st -ne 0 ]; then
     echo "FAIL $1: status $st: $(head -c 300 "$tmp/err" | tr '\n' ' ')"
   elif [ -n "$wide" ]; then
     echo "FAIL $1: lines wider than 80 columns (line: width) $wide"
+  elif [ -n "$noise" ]; then
+    echo "FAIL $1: numbers with more than 6 significant digits: $noise"
   else
     echo "ok $1"
   fi
@@ -42,6 +48,20 @@ want='0.333333
 error: :set digits needs 0 (shortest that reads back) to 17, not '"'18'"
 if [ "$out" = "$want" ]; then echo "ok teach: :set digits"
 else echo "FAIL teach: :set digits: got $(printf '%s' "$out" | tr '\n' '|')"; fi
+
+# --digits N on the command line: for -e, and over a script's :set digits
+printf '1 / 3\n:set digits 3\n2 / 3\n' > "$tmp/d.qcs"
+out=$("$QCS" --digits 4 "$tmp/d.qcs" -e '1 / 7' 2>&1 | tr '\n' ' ')
+out0=$("$QCS" --digits 0 "$tmp/d.qcs" 2>&1 | tr '\n' ' ')
+if [ "$out" = "0.3333 0.6667 0.1429 " ] &&
+   [ "$out0" = "0.3333333333333333 0.6666666666666666 " ]
+then echo "ok teach: --digits N, over a script's :set digits"
+else echo "FAIL teach: --digits: got '$out' and '$out0'"; fi
+if "$QCS" --digits 18 -e 1 > /dev/null 2> "$tmp/err"; then
+  echo "FAIL teach: --digits 18 accepted"
+elif grep -q "qcs: error: --digits needs 0 (shortest that reads back) to 17, not '18'" "$tmp/err"
+then echo "ok teach: --digits 18 refused"
+else echo "FAIL teach: --digits 18: $(cat "$tmp/err")"; fi
 
 # plotRay's curve is Density (or Field) at the plotted t, and its roots
 # are Roots: read the data-* attributes back and check them in qcs.

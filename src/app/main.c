@@ -48,6 +48,7 @@ typedef struct Options {
   int nlimits;
   unsigned long long max_spp, max_pixels; /* as given, or the defaults */
   int status;
+  int digits;              /* --digits N, or -1 */
   size_t stack_use, stack_reserved;
   RenderOverrides render;
   int tradeoff;            /* qcs tradeoff: files[0] is the script */
@@ -123,6 +124,9 @@ static void usage(FILE *out) {
           "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
           "  --set NAME=VALUE    replace the top-level definition NAME before\n"
           "                      the scripts run (VALUE is a qcs expression)\n"
+          "  --digits N          print Reals to N significant digits (0, the\n"
+          "                      default: the shortest that reads back); wins\n"
+          "                      over a script's :set digits\n"
           "  -o FILE             render to FILE (.exr, .png, .ppm), or mesh to it\n"
           "                      (.stl, .obj): what the scripts render, or else\n"
           "                      their `scene`\n"
@@ -176,6 +180,10 @@ static Interp *configured_interp(Options *o) {
   Interp *I = bind_interp_new();
   interp_set_stack(I, o->stack_base, o->stack_use);
   interp_set_stack_reserved(I, o->stack_reserved);
+  if (o->digits >= 0) {
+    I->digits = o->digits;
+    I->digits_fixed = 1;
+  }
   for (int i = 0; i < o->nlimits; i++) {
     char err[300];
     if (strcmp(o->limit_names[i], "max-stack") &&
@@ -668,6 +676,7 @@ static int merge_main(int argc, char **argv) {
 int main(int argc, char **argv) {
   static Options o;
   o.t_start = now();
+  o.digits = -1;
   o.preview = PREVIEW_AUTO;
   o.max_spp = QCS_DEFAULT_MAX_SPP;
   o.max_pixels = QCS_DEFAULT_MAX_PIXELS;
@@ -715,6 +724,17 @@ int main(int argc, char **argv) {
         return 1;
       }
       o.exprs[o.nexprs++] = argv[++i];
+    } else if (!strcmp(a, "--digits")) {
+      char *end = NULL;
+      long d = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : -1;
+      if (!end || end == argv[i + 1] || *end || d < 0 || d > 17) {
+        fprintf(stderr, "qcs: error: --digits needs 0 (shortest that reads "
+                "back) to 17%s%s%s\n", end ? ", not '" : "",
+                end ? argv[i + 1] : "", end ? "'" : "");
+        return 1;
+      }
+      o.digits = (int)d;
+      i++;
     } else if (!strcmp(a, "--set")) {
       if (i + 1 >= argc || !strchr(argv[i + 1], '=')) {
         fprintf(stderr, "qcs: error: --set needs NAME=VALUE\n");
