@@ -63,6 +63,25 @@ elif grep -q "qcs: error: --digits needs 0 (shortest that reads back) to 17, not
 then echo "ok teach: --digits 18 refused"
 else echo "FAIL teach: --digits 18: $(cat "$tmp/err")"; fi
 
+# A soft object's Trace: within 80 columns, a steps column with the
+# Laguerre iterations of each solved interval (at least 12: the sextic's 6
+# roots found and 6 polished), the same numbers plotRay writes per interval.
+soft='SoftObject 0.5 [Key (0, 0, 0) 1 1, Key (0.8, 0, 0) 1 1]'
+(cd "$tmp" && "$top/$QCS" --digits 6 -e "Trace ($soft) (-2, 0.1, 0) (1, 0, 0)" \
+  -e "plotRay \"soft.svg\" ($soft) (-2, 0.1, 0) (1, 0, 0)" > trace 2> err)
+wide=$(awk 'length($0) > 80' "$tmp/trace" | head -1)
+steps=$(awk '/solve: Laguerre/ { for (i = 1; i <= NF; i++) if ($i == "Laguerre") print $(i + 1) }' "$tmp/trace" | tr '\n' ' ')
+few=$(printf '%s\n' $steps | awk '$1 !~ /^[0-9]+$/ || $1 < 12' | head -1)
+plotted=$(grep -o 'data-decision="4" data-laguerre="[0-9]*"' "$tmp/soft.svg" | sed 's/.*="//; s/"//' | tr '\n' ' ')
+if [ -n "$wide" ]; then echo "FAIL teach: soft Trace: a line over 80 columns: $wide"
+elif ! grep -q '^t0 .* steps roots$' "$tmp/trace"; then
+  echo "FAIL teach: soft Trace: no steps column: $(head -c 300 "$tmp/trace")"
+elif [ -z "$steps" ] || [ -n "$few" ]; then
+  echo "FAIL teach: soft Trace: Laguerre steps '$steps'"
+elif [ "$steps" != "$plotted" ]; then
+  echo "FAIL teach: soft Trace steps '$steps', plotRay's '$plotted'"
+else echo "ok teach: soft Trace shows the Laguerre steps per interval ($steps)"; fi
+
 # plotRay's curve is Density (or Field) at the plotted t, and its roots
 # are Roots: read the data-* attributes back and check them in qcs.
 curve_check() { # curve_check NAME OBJ O D CLASS PROBE

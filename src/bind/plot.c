@@ -389,7 +389,7 @@ static Value *pl_ray(Interp *I, Value **args, Pos pos) {
     if (log.lg[i].depth > maxdepth) maxdepth = log.lg[i].depth;
   if (maxdepth > 24) maxdepth = 24;
 
-  double plot_h = 300, strip = soft ? 0 : 14.0 * (maxdepth + 1) + 30;
+  double plot_h = 300, strip = soft ? 48 : 14.0 * (maxdepth + 1) + 30;
   double H = 70 + plot_h + 50 + strip + 110;
   Svg s;
   if (svg_open(&s, 820, H) != 0) qcs_error(pos, "out of memory");
@@ -500,6 +500,37 @@ static Value *pl_ray(Interp *I, Value **args, Pos pos) {
     };
     svg_legend(&s, y, items, (int)(sizeof items / sizeof *items));
   } else {
+    /* the intervals again as a row of bars, each with the iterations
+       spent solving eq. (4) on it */
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">intervals between key "
+            "bounds, with the Laguerre iterations (+ Newton/bisection "
+            "steps) spent on each:</text>\n", s.px0, y);
+    y += 8;
+    for (size_t i = 0; i < log.nsoft; i++) {
+      const soft_trace_event *e = &log.soft[i];
+      if (!isfinite(e->t1) || e->t1 <= ta || e->t0 >= tb) continue;
+      double x0 = sx(&s, fmax(e->t0, ta)), x1 = sx(&s, fmin(e->t1, tb));
+      const char *col = e->decision == SOFT_IV_EMPTY ? "#ffffff"
+                        : e->decision < SOFT_IV_QUICK ? "#9e9e9e"
+                                                      : "#2ca02c";
+      char label[48] = "";
+      if (e->decision >= SOFT_IV_QUICK) {
+        if (e->bsteps) snprintf(label, sizeof label, "%ld+%ld", e->lsteps,
+                                e->bsteps);
+        else snprintf(label, sizeof label, "%ld", e->lsteps);
+      }
+      fprintf(f, "<rect class=\"soft-interval\" x=\"%.2f\" y=\"%.1f\" "
+              "width=\"%.2f\" height=\"16\" fill=\"%s\" "
+              "fill-opacity=\"0.5\" stroke=\"#555\" data-t0=\"%.17g\" "
+              "data-t1=\"%.17g\" data-decision=\"%d\" data-laguerre=\"%ld\" "
+              "data-bracket=\"%ld\"/>\n", x0, y, x1 - x0, col, e->t0, e->t1,
+              e->decision, e->lsteps, e->bsteps);
+      if (*label && x1 - x0 >= 7.0 * (double)strlen(label))
+        fprintf(f, "<text x=\"%.2f\" y=\"%.1f\" text-anchor=\"middle\" "
+                "font-size=\"11\">%s</text>\n", 0.5 * (x0 + x1), y + 12,
+                label);
+    }
+    y += 16 + 24;
     static const LegendItem items[] = {
         {"stroke=\"black\" stroke-width=\"2\"", 0, "field"},
         {"stroke=\"#d62728\" stroke-dasharray=\"6 4\"", 0, "magic"},

@@ -401,18 +401,23 @@ static void print_soft_trace(FILE *out, const TraceLog *t, int digits) {
           " term outweighs the rest  solve: eq. (4) solved (bound: by its "
           "range;\n"
           " Laguerre: verified by signs; cascade: by derivatives)  "
-          "roots: crossings\n");
+          "roots: crossings\n"
+          " steps: Laguerre iterations (the sextic's 6 roots found, then "
+          "each polished)\n"
+          " + Newton/bisection steps (cascade, or a sextic monotone "
+          "there)\n");
   static const char *const head[] = {"t0", "t1", "keys", "lo", "hi",
-                                     "decision", "roots"};
+                                     "decision", "steps", "roots"};
+  enum { NC = 8 };
   size_t rows = 0;
   for (size_t i = 0; i < t->nsoft; i++)
     rows += t->soft[i].nroots > 1 ? (size_t)t->soft[i].nroots : 1;
-  char (*cells)[CELL] = calloc(rows * 7 + 1, CELL);
+  char (*cells)[CELL] = calloc(rows * NC + 1, CELL);
   if (!cells) return;
   size_t r = 0;
   for (size_t i = 0; i < t->nsoft; i++) {
     const soft_trace_event *e = &t->soft[i];
-    char (*c)[CELL] = cells + r * 7;
+    char (*c)[CELL] = cells + r * NC;
     double ts = fmax(fabs(e->t0), fabs(e->t1));
     cell(c[0], e->t0, digits, ts);
     cell(c[1], e->t1, digits, ts);
@@ -428,14 +433,17 @@ static void print_soft_trace(FILE *out, const TraceLog *t, int digits) {
     }
     strcpy(c[5], e->decision >= 0 && e->decision <= SOFT_IV_CASCADE
                      ? soft_decisions[e->decision] : "?");
-    if (e->nroots == 0) strcpy(c[6], "-");
+    if (e->decision < SOFT_IV_QUICK) strcpy(c[6], "-");
+    else if (e->bsteps) snprintf(c[6], CELL, "%ld+%ld", e->lsteps, e->bsteps);
+    else snprintf(c[6], CELL, "%ld", e->lsteps);
+    if (e->nroots == 0) strcpy(c[7], "-");
     for (int k = 0; k < e->nroots; k++) {
-      char (*ck)[CELL] = cells + (r + (size_t)k) * 7;
-      cell(ck[6], e->roots[k], digits, 0);
+      char (*ck)[CELL] = cells + (r + (size_t)k) * NC;
+      cell(ck[7], e->roots[k], digits, 0);
     }
     r += e->nroots > 1 ? (size_t)e->nroots : 1;
   }
-  print_table(out, 7, head, cells, rows);
+  print_table(out, NC, head, cells, rows);
   free(cells);
 }
 
