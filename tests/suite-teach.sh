@@ -114,6 +114,25 @@ curve_check "plotRay curve of a soft object is Field, its roots are Roots" \
   "SoftObject 0.5 [Key (0, 0, 0) 1 1, Key (0.8, 0, 0) 1 1]" "(-2, 0.1, 0)" \
   "(1, 0, 0)" field "(\\p -> Field p obj)"
 
+# plotConvolution's curves are Density and TrueDensity at the plotted t,
+# and its crossings are where each is 0.5 (the quasi one to 1e-9, the true
+# one to 1e-6: TrueDensity is good to 1e-7, its slope there about 6).
+(cd "$tmp" && "$top/$QCS" -e 'plotConvolution "conv.svg" 0.1 UnitCube (1.3, 1.3, 1.3) (-1, -1, -1)' \
+  > /dev/null 2> err) || echo "FAIL teach: plotConvolution: $(head -c 200 "$tmp/err")"
+attr() { grep "class=\"$1\"" "$tmp/conv.svg" | sed "s/.*$2=\"\([^\"]*\)\".*/\1/" | tr ' ' ','; }
+cat > "$tmp/conv.qcs" <<QCS
+at t = (1.3 - t, 1.3 - t, 1.3 - t);
+check f ts ys = (length ts, length [t \\\\ (t, y) <- zip ts ys, abs (f (at t) - y) > 1e-12]);
+check (\\p -> Density 0.1 p UnitCube) [$(attr quasi data-x)] [$(attr quasi data-y)]
+check (\\p -> TrueDensity 0.1 p UnitCube) [$(attr true data-x)] [$(attr true data-y)]
+abs (Density 0.1 (at $(attr cross-quasi data-t)) UnitCube - 0.5) < 1e-9
+abs (TrueDensity 0.1 (at $(attr cross-true data-t)) UnitCube - 0.5) < 1e-6
+QCS
+got=$("$QCS" "$tmp/conv.qcs" 2>&1 | tr '\n' ' ')
+if [ "$got" = "(201, 0) (33, 0) True True " ]; then
+  echo "ok teach: plotConvolution's curves are Density and TrueDensity, its crossings 0.5"
+else echo "FAIL teach: plotConvolution data: got $got"; fi
+
 # Every plot writes its file, and a failed write leaves nothing behind.
 (cd "$tmp" && "$top/$QCS" -e 'plotDisplacement "d.svg"' \
   -e 'plotField "c.svg" (SoftObject 0.5 [Key (0, 0, 0) 1 1]) (-2, 0, 0) (1, 0, 0)' \

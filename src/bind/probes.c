@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "core/bounds.h"
+#include "core/conv.h"
 #include "core/density.h"
 #include "lang/builtins.h"
 #include "lang/eval.h"
@@ -43,6 +44,27 @@ static Value *pr_density(Interp *I, Value **args, Pos pos) {
   double rho = dt_density(t, p);
   dt_tape_free(t);
   return val_num(rho);
+}
+
+/* TrueDensity r p tree: the true convolution that Density approximates
+   (Lobb's Figure 5): the fraction of the ball of radius r about p inside
+   the sharp polyhedron, to about 1e-7. */
+#define TRUE_TOL 1e-6
+static Value *pr_true_density(Interp *I, Value **args, Pos pos) {
+  double r = get_radius(I, args[0], pos), p[3];
+  get_point(I, args[1], pos, "the point", p);
+  dt_tape *t = compile_density_tape(I, args[2], r, pos);
+  csg_tape *c = conv_sharp_of(t);
+  dt_tape_free(t);
+  if (!c) qcs_error(pos, "out of memory");
+  double v;
+  if (r == 0) {
+    v = csg_inside(c, p) ? 1 : 0;
+  } else {
+    v = conv_fraction(c, p, r, TRUE_TOL, NULL);
+  }
+  csg_tape_free(c);
+  return val_num(v);
 }
 
 /* Is v (forced) a SoftObject? */
@@ -496,6 +518,10 @@ static Value *pr_lg(Interp *I, Value **args, Pos pos) {
   X("Density", 3, pr_density,                                                \
     "Density r p tree: the density of the tree smoothed with radius r at p"  \
     "; e.g. Density 0.1 (0.5, 0.5, 0.5) UnitCube")                           \
+  X("TrueDensity", 3, pr_true_density,                                       \
+    "TrueDensity r p tree: the true convolution Density stands in for: the "  \
+    "fraction of the ball of radius r about p inside the sharp polyhedron; "  \
+    "e.g. TrueDensity 0.1 (1, 1, 1) UnitCube")                                \
   X("Gradient", 3, pr_gradient,                                              \
     "Gradient r p tree: the density's (or soft field's) gradient at p"      \
     "; e.g. Gradient 0.1 (1, 0.5, 0.5) UnitCube")                            \

@@ -15,7 +15,7 @@
  *    that lies inside. The true value is computed by integrating exact
  *    chord lengths (sharp CSG span lists, csg.h) over the disc of parallel
  *    chords through the ball with nested adaptive Gauss-Kronrod (7-15)
- *    quadrature; see conv_fraction for its accuracy.
+ *    quadrature (core/conv.h); see conv_fraction for its accuracy.
  *
  * Memory: nothing here keeps a caller's pointer after returning. The
  * scene and settings handed to the capture hook are borrowed for the
@@ -27,6 +27,7 @@
 #include <stdio.h>
 
 #include "core/csg.h"
+#include "core/conv.h"
 #include "core/density.h"
 
 /* Kept light (no value.h) so that repl.c can include it. */
@@ -89,20 +90,6 @@ int tradeoff_file(struct Interp *I, const char *path, const TradeoffOptions *o);
    with spp > 0 are plotted as the spp ladder (RMS RGB error). */
 int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
                  const char *path, char *err, size_t errlen);
-
-/* ---- the true convolution ---- */
-
-/* The sharp polyhedron a density tape describes (Product = Intersection,
-   Sum and Union = Union, Difference = set difference). Caller frees with
-   csg_tape_free. NULL on failure. */
-csg_tape *conv_sharp_of(const dt_tape *t);
-
-/* The fraction of the ball of radius r about p inside the sharp object t,
-   to an absolute accuracy of about tol (the quadrature's error estimate;
-   verified against exact values by the tests). *evals, if not NULL, is
-   increased by the number of chords cast. */
-double conv_fraction(const csg_tape *t, const double p[3], double r,
-                     double tol, long *evals);
 
 /* The convolution report: canonical objects and radii, the distance
    between the 0.5-isosurfaces of both fields along sample rays, and the
