@@ -774,14 +774,15 @@ static Value *pl_convolution(Interp *I, Value **args, Pos pos) {
           "y2=\"%.1f\" stroke=\"#777\" stroke-width=\"1.5\" data-t=\"%.17g\"/>\n",
           sx(&s, ts), s.py0, sx(&s, ts), s.py1, ts);
   svg_hline(&s, 0.5, "stroke=\"#d62728\" stroke-dasharray=\"6 4\"");
-  svg_curve(&s, NQ + 1, tq, yq, "quasi", "stroke=\"black\" stroke-width=\"2\"",
-            1);
+  /* the true curve under the quasi one: where they agree, black shows */
   svg_curve(&s, NT + 1, tt, yt, "true",
             "stroke=\"#1f77b4\" stroke-width=\"2\" stroke-dasharray=\"7 4\"",
             1);
   for (int i = 0; i <= NT; i++)
     fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.5\" fill=\"#1f77b4\"/>\n",
             sx(&s, tt[i]), sy(&s, yt[i]));
+  svg_curve(&s, NQ + 1, tq, yq, "quasi", "stroke=\"black\" stroke-width=\"2\"",
+            1);
   if (isfinite(cq))
     fprintf(f, "<circle class=\"cross-quasi\" cx=\"%.2f\" cy=\"%.2f\" r=\"5\" "
             "fill=\"black\" data-t=\"%.17g\"/>\n", sx(&s, cq), sy(&s, 0.5), cq);
