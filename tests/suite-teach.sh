@@ -34,6 +34,16 @@ for f in examples/lessons/*.qcs; do
   n=$(ls "$tmp" | grep -c -E '\.(svg|png)$')
   if [ "$n" -gt 0 ]; then echo "ok teach: lesson $(basename "$f" .qcs) draws ($n files)"
   else echo "FAIL teach: lesson $(basename "$f" .qcs) wrote no picture"; fi
+  # the README's gallery shows every picture (each SVG; a slice's PNG is
+  # inside its SVG)
+  missing=""
+  for svg in "$tmp"/*.svg; do
+    [ -f "$svg" ] || continue
+    pic=doc/images/lessons/$(basename "$svg" .svg).png
+    { [ -s "$pic" ] && grep -qF "($pic)" README.md; } || missing="$missing $pic"
+  done
+  if [ -z "$missing" ]; then echo "ok teach: lesson $(basename "$f" .qcs) pictures in the README"
+  else echo "FAIL teach: lesson $(basename "$f" .qcs): not in the README's gallery:$missing"; fi
 done
 
 # :set digits at the prompt: numbers, a gradient's rounding-noise
