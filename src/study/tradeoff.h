@@ -44,6 +44,7 @@ typedef struct TradeoffOptions {
   const char *svg;      /* plot file (NULL: tradeoff.svg; "" for none) */
   FILE *out;            /* the table (NULL: stdout) */
   int spp_ladder;       /* 1: the samples-per-pixel ladder instead */
+  int mesh_ladder;      /* 1: the mesh-tolerance ladder instead */
 } TradeoffOptions;
 
 typedef struct TradeoffRow {
@@ -57,6 +58,11 @@ typedef struct TradeoffRow {
   double rms_rgb;       /* RMS RGB difference, all pixels */
   long changed;         /* hit vs miss, or a different surface */
   long both;            /* pixels hit on the same surface in both */
+  int mesh;             /* a row of the mesh ladder: tol is the mesh
+                           tolerance, max_dz and rms_dz the sampled
+                           distance of the mesh to the surface */
+  size_t triangles;     /* the mesh ladder: triangles made */
+  double certified;     /* the mesh ladder: the mesher's proven bound */
 } TradeoffRow;
 
 /* Render s at every rung and fill rows[TRADEOFF_RUNGS] (the last row, the
@@ -79,6 +85,23 @@ int tradeoff_scene(const struct Scene *s, const struct RenderSettings *base,
 int tradeoff_spp(const struct Scene *s, const struct RenderSettings *base,
                  const TradeoffOptions *o, const char *name,
                  TradeoffRow *rows, char *err, size_t errlen);
+
+/* 4. The mesh-tolerance ladder (qcs tradeoff --mesh FILE): the bounded
+   part of s (the scene's root if it is bounded, else the bounded parts of
+   its unions: a floor is left out, and the report says so) meshed
+   (render/mesh.h) at tolerances of 1/10, 1/20, 1/40 and 1/80 of its
+   size, best wall time of the repeats (default 1); for each rung the
+   triangles, the time, the mesher's certified bound and a sampled
+   distance: from the centre and edge midpoints of up to
+   TRADEOFF_MESH_SAMPLES triangles along the triangle's normal to the
+   nearest crossing of the true surface (exact ray spans, scene/ray.h).
+   Fills rows[TRADEOFF_MESH_RUNGS]. Table to o->out, plot (error against
+   time) to o->svg. 0, or -1 with a message in err. */
+#define TRADEOFF_MESH_RUNGS 4
+#define TRADEOFF_MESH_SAMPLES 4000
+int tradeoff_mesh(const struct Scene *s, const TradeoffOptions *o,
+                  const char *name, TradeoffRow *rows, char *err,
+                  size_t errlen);
 
 /* Run the script path in I with its first render captured (or, if it
    renders nothing, its `scene`) and report its tradeoff. The other
