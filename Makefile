@@ -64,7 +64,7 @@ UNIT_BINS += $(STAB_SRCS:tests/stability/%.c=$(BUILD)/tests/%)
 # The fuzz targets of fuzz/ as plain programs that replay fuzz/corpus/.
 REPLAY_BINS := $(patsubst %,$(BUILD)/fuzz/replay_%,parse eval probes image render)
 
-.PHONY: all units deps demo test check sanitize tsan install uninstall clean bench update-references gallery layers difftest
+.PHONY: all units deps demo test check sanitize tsan install uninstall clean bench update-references gallery lesson-pictures layers difftest
 
 BIN ?= qcs
 
@@ -199,6 +199,12 @@ gallery: deps
 	  echo "gallery/$$n.png gallery/$$n.exr: $$(grep -m1 " sample" gallery/$$n.log | sed 's/^[^:]*: //')" || \
 	  { echo "error: $$f:"; cat gallery/$$n.log; exit 1; }; \
 	done
+
+# The lessons' pictures for the README (doc/images/lessons/): needs
+# chromium and ImageMagick.
+lesson-pictures:
+	@$(MAKE) -s qcs
+	@sh tools/lesson-pictures.sh
 
 # bench: qcs timed side by side with POV-Ray 3.7 (issue 7); see bench/README.md.
 # POV-Ray (Debian package povray) is installed as root if missing; without it

@@ -70,3 +70,44 @@ if grep -q '<svg' "$tmp/s.svg" 2>/dev/null && grep -q '</svg>' "$tmp/s.svg" &&
      python3 -c 'import sys, xml.dom.minidom as m; m.parse(sys.argv[1])' "$tmp/s.svg"; }; then
   echo "ok tradeoff-spp-plot"
 else echo "FAIL tradeoff-spp-plot: no well-formed labelled SVG"; fi
+# the mesh-tolerance ladder: a sphere (one key) over a floor, which is left
+# out; triangles rise rung by rung, each rung within the mesher's promise
+# (certified <= tolerance), and the sampled distance (at least the true
+# distance of each point; for a sphere the normal is nearly radial, so
+# about it) within the certified bound and falling.
+cat > "$tmp/ball.qcs" <<'QCS'
+scene = Union (SoftObject 0.5 [Key (0, 1, 0) 1 1]) (Halfspace ((0, 1, 0), 0));
+QCS
+if "$QCS" tradeoff --mesh -o "$tmp/mesh.svg" "$tmp/ball.qcs" >"$tmp/out4" 2>"$tmp/err4"; then
+  echo "ok tradeoff-mesh-runs"
+else echo "FAIL tradeoff-mesh-runs: $(head -c 300 "$tmp/err4")"; fi
+grep -q '1 unbounded part left out' "$tmp/out4" && echo "ok tradeoff-mesh-says-floor-left-out" ||
+  echo "FAIL tradeoff-mesh-says-floor-left-out: $(head -2 "$tmp/out4")"
+# columns: | tolerance | triangles | time | certified | max | rms | points |
+awk -F'|' '/^\| [0-9.e-]+ \| [0-9]+ \|/ {
+    tol = $2 + 0; tri = $3 + 0; cert = $5 + 0; mx = $6 + 0; rms = $7 + 0;
+    if (cert > tol) bad = bad " certified " cert " > tol " tol;
+    if (!(mx > 0) || mx > cert) bad = bad " sampled " mx " vs certified " cert;
+    if (rms > mx) bad = bad " rms > max at " tol;
+    if (n && !(tri > prev_tri)) bad = bad " triangles " prev_tri " then " tri;
+    if (n && !(mx < prev_mx)) bad = bad " sampled " prev_mx " then " mx;
+    if ($8 ~ /beyond/) bad = bad " unresolved points at " tol;
+    prev_tri = tri; prev_mx = mx; n++
+  }
+  END {
+    if (n != 4) bad = bad " " n " rungs";
+    if (bad) { print "FAIL tradeoff-mesh-ladder:" bad; exit }
+    print "ok tradeoff-mesh-ladder"
+  }' "$tmp/out4"
+if grep -q 'distance of the mesh to the surface' "$tmp/mesh.svg" 2>/dev/null &&
+   grep -q 'triangles</text>' "$tmp/mesh.svg" &&
+   { ! command -v python3 >/dev/null ||
+     python3 -c 'import sys, xml.dom.minidom as m; m.parse(sys.argv[1])' "$tmp/mesh.svg"; }; then
+  echo "ok tradeoff-mesh-plot"
+else echo "FAIL tradeoff-mesh-plot: no well-formed labelled SVG"; fi
+printf 'scene = Halfspace ((0, 1, 0), 0);\n' > "$tmp/floor.qcs"
+if "$QCS" tradeoff --mesh -o "$tmp/no.svg" "$tmp/floor.qcs" >/dev/null 2>"$tmp/err5"; then
+  echo "FAIL tradeoff-mesh-nothing-bounded: succeeded"
+elif grep -q 'no bounded part to mesh' "$tmp/err5" && [ ! -e "$tmp/no.svg" ]; then
+  echo "ok tradeoff-mesh-nothing-bounded"
+else echo "FAIL tradeoff-mesh-nothing-bounded: $(head -c 200 "$tmp/err5")"; fi

@@ -48,6 +48,7 @@ typedef struct Options {
   int nlimits;
   unsigned long long max_spp, max_pixels; /* as given, or the defaults */
   int status;
+  int digits;              /* --digits N, or -1 */
   size_t stack_use, stack_reserved;
   RenderOverrides render;
   int tradeoff;            /* qcs tradeoff: files[0] is the script */
@@ -126,6 +127,9 @@ static void usage(FILE *out) {
           "  -e, --eval EXPR     evaluate and print EXPR (after any FILEs)\n"
           "  --set NAME=VALUE    replace the top-level definition NAME before\n"
           "                      the scripts run (VALUE is a qcs expression)\n"
+          "  --digits N          print Reals to N significant digits (0, the\n"
+          "                      default: the shortest that reads back); wins\n"
+          "                      over a script's :set digits\n"
           "  -o FILE             render to FILE (.exr, .png, .ppm), or mesh to it\n"
           "                      (.stl, .obj): what the scripts render, or else\n"
           "                      their `scene`\n"
@@ -179,6 +183,10 @@ static Interp *configured_interp(Options *o) {
   Interp *I = bind_interp_new();
   interp_set_stack(I, o->stack_base, o->stack_use);
   interp_set_stack_reserved(I, o->stack_reserved);
+  if (o->digits >= 0) {
+    I->digits = o->digits;
+    I->digits_fixed = 1;
+  }
   for (int i = 0; i < o->nlimits; i++) {
     char err[300];
     if (strcmp(o->limit_names[i], "max-stack") &&
@@ -344,8 +352,8 @@ static void *run(void *arg) {
 /* ---- qcs tradeoff / qcs convolution (issue 6) ---- */
 
 static void tradeoff_usage(FILE *out) {
-  fputs("usage: qcs tradeoff [--spp] [--size WxH] [--threads N] [--repeats N] "
-        "[-o PLOT.svg] FILE.qcs\n"
+  fputs("usage: qcs tradeoff [--spp | --mesh] [--size WxH] [--threads N] "
+        "[--repeats N]\n                    [-o PLOT.svg] FILE.qcs\n"
         "       qcs convolution\n"
         "\n"
         "tradeoff: render what FILE renders (or its `scene`) at root "
@@ -354,7 +362,10 @@ static void tradeoff_usage(FILE *out) {
         "plot error against time\n(default tradeoff.svg). With --spp: "
         "render it at 1, 4, 16, 64 samples per pixel\nagainst a 256-sample "
         "reference (the script's size capped to 160 wide unless\n--size) "
-        "and plot RMS RGB error against time.\n"
+        "and plot RMS RGB error against time. With --mesh: mesh its bounded "
+        "part\nat 1/10, 1/20, 1/40, 1/80 of its size (best of --repeats, "
+        "default 1):\ntriangles, time, certified and sampled distance to "
+        "the surface.\n"
         "convolution: the quasi-convolutional surface against the true\n"
         "convolution of the polyhedron with the ball, on canonical "
         "objects.\n", out);
@@ -374,6 +385,8 @@ static int tradeoff_args(int argc, char **argv, Options *o) {
       return 1;
     } else if (!strcmp(a, "--spp")) {
       o->topt.spp_ladder = 1;
+    } else if (!strcmp(a, "--mesh")) {
+      o->topt.mesh_ladder = 1;
     } else if (!strcmp(a, "--size") && i + 1 < argc &&
                sscanf(argv[i + 1], "%dx%d%c", &w, &h, &c) == 2 && w > 0 &&
                h > 0) {
@@ -671,6 +684,7 @@ static int merge_main(int argc, char **argv) {
 int main(int argc, char **argv) {
   static Options o;
   o.t_start = now();
+  o.digits = -1;
   o.preview = PREVIEW_AUTO;
   o.max_spp = QCS_DEFAULT_MAX_SPP;
   o.max_pixels = QCS_DEFAULT_MAX_PIXELS;
@@ -718,6 +732,17 @@ int main(int argc, char **argv) {
         return 1;
       }
       o.exprs[o.nexprs++] = argv[++i];
+    } else if (!strcmp(a, "--digits")) {
+      char *end = NULL;
+      long d = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : -1;
+      if (!end || end == argv[i + 1] || *end || d < 0 || d > 17) {
+        fprintf(stderr, "qcs: error: --digits needs 0 (shortest that reads "
+                "back) to 17%s%s%s\n", end ? ", not '" : "",
+                end ? argv[i + 1] : "", end ? "'" : "");
+        return 1;
+      }
+      o.digits = (int)d;
+      i++;
     } else if (!strcmp(a, "--set")) {
       if (i + 1 >= argc || !strchr(argv[i + 1], '=')) {
         fprintf(stderr, "qcs: error: --set needs NAME=VALUE\n");

@@ -15,6 +15,7 @@
 #include "bind/compile.h"
 #include "lang/builtins.h"
 #include "core/bounds.h"
+#include "core/conv.h"
 #include "core/csg.h"
 #include "core/lg.h"
 #include "core/soft.h"
@@ -389,7 +390,7 @@ static Value *pl_ray(Interp *I, Value **args, Pos pos) {
     if (log.lg[i].depth > maxdepth) maxdepth = log.lg[i].depth;
   if (maxdepth > 24) maxdepth = 24;
 
-  double plot_h = 300, strip = soft ? 0 : 14.0 * (maxdepth + 1) + 30;
+  double plot_h = 300, strip = soft ? 48 : 14.0 * (maxdepth + 1) + 30;
   double H = 70 + plot_h + 50 + strip + 110;
   Svg s;
   if (svg_open(&s, 820, H) != 0) qcs_error(pos, "out of memory");
@@ -500,6 +501,37 @@ static Value *pl_ray(Interp *I, Value **args, Pos pos) {
     };
     svg_legend(&s, y, items, (int)(sizeof items / sizeof *items));
   } else {
+    /* the intervals again as a row of bars, each with the iterations
+       spent solving eq. (4) on it */
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">intervals between key "
+            "bounds, with the Laguerre iterations (+ Newton/bisection "
+            "steps) spent on each:</text>\n", s.px0, y);
+    y += 8;
+    for (size_t i = 0; i < log.nsoft; i++) {
+      const soft_trace_event *e = &log.soft[i];
+      if (!isfinite(e->t1) || e->t1 <= ta || e->t0 >= tb) continue;
+      double x0 = sx(&s, fmax(e->t0, ta)), x1 = sx(&s, fmin(e->t1, tb));
+      const char *col = e->decision == SOFT_IV_EMPTY ? "#ffffff"
+                        : e->decision < SOFT_IV_QUICK ? "#9e9e9e"
+                                                      : "#2ca02c";
+      char label[48] = "";
+      if (e->decision >= SOFT_IV_QUICK) {
+        if (e->bsteps) snprintf(label, sizeof label, "%ld+%ld", e->lsteps,
+                                e->bsteps);
+        else snprintf(label, sizeof label, "%ld", e->lsteps);
+      }
+      fprintf(f, "<rect class=\"soft-interval\" x=\"%.2f\" y=\"%.1f\" "
+              "width=\"%.2f\" height=\"16\" fill=\"%s\" "
+              "fill-opacity=\"0.5\" stroke=\"#555\" data-t0=\"%.17g\" "
+              "data-t1=\"%.17g\" data-decision=\"%d\" data-laguerre=\"%ld\" "
+              "data-bracket=\"%ld\"/>\n", x0, y, x1 - x0, col, e->t0, e->t1,
+              e->decision, e->lsteps, e->bsteps);
+      if (*label && x1 - x0 >= 7.0 * (double)strlen(label))
+        fprintf(f, "<text x=\"%.2f\" y=\"%.1f\" text-anchor=\"middle\" "
+                "font-size=\"11\">%s</text>\n", 0.5 * (x0 + x1), y + 12,
+                label);
+    }
+    y += 16 + 24;
     static const LegendItem items[] = {
         {"stroke=\"black\" stroke-width=\"2\"", 0, "field"},
         {"stroke=\"#d62728\" stroke-dasharray=\"6 4\"", 0, "magic"},
@@ -654,6 +686,159 @@ static Value *pl_field(Interp *I, Value **args, Pos pos) {
   svg_close(I, &s, path, pos);
   err_release(&cu_scene);
   scene_free(sc);
+  return val_str(path);
+}
+
+/* ---- plotConvolution ------------------------------------------------- */
+
+/* The first crossing of density 0.5 along o + t d in [ta, tb] from n + 1
+   samples y[] at t[]: the first sign change, bisected on the density. */
+static double quasi_crossing(const dt_tape *tp, const double o[3],
+                             const double d[3], const double *t,
+                             const double *y, int n) {
+  for (int i = 0; i < n; i++) {
+    if ((y[i] >= 0.5) == (y[i + 1] >= 0.5)) continue;
+    double a = t[i], b = t[i + 1];
+    int above_a = y[i] >= 0.5;
+    for (int k = 0; k < 80 && b - a > 0; k++) {
+      double m = 0.5 * (a + b);
+      double p[3] = {o[0] + m * d[0], o[1] + m * d[1], o[2] + m * d[2]};
+      if ((dt_density(tp, p) >= 0.5) == above_a) a = m;
+      else b = m;
+    }
+    return 0.5 * (a + b);
+  }
+  return NAN;
+}
+
+/* plotConvolution "f.svg" r tree o d: Lobb's Figure 5 along a ray, the
+   quasi-convolution (Density) against the true convolution (TrueDensity)
+   near where the ray meets the sharp polyhedron, with both 0.5
+   crossings. */
+#define CONV_TOL 1e-6 /* TrueDensity's */
+static Value *pl_convolution(Interp *I, Value **args, Pos pos) {
+  const char *path = get_path(I, args[0], pos, ".svg");
+  double r = force_num(I, args[1], pos, "the radius"), o[3], d[3];
+  if (!isfinite(r) || r <= 0)
+    qcs_error(pos, "plotConvolution needs a radius > 0, not %g", r);
+  get_vec(I, args[3], pos, "the ray origin", o);
+  get_vec(I, args[4], pos, "the ray direction", d);
+  double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(dl > 0)) qcs_error(pos, "the ray direction cannot be zero");
+  dt_tape *tp = compile_density_tape(I, args[2], r, pos);
+  ErrCleanup cu_tape, cu_csg, cu_svg;
+  err_defer(&cu_tape, free_tape_cb, tp);
+  csg_tape *sharp = conv_sharp_of(tp);
+  if (!sharp) qcs_error(pos, "out of memory");
+  err_defer(&cu_csg, free_csg_cb, sharp);
+  csg_span sp[MAX_SPANS], scratch[256];
+  int ns = csg_ray_spans(sharp, o, d, 0, INFINITY, sp, MAX_SPANS, scratch,
+                         256);
+  double ts = ns <= 0 ? NAN : sp[0].t0 > 0 ? sp[0].t0 : sp[0].t1;
+  if (!isfinite(ts)) /* the sharp surface */
+    qcs_error(pos, "plotConvolution: the ray does not cross the sharp "
+              "polyhedron's surface");
+  double half = 2.5 * r / dl, ta = fmax(0, ts - half), tb = ts + half;
+  enum { NQ = 200, NT = 32 };
+  double tq[NQ + 1], yq[NQ + 1], tt[NT + 1], yt[NT + 1];
+  for (int i = 0; i <= NQ; i++) {
+    tq[i] = ta + (tb - ta) * i / NQ;
+    double p[3] = {o[0] + tq[i] * d[0], o[1] + tq[i] * d[1],
+                   o[2] + tq[i] * d[2]};
+    yq[i] = dt_density(tp, p);
+  }
+  for (int i = 0; i <= NT; i++) {
+    eval_check(I, pos);
+    tt[i] = ta + (tb - ta) * i / NT;
+    double p[3] = {o[0] + tt[i] * d[0], o[1] + tt[i] * d[1],
+                   o[2] + tt[i] * d[2]};
+    yt[i] = conv_fraction(sharp, p, r, CONV_TOL, NULL);
+  }
+  double cq = quasi_crossing(tp, o, d, tq, yq, NQ);
+  double ct = conv_crossing(sharp, r, o, d, isfinite(cq) ? cq : ts, CONV_TOL,
+                            NULL, NULL);
+  if (ct < 0) ct = NAN;
+
+  Svg s;
+  if (svg_open(&s, 760, 650) != 0) qcs_error(pos, "out of memory");
+  err_defer(&cu_svg, svg_discard, &s);
+  s.px0 = 80; s.px1 = 740; s.py0 = 50; s.py1 = 330;
+  s.x0 = ta; s.x1 = tb; s.y0 = -0.05; s.y1 = 1.1;
+  double ymax = 1;
+  for (int i = 0; i <= NQ; i++) ymax = fmax(ymax, yq[i]);
+  s.y1 = 1.1 * ymax;
+  svg_axes(&s, "Figure 5: quasi- against true convolution along the ray",
+           "t along o + t d", "density");
+  FILE *f = s.f;
+  fprintf(f, "<line class=\"sharp\" x1=\"%.2f\" y1=\"%.1f\" x2=\"%.2f\" "
+          "y2=\"%.1f\" stroke=\"#777\" stroke-width=\"1.5\" data-t=\"%.17g\"/>\n",
+          sx(&s, ts), s.py0, sx(&s, ts), s.py1, ts);
+  svg_hline(&s, 0.5, "stroke=\"#d62728\" stroke-dasharray=\"6 4\"");
+  /* the true curve under the quasi one: where they agree, black shows */
+  svg_curve(&s, NT + 1, tt, yt, "true",
+            "stroke=\"#1f77b4\" stroke-width=\"2\" stroke-dasharray=\"7 4\"",
+            1);
+  for (int i = 0; i <= NT; i++)
+    fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.5\" fill=\"#1f77b4\"/>\n",
+            sx(&s, tt[i]), sy(&s, yt[i]));
+  svg_curve(&s, NQ + 1, tq, yq, "quasi", "stroke=\"black\" stroke-width=\"2\"",
+            1);
+  if (isfinite(cq))
+    fprintf(f, "<circle class=\"cross-quasi\" cx=\"%.2f\" cy=\"%.2f\" r=\"5\" "
+            "fill=\"black\" data-t=\"%.17g\"/>\n", sx(&s, cq), sy(&s, 0.5), cq);
+  if (isfinite(ct))
+    fprintf(f, "<circle class=\"cross-true\" cx=\"%.2f\" cy=\"%.2f\" r=\"5\" "
+            "fill=\"none\" stroke=\"#1f77b4\" stroke-width=\"2\" "
+            "data-t=\"%.17g\"/>\n", sx(&s, ct), sy(&s, 0.5), ct);
+  svg_end_data(&s);
+  /* below: the difference, which the eye cannot read off the curves */
+  double dq[NT + 1], dmax = 0;
+  for (int i = 0; i <= NT; i++) {
+    double p[3] = {o[0] + tt[i] * d[0], o[1] + tt[i] * d[1],
+                   o[2] + tt[i] * d[2]};
+    dq[i] = dt_density(tp, p) - yt[i];
+    dmax = fmax(dmax, fabs(dq[i]));
+  }
+  if (!(dmax > 0)) dmax = 1e-3;
+  s.py0 = 390; s.py1 = 520;
+  s.y0 = -1.15 * dmax; s.y1 = 1.15 * dmax;
+  svg_axes(&s, "", "t along o + t d", "quasi - true");
+  svg_hline(&s, 0, "stroke=\"#999\"");
+  fprintf(f, "<line x1=\"%.2f\" y1=\"%.1f\" x2=\"%.2f\" y2=\"%.1f\" "
+          "stroke=\"#777\" stroke-width=\"1.5\"/>\n", sx(&s, ts), s.py0,
+          sx(&s, ts), s.py1);
+  svg_curve(&s, NT + 1, tt, dq, "difference",
+            "stroke=\"#9467bd\" stroke-width=\"2\"", 1);
+  svg_end_data(&s);
+  char note[160] = "";
+  if (isfinite(cq) && isfinite(ct)) {
+    char b[40];
+    format_real_digits(b, (cq - ct) * dl / r, 3);
+    snprintf(note, sizeof note, "0.5 crossings: quasi - true = %s r along the "
+             "ray (> 0: the quasi surface is met later)", b);
+  } else {
+    snprintf(note, sizeof note, "no 0.5 crossing of %s in this window",
+             isfinite(cq) ? "the true convolution" : "the quasi-convolution");
+  }
+  fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">", s.px0, s.py1 + 62);
+  svg_text_esc(f, note);
+  fputs("</text>\n", f);
+  static const LegendItem items[] = {
+      {"stroke=\"black\" stroke-width=\"2\"", 0, "quasi: Density (eq. 2 combined)"},
+      {"stroke=\"#1f77b4\" stroke-width=\"2\" stroke-dasharray=\"7 4\"", 0,
+       "true: TrueDensity (ball fraction)"},
+      {"stroke=\"#777\" stroke-width=\"1.5\"", 0, "sharp surface"},
+      {"stroke=\"#d62728\" stroke-dasharray=\"6 4\"", 0, "0.5 level"},
+      {"stroke=\"#9467bd\" stroke-width=\"2\"", 0,
+       "below: Density - TrueDensity"},
+  };
+  svg_legend(&s, s.py1 + 88, items, 5);
+  err_release(&cu_svg);
+  svg_close(I, &s, path, pos);
+  err_release(&cu_csg);
+  csg_tape_free(sharp);
+  err_release(&cu_tape);
+  dt_tape_free(tp);
   return val_str(path);
 }
 
@@ -928,6 +1113,11 @@ static Value *pl_slice(Interp *I, Value **args, Pos pos) {
   X("plotDisplacement", 1, pl_displacement,                                   \
     "plotDisplacement \"f.svg\": eq. (5), the isosurface offset against t; "  \
     "e.g. plotDisplacement \"d.svg\"")                                         \
+  X("plotConvolution", 5, pl_convolution,                                     \
+    "plotConvolution \"f.svg\" r tree o d: Figure 5, Density against "        \
+    "TrueDensity along the ray near the sharp surface, with both 0.5 "        \
+    "crossings; e.g. plotConvolution \"conv.svg\" 0.1 UnitCube (1.3, 1.3, "   \
+    "1.3) (-1, -1, -1)")                                                      \
   X("plotField", 4, pl_field,                                                 \
     "plotField \"f.svg\" soft o d: Wyvill's C(r) and the field along a line; " \
     "e.g. plotField \"c.svg\" (SoftObject 0.5 [Key (0, 0, 0) 1 1]) "           \

@@ -11,9 +11,13 @@
  *                                   axes and legend go to s.svg beside it
  *   plotDisplacement "d.svg"        eq. (5): the isosurface offset against t
  *   plotField "c.svg" soft o d      Wyvill's C(r) and the field along a line
+ *   plotConvolution "f.svg" r tree o d
+ *                                   Figure 5: the quasi- against the true
+ *                                   convolution along a ray, their
+ *                                   difference and both 0.5 crossings
  *
  * Every number plotted comes from the kernels the probes call (density.h,
- * bounds.h, lg.h, soft.h), and every file is written whole or not at all
+ * bounds.h, lg.h, soft.h, conv.h), and every file is written whole or not at all
  * (img_write_bytes, img_write). The SVGs carry the plotted data in
  * data-* attributes so that tests can check them against the probes.
  * Each plot returns the name of the file it wrote. */

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "core/bounds.h"
+#include "core/conv.h"
 #include "core/density.h"
 #include "lang/builtins.h"
 #include "lang/eval.h"
@@ -43,6 +44,27 @@ static Value *pr_density(Interp *I, Value **args, Pos pos) {
   double rho = dt_density(t, p);
   dt_tape_free(t);
   return val_num(rho);
+}
+
+/* TrueDensity r p tree: the true convolution that Density approximates
+   (Lobb's Figure 5): the fraction of the ball of radius r about p inside
+   the sharp polyhedron, to about 1e-7. */
+#define TRUE_TOL 1e-6
+static Value *pr_true_density(Interp *I, Value **args, Pos pos) {
+  double r = get_radius(I, args[0], pos), p[3];
+  get_point(I, args[1], pos, "the point", p);
+  dt_tape *t = compile_density_tape(I, args[2], r, pos);
+  csg_tape *c = conv_sharp_of(t);
+  dt_tape_free(t);
+  if (!c) qcs_error(pos, "out of memory");
+  double v;
+  if (r == 0) {
+    v = csg_inside(c, p) ? 1 : 0;
+  } else {
+    v = conv_fraction(c, p, r, TRUE_TOL, NULL);
+  }
+  csg_tape_free(c);
+  return val_num(v);
 }
 
 /* Is v (forced) a SoftObject? */
@@ -401,18 +423,23 @@ static void print_soft_trace(FILE *out, const TraceLog *t, int digits) {
           " term outweighs the rest  solve: eq. (4) solved (bound: by its "
           "range;\n"
           " Laguerre: verified by signs; cascade: by derivatives)  "
-          "roots: crossings\n");
+          "roots: crossings\n"
+          " steps: Laguerre iterations (the sextic's 6 roots found, then "
+          "each polished)\n"
+          " + Newton/bisection steps (cascade, or a sextic monotone "
+          "there)\n");
   static const char *const head[] = {"t0", "t1", "keys", "lo", "hi",
-                                     "decision", "roots"};
+                                     "decision", "steps", "roots"};
+  enum { NC = 8 };
   size_t rows = 0;
   for (size_t i = 0; i < t->nsoft; i++)
     rows += t->soft[i].nroots > 1 ? (size_t)t->soft[i].nroots : 1;
-  char (*cells)[CELL] = calloc(rows * 7 + 1, CELL);
+  char (*cells)[CELL] = calloc(rows * NC + 1, CELL);
   if (!cells) return;
   size_t r = 0;
   for (size_t i = 0; i < t->nsoft; i++) {
     const soft_trace_event *e = &t->soft[i];
-    char (*c)[CELL] = cells + r * 7;
+    char (*c)[CELL] = cells + r * NC;
     double ts = fmax(fabs(e->t0), fabs(e->t1));
     cell(c[0], e->t0, digits, ts);
     cell(c[1], e->t1, digits, ts);
@@ -428,14 +455,17 @@ static void print_soft_trace(FILE *out, const TraceLog *t, int digits) {
     }
     strcpy(c[5], e->decision >= 0 && e->decision <= SOFT_IV_CASCADE
                      ? soft_decisions[e->decision] : "?");
-    if (e->nroots == 0) strcpy(c[6], "-");
+    if (e->decision < SOFT_IV_QUICK) strcpy(c[6], "-");
+    else if (e->bsteps) snprintf(c[6], CELL, "%ld+%ld", e->lsteps, e->bsteps);
+    else snprintf(c[6], CELL, "%ld", e->lsteps);
+    if (e->nroots == 0) strcpy(c[7], "-");
     for (int k = 0; k < e->nroots; k++) {
-      char (*ck)[CELL] = cells + (r + (size_t)k) * 7;
-      cell(ck[6], e->roots[k], digits, 0);
+      char (*ck)[CELL] = cells + (r + (size_t)k) * NC;
+      cell(ck[7], e->roots[k], digits, 0);
     }
     r += e->nroots > 1 ? (size_t)e->nroots : 1;
   }
-  print_table(out, 7, head, cells, rows);
+  print_table(out, NC, head, cells, rows);
   free(cells);
 }
 
@@ -488,6 +518,10 @@ static Value *pr_lg(Interp *I, Value **args, Pos pos) {
   X("Density", 3, pr_density,                                                \
     "Density r p tree: the density of the tree smoothed with radius r at p"  \
     "; e.g. Density 0.1 (0.5, 0.5, 0.5) UnitCube")                           \
+  X("TrueDensity", 3, pr_true_density,                                       \
+    "TrueDensity r p tree: the true convolution Density stands in for: the "  \
+    "fraction of the ball of radius r about p inside the sharp polyhedron; "  \
+    "e.g. TrueDensity 0.1 (1, 1, 1) UnitCube")                                \
   X("Gradient", 3, pr_gradient,                                              \
     "Gradient r p tree: the density's (or soft field's) gradient at p"      \
     "; e.g. Gradient 0.1 (1, 0.5, 0.5) UnitCube")                            \

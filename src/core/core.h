@@ -9,6 +9,7 @@
  *               pruning to a ray segment (Lobb, Section 2)
  *   csg.h       sharp CSG tapes: point classification, span lists (Roth)
  *   bounds.h    outer and inner bounds of a density tape (Figure 8)
+ *   conv.h      the true convolution the density approximates (Figure 5)
  *   lg.h        LG bounds and the guaranteed root search (Section 3.4)
  *   poly.h      real polynomials up to degree 6 and their real roots
  *   soft.h      soft objects: field, keys' BVH, every crossing of a ray

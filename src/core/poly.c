@@ -62,9 +62,10 @@ void poly_shift(const double *c, int deg, double x0, double *out) {
  * ever shrinks, so a sign change cannot be lost. Stops when p is zero to
  * within its rounding bound or the bracket is a few ulps wide. */
 static double bracket_root(const double *c, int n, double lo, double hi,
-                           int slo) {
+                           int slo, long *steps) {
   double x = 0.5 * (lo + hi), dxold = hi - lo, dx = dxold;
   for (int it = 0; it < 200; it++) {
+    ++*steps;
     double dp, err, p = poly_eval_d(c, n, x, &dp, &err);
     if (fabs(p) <= err) return x;
     if ((p > 0) == slo) lo = x; else hi = x;
@@ -91,7 +92,7 @@ static double bracket_root(const double *c, int n, double lo, double hi,
  * (found recursively) cut [a, b] into pieces on which p is monotone, so each
  * piece holds a crossing exactly when its end states differ. */
 static int cascade(const double *c, int n, double a, double b, int sa,
-                   int sb, double *out) {
+                   int sb, double *out, long *steps) {
   double crit[POLY_MAX_DEG];
   int m = 0;
   if (n >= 2) {
@@ -99,14 +100,14 @@ static int cascade(const double *c, int n, double a, double b, int sa,
     int dn = poly_deriv(c, n, dc);
     int da = poly_eval(dc, dn, a, NULL) > 0;
     int db = poly_eval(dc, dn, b, NULL) > 0;
-    m = cascade(dc, dn, a, b, da, db, crit);
+    m = cascade(dc, dn, a, b, da, db, crit, steps);
   }
   int count = 0, slo = sa;
   double lo = a;
   for (int i = 0; i <= m; i++) {
     double hi = i < m ? crit[i] : b;
     int shi = i < m ? poly_eval(c, n, hi, NULL) > 0 : sb;
-    if (shi != slo && hi > lo) out[count++] = bracket_root(c, n, lo, hi, slo);
+    if (shi != slo && hi > lo) out[count++] = bracket_root(c, n, lo, hi, slo, steps);
     else if (shi != slo) out[count++] = lo;  /* empty piece: a point */
     lo = hi;
     slo = shi;
@@ -122,9 +123,11 @@ static double cmag(double complex z) {
 
 /* Refine *x towards a root of the degree-m complex polynomial a. Returns 0
  * if it did not converge within the iteration limit. */
-static int laguer(const double complex *a, int m, double complex *x) {
+static int laguer(const double complex *a, int m, double complex *x,
+                  long *steps) {
   static const double frac[9] = {0, .5, .25, .75, .13, .38, .62, .88, 1};
   for (int iter = 1; iter <= 80; iter++) {
+    ++*steps;
     double complex b = a[m], d = 0, f = 0;
     double err = cmag(b), abx = cmag(*x);
     for (int j = m - 1; j >= 0; j--) {
@@ -165,13 +168,13 @@ static void sort_doubles(double *v, int n) {
  * alternate; otherwise returns -1 and the caller falls back. */
 static int laguerre_crossings(const double *c, int n, const double *q,
                               double m, double h, double a, double b,
-                              int sa, int sb, double *out) {
+                              int sa, int sb, double *out, long *steps) {
   double complex ad[POLY_MAX_DEG + 1], orig[POLY_MAX_DEG + 1];
   double complex z[POLY_MAX_DEG];
   for (int i = 0; i <= n; i++) { ad[i] = q[i]; orig[i] = c[i]; }
   for (int j = n; j >= 1; j--) {
     double complex x = 0;
-    if (!laguer(ad, j, &x)) return -1;
+    if (!laguer(ad, j, &x, steps)) return -1;
     z[j - 1] = x;
     double complex bb = ad[j];
     for (int jj = j - 1; jj >= 0; jj--) {
@@ -184,7 +187,7 @@ static int laguerre_crossings(const double *c, int n, const double *q,
   int nc = 0;
   for (int j = 0; j < n; j++) {
     double complex x = m + h * z[j];
-    if (!laguer(orig, n, &x)) return -1;
+    if (!laguer(orig, n, &x, steps)) return -1;
     double complex v = (x - m) / h;
     double re = creal(v), im = fabs(cimag(v)), scale = 1 + fabs(re);
     if (im <= 1e-9 * scale) {
@@ -220,10 +223,28 @@ static int laguerre_crossings(const double *c, int n, const double *q,
 
 /* ---- driver ---------------------------------------------------------- */
 
+static int crossings(const double *c, int deg, double a, double b,
+                     int pos_a, int pos_b, unsigned opts, double *roots,
+                     poly_stats *st, long *lsteps, long *bsteps);
+
 int poly_crossings(const double *c, int deg, double a, double b, int pos_a,
                    int pos_b, unsigned opts, double *roots, poly_stats *st) {
   pos_a = pos_a != 0;
   pos_b = pos_b != 0;
+  long lsteps = 0, bsteps = 0;
+  int k = crossings(c, deg, a, b, pos_a, pos_b, opts, roots, st, &lsteps,
+                    &bsteps);
+  if (st) {
+    st->laguerre_steps += lsteps;
+    st->bracket_steps += bsteps;
+  }
+  return k;
+}
+
+/* poly_crossings, counting its iterations into *lsteps and *bsteps. */
+static int crossings(const double *c, int deg, double a, double b,
+                     int pos_a, int pos_b, unsigned opts, double *roots,
+                     poly_stats *st, long *lsteps, long *bsteps) {
   if (st) st->solves++;
   if (!(a < b)) return 0;
   int n = poly_degree(c, deg);
@@ -251,19 +272,20 @@ int poly_crossings(const double *c, int deg, double a, double b, int pos_a,
   if (fabs(q[1]) > s2 + slack) {  /* p' cannot vanish: p is monotone */
     if (st) st->quick++;
     if (pos_a == pos_b) return 0;
-    roots[0] = bracket_root(c, n, a, b, pos_a);
+    roots[0] = bracket_root(c, n, a, b, pos_a, bsteps);
     return 1;
   }
 
   if (!(opts & POLY_CASCADE_ONLY)) {
-    int k = laguerre_crossings(c, n, q, m, h, a, b, pos_a, pos_b, roots);
+    int k = laguerre_crossings(c, n, q, m, h, a, b, pos_a, pos_b, roots,
+                               lsteps);
     if (k >= 0) {
       if (st) st->laguerre++;
       return k;
     }
   }
   if (st) st->fallbacks++;
-  return cascade(c, n, a, b, pos_a, pos_b, roots);
+  return cascade(c, n, a, b, pos_a, pos_b, roots, bsteps);
 }
 
 int poly_roots(const double *c, int deg, double a, double b, double *roots,

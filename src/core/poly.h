@@ -26,6 +26,9 @@ typedef struct {
   long laguerre;   /* settled by Laguerre + verification */
   long fallbacks;  /* Laguerre rejected (cluster, multiple root, no
                       convergence, parity mismatch): derivative cascade */
+  long laguerre_steps; /* Laguerre iterations: finding the roots of the
+                          deflated polynomials, then polishing each */
+  long bracket_steps;  /* Newton/bisection steps on monotone brackets */
 } poly_stats;
 
 /* Options of poly_crossings. */

@@ -655,6 +655,7 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
         ev.fhi = fhi;
         ev.nkeys = na;
         ev.nroots = 0;
+        ev.lsteps = ev.bsteps = 0;
         ev.decision = (fhi <= obj->magic && state == 0) ||
                               (flo > obj->magic && state == 1)
                           ? SOFT_IV_BOUND : SOFT_IV_COEFF;
@@ -667,6 +668,10 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
         double v[POLY_MAX_DEG];
         poly_stats before = stats->poly;
         int nv = poly_crossings(c, 6, -1.0, 1.0, state, sb, 0, v, &stats->poly);
+        if (hook) {
+          ev.lsteps = stats->poly.laguerre_steps - before.laguerre_steps;
+          ev.bsteps = stats->poly.bracket_steps - before.bracket_steps;
+        }
         if (hook)
           ev.decision = stats->poly.fallbacks > before.fallbacks
                             ? SOFT_IV_CASCADE
@@ -701,7 +706,7 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
          end: crossings must alternate. */
       if (hook) {
         soft_trace_event ev = {cur / len, tnext / len, NAN, NAN, 0,
-                               SOFT_IV_EMPTY, 0, {0}};
+                               SOFT_IV_EMPTY, 0, {0}, 0, 0};
         if (state == 1 && iv > 0) ev.roots[ev.nroots++] = cur / len;
         hook->fn(hook->ctx, &ev);
       }

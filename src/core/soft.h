@@ -135,6 +135,8 @@ typedef struct soft_trace_event {
   int decision;      /* SOFT_IV_* */
   int nroots;        /* crossings it reported, at roots[] (units of t) */
   double roots[POLY_MAX_DEG];
+  long lsteps;       /* Laguerre iterations spent on it (poly_stats) */
+  long bsteps;       /* Newton/bisection steps spent on it */
 } soft_trace_event;
 
 typedef struct soft_hook {

@@ -125,7 +125,9 @@ typedef struct ConDecl {
   int arity;
 } ConDecl;
 
-typedef enum { ITEM_DEF, ITEM_EXPR, ITEM_TYPE, ITEM_SIG, ITEM_IMPORT } ItemKind;
+typedef enum {
+  ITEM_DEF, ITEM_EXPR, ITEM_TYPE, ITEM_SIG, ITEM_IMPORT, ITEM_SET
+} ItemKind;
 
 /* `param NAME = DEFAULT [in [LO, HI]] ["DOC"]`: an ITEM_DEF of NAME with
    this attached (interp.c checks --set values against it). */
@@ -148,6 +150,7 @@ typedef struct Item {
   Param *param;       /* ITEM_DEF made by `param` */
   const char *import; /* ITEM_IMPORT: the path as written */
   Sym *import_as;     /* ITEM_IMPORT: `as Name`, or NULL */
+  int digits;         /* ITEM_SET: `:set digits N` */
 } Item;
 
 #endif

@@ -695,6 +695,9 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
     check_sets(I, runname);
   if (imported || I->declare_only) return RUN_OK;
   for (int i = 0; i < n; i++) {
+    /* :set digits N applies from its line on; --digits N overrides it */
+    if (items[i]->kind == ITEM_SET && !I->digits_fixed)
+      I->digits = items[i]->digits;
     if (items[i]->kind != ITEM_EXPR) continue;
     if (mode == MODE_SCRIPT) {
       I->anim = grow(I->anim, I->nanim, &I->capanim, sizeof(Item *));

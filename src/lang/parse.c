@@ -1213,10 +1213,39 @@ static Item *param_item(Parser *P, Pos pos) {
   return it;
 }
 
-/* item -> typedecl | sig | param | import | binding | expr */
+/* setting -> ':' 'set' 'digits' NUMBER
+   The REPL's `:set digits N` written in a script: the Reals its top-level
+   expressions print from this line on have N significant digits (0: the
+   shortest form that reads back). The limits stay command-line options. */
+static Item *set_item(Parser *P, Pos pos) {
+  next(P); /* : */
+  next(P); /* set */
+  Token *name = cur(P);
+  if (peek(P) != T_NAME || name->len != 6 || memcmp(name->start, "digits", 6))
+    error_at_token(P, "a script's :set changes only digits (`:set digits "
+                   "6`), found %s; limits are options (--max-steps N)",
+                   describe(P));
+  next(P);
+  Token *v = cur(P);
+  if (peek(P) != T_NUM || !(v->num >= 0 && v->num <= 17) ||
+      v->num != (int)v->num)
+    error_at_token(P, ":set digits needs a whole number from 0 (shortest "
+                   "that reads back) to 17, found %s", describe(P));
+  next(P);
+  Item *it = GC_MALLOC(sizeof *it);
+  it->kind = ITEM_SET;
+  it->pos = pos;
+  it->digits = (int)v->num;
+  return it;
+}
+
+/* item -> typedecl | sig | param | import | setting | binding | expr */
 static Item *item(Parser *P) {
   Pos pos = pos_here(P);
   if (peek(P) == T_PARAM) return param_item(P, pos);
+  if (peek(P) == T_COLON && P->toks[P->i + 1].kind == T_NAME &&
+      P->toks[P->i + 1].len == 3 && !memcmp(P->toks[P->i + 1].start, "set", 3))
+    return set_item(P, pos);
   if (peek(P) == T_IMPORT) {
     next(P);
     if (peek(P) != T_STR)

@@ -174,6 +174,40 @@ static _Noreturn void show_too_big(Interp *I) {
                    "than %s of memory", sz);
 }
 
+/* With digits set, a number within rounding of 0 beside larger ones of
+   the same tuple or list (a gradient's 2e-31 beside 7.5, a plane offset's
+   2.3e-16 beside 1) shows as 0: the scale is the largest magnitude of a
+   tuple, or of a list of at most ZERO_SCAN numbers, all finite; -1 for
+   anything else. print_value has forced the value already. */
+#define ZERO_SCAN 4096
+static void print_rec(Interp *I, FILE *out, Value *v, int parens);
+static double zero_scale(Interp *I, Value *v) {
+  if (I->digits <= 0) return -1;
+  double scale = 0;
+  if (v->kind == V_TUPLE) {
+    for (int i = 0; i < v->u.tup.n; i++) {
+      Value *x = force(I, v->u.tup.items[i]);
+      if (x->kind != V_NUM || !isfinite(x->u.num)) return -1;
+      scale = fmax(scale, fabs(x->u.num));
+    }
+    return scale;
+  }
+  for (int n = 0; v->kind == V_CONS; n++) {
+    Value *x = force(I, v->u.cons.head);
+    if (n == ZERO_SCAN || x->kind != V_NUM || !isfinite(x->u.num)) return -1;
+    scale = fmax(scale, fabs(x->u.num));
+    v = force(I, v->u.cons.tail);
+  }
+  return v->kind == V_NIL ? scale : -1;
+}
+
+static void print_elem(Interp *I, FILE *out, Value *x, double scale) {
+  if (scale > 0 && fabs(force(I, x)->u.num) <= 8 * DBL_EPSILON * scale)
+    fputs("0", out);
+  else
+    print_rec(I, out, x, 0);
+}
+
 static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
   eval_check(I, pos_none);
   if (cur_show && out == cur_show->f && cur_show->over) show_too_big(I);
@@ -197,37 +231,24 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
     print_str(out, v->u.str);
     break;
   case V_TUPLE: {
-    /* With digits set, a coordinate within rounding of 0 beside larger
-       ones (a gradient's 2e-31 beside 7.5) shows as 0. */
-    double scale = -1;
-    if (I->digits > 0) {
-      scale = 0;
-      for (int i = 0; i < v->u.tup.n && scale >= 0; i++) {
-        Value *x = force(I, v->u.tup.items[i]);
-        if (x->kind != V_NUM || !isfinite(x->u.num)) scale = -1;
-        else if (fabs(x->u.num) > scale) scale = fabs(x->u.num);
-      }
-    }
+    double scale = zero_scale(I, v);
     fputc('(', out);
     for (int i = 0; i < v->u.tup.n; i++) {
       if (i) fputs(", ", out);
-      Value *x = v->u.tup.items[i];
-      if (scale > 0 && fabs(force(I, x)->u.num) <= 8 * DBL_EPSILON * scale)
-        fputs("0", out);
-      else
-        print_rec(I, out, x, 0);
+      print_elem(I, out, v->u.tup.items[i], scale);
     }
     fputc(')', out);
     break;
   }
   case V_NIL:
-  case V_CONS:
+  case V_CONS: {
+    double scale = zero_scale(I, v);
     fputc('[', out);
     unsigned long long n = 0;
     for (int first = 1; v->kind == V_CONS; first = 0) {
       eval_list_count(I, pos_none, ++n);
       if (!first) fputs(", ", out);
-      print_rec(I, out, v->u.cons.head, 0);
+      print_elem(I, out, v->u.cons.head, scale);
       v = force(I, v->u.cons.tail);
     }
     if (v->kind != V_NIL) {
@@ -236,6 +257,7 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
     }
     fputc(']', out);
     break;
+  }
   case V_CON:
     fputs(v->u.con.con->name, out);
     for (int i = 0; i < v->u.con.n; i++) {

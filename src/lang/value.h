@@ -153,6 +153,8 @@ struct Interp {
   int max_spp;               /* max-spp: samples per pixel of a render */
   int digits;                /* :set digits: significant digits of printed
                                 Reals; 0 = the shortest that reads back */
+  int digits_fixed;          /* --digits N given: a script's :set digits
+                                does not change digits */
   const Pos *origin;         /* the call from the user's code that led
                                 into the prelude code now running (a
                                 thunk made by the prelude keeps the one in

@@ -10,6 +10,7 @@
 
 #include "lang/interp.h"
 #include "render/camera.h"
+#include "render/mesh.h"
 #include "render/render.h"
 #include "scene/scene.h"
 #include "scene/ray.h"
@@ -331,6 +332,209 @@ int tradeoff_spp(const Scene *s, const RenderSettings *base_in,
   return 0;
 }
 
+/* ------------------------------------------------------------------ */
+/* 4. The mesh-tolerance ladder                                        */
+
+/* The bounded parts of node into parts[]: the node if its box is finite,
+   else those of a union's children; an unbounded part that is not a
+   union (a floor) is counted in *left. */
+static void bounded_parts(const Scene *s, int node, int *parts, int *n,
+                          int max, int *left) {
+  double lo[3], hi[3];
+  if (render_node_box(s, node, lo, hi) && isfinite(hi[0] - lo[0]) &&
+      isfinite(hi[1] - lo[1]) && isfinite(hi[2] - lo[2])) {
+    if (*n < max) parts[(*n)++] = node;
+    return;
+  }
+  if (s->nodes[node].kind == SC_UNION) {
+    bounded_parts(s, s->nodes[node].a, parts, n, max, left);
+    bounded_parts(s, s->nodes[node].b, parts, n, max, left);
+    return;
+  }
+  ++*left;
+}
+
+typedef struct MeshErr {
+  double max, sum2;
+  long n, unresolved;
+} MeshErr;
+
+/* The distance from p along the unit vector u to the nearest crossing of
+   node's surface within L either way; -1 if there is none. */
+static double normal_dist(const Scene *s, int node, const double p[3],
+                          const double u[3], double L, RayCtx *c) {
+  double o[3] = {p[0] - L * u[0], p[1] - L * u[1], p[2] - L * u[2]};
+  csg_span *sp;
+  ray_reset(c);
+  int ns = ray_spans(s, node, o, u, 0, 2 * L, c, &sp);
+  double best = -1;
+  for (int i = 0; i < ns; i++) {
+    double e[2] = {sp[i].t0, sp[i].t1};
+    for (int k = 0; k < 2; k++)
+      if (e[k] > 0 && e[k] < 2 * L && (best < 0 || fabs(e[k] - L) < best))
+        best = fabs(e[k] - L);
+  }
+  return best;
+}
+
+/* The sampled distance of mesh m to node's surface (see tradeoff.h). */
+static void mesh_error(const Scene *s, int node, const Mesh *m, double L,
+                       RayCtx *c, MeshErr *e) {
+  size_t stride = m->nt > TRADEOFF_MESH_SAMPLES
+                      ? (m->nt + TRADEOFF_MESH_SAMPLES - 1) /
+                            TRADEOFF_MESH_SAMPLES
+                      : 1;
+  for (size_t t = 0; t < m->nt; t += stride) {
+    const double *A = m->v + 3 * m->t[3 * t], *B = m->v + 3 * m->t[3 * t + 1],
+                 *C = m->v + 3 * m->t[3 * t + 2];
+    double ab[3], ac[3], u[3];
+    for (int k = 0; k < 3; k++) ab[k] = B[k] - A[k], ac[k] = C[k] - A[k];
+    u[0] = ab[1] * ac[2] - ab[2] * ac[1];
+    u[1] = ab[2] * ac[0] - ab[0] * ac[2];
+    u[2] = ab[0] * ac[1] - ab[1] * ac[0];
+    double ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (!(ul > 0)) continue;
+    for (int k = 0; k < 3; k++) u[k] /= ul;
+    double pts[4][3];
+    for (int k = 0; k < 3; k++) {
+      pts[0][k] = (A[k] + B[k] + C[k]) / 3;
+      pts[1][k] = 0.5 * (A[k] + B[k]);
+      pts[2][k] = 0.5 * (B[k] + C[k]);
+      pts[3][k] = 0.5 * (C[k] + A[k]);
+    }
+    /* three directions near the axes but in no plane of a box: a line
+       through a point of a sharp edge then crosses there, not along a
+       face */
+    static const double axes[3][3] = {
+        {0.9415, 0.2957, 0.1614}, {0.1542, 0.9232, -0.3519},
+        {-0.2130, 0.1429, 0.9665}};
+    for (int q = 0; q < 4; q++) {
+      /* the nearest crossing along the normal and three directions: at
+         least the point's distance to the surface, and near it where the
+         mesh cuts a sharp edge (along the normal alone it is far) */
+      double dd = normal_dist(s, node, pts[q], u, L, c);
+      for (int a = 0; a < 3; a++) {
+        double w[3], wl = sqrt(axes[a][0] * axes[a][0] +
+                               axes[a][1] * axes[a][1] +
+                               axes[a][2] * axes[a][2]);
+        for (int k = 0; k < 3; k++) w[k] = axes[a][k] / wl;
+        double da = normal_dist(s, node, pts[q], w, L, c);
+        if (da >= 0 && (dd < 0 || da < dd)) dd = da;
+      }
+      if (dd < 0) {
+        e->unresolved++;
+        continue;
+      }
+      e->max = fmax(e->max, dd);
+      e->sum2 += dd * dd;
+      e->n++;
+    }
+  }
+}
+
+int tradeoff_mesh(const Scene *s, const TradeoffOptions *o, const char *name,
+                  TradeoffRow *rows, char *err, size_t errlen) {
+  FILE *out = o->out ? o->out : stdout;
+  const char *svg = o->svg ? o->svg : "tradeoff.svg";
+  int reps = o->repeats > 0 ? o->repeats : 1;
+  int parts[64], np = 0, left = 0;
+  bounded_parts(s, s->root, parts, &np, 64, &left);
+  if (np == 0) {
+    snprintf(err, errlen, "tradeoff --mesh: %s has no bounded part to mesh",
+             name);
+    return -1;
+  }
+  double size = 0;
+  for (int i = 0; i < np; i++) {
+    double lo[3], hi[3];
+    render_node_box(s, parts[i], lo, hi);
+    for (int k = 0; k < 3; k++) size = fmax(size, hi[k] - lo[k]);
+  }
+  RayCtx *c = ray_ctx_new(s, 1e-10 * fmax(size, 1));
+  if (!c) {
+    snprintf(err, errlen, "out of memory");
+    return -1;
+  }
+  for (int r = 0; r < TRADEOFF_MESH_RUNGS; r++) {
+    TradeoffRow *row = &rows[r];
+    memset(row, 0, sizeof *row);
+    row->mesh = 1;
+    row->tol = size / (10.0 * (1 << r));
+    MeshErr e = {0, 0, 0, 0};
+    for (int i = 0; i < np; i++) {
+      MeshSettings ms;
+      memset(&ms, 0, sizeof ms);
+      ms.tol = row->tol;
+      ms.max_triangles = 20000000;
+      double best = INFINITY;
+      for (int k = 0; k < reps; k++) {
+        Mesh *m = NULL;
+        MeshReport mr;
+        int bad;
+        if (mesh_scene(s, parts[i], &ms, &m, &mr, &bad, err, errlen)) {
+          ray_ctx_free(c);
+          return -1;
+        }
+        best = fmin(best, mr.seconds);
+        if (k == reps - 1) {
+          row->triangles += mr.triangles;
+          row->certified = fmax(row->certified, mr.certified);
+          mesh_error(s, parts[i], m, 4 * row->tol, c, &e);
+        }
+        mesh_free(m);
+      }
+      row->seconds += best;
+    }
+    row->max_dz = e.max;
+    row->rms_dz = e.n ? sqrt(e.sum2 / (double)e.n) : 0;
+    row->changed = e.unresolved;
+    row->both = e.n;
+  }
+  ray_ctx_free(c);
+
+  fprintf(out, "mesh-tolerance tradeoff of %s: %d bounded part%s, size %.4g",
+          name, np, np == 1 ? "" : "s", size);
+  if (left)
+    fprintf(out, " (%d unbounded part%s left out: a floor?)", left,
+            left == 1 ? "" : "s");
+  fprintf(out, ".\neach rung meshed %d time%s (best wall time kept). "
+          "certified: the mesher's proven bound on\nthe distance of every "
+          "mesh point to the surface. sampled: from the centre and edge\n"
+          "midpoints of up to %d triangles a part to the nearest crossing "
+          "of the surface\nalong the triangle's normal or 3 fixed lines "
+          "(exact ray spans; at least the\ndistance to the surface), max and "
+          "RMS over the points.\n\n"
+          "| tolerance | triangles | time s | certified | sampled max | "
+          "sampled RMS | points |\n|---|---|---|---|---|---|---|\n",
+          reps, reps == 1 ? "" : "s", TRADEOFF_MESH_SAMPLES);
+  for (int r = 0; r < TRADEOFF_MESH_RUNGS; r++) {
+    fprintf(out, "| %.3g | %zu | %.4f | %.3g | %.3g | %.3g | %ld", rows[r].tol,
+            rows[r].triangles, rows[r].seconds, rows[r].certified,
+            rows[r].max_dz, rows[r].rms_dz, rows[r].both);
+    if (rows[r].changed)
+      fprintf(out, " (%ld beyond 4 tol)", rows[r].changed);
+    fputs(" |\n", out);
+  }
+  if (rows[0].seconds > 0 && rows[0].triangles > 0)
+    fprintf(out, "\nhalving the tolerance multiplied the triangles by %.2g "
+            "and the time by %.2g\n(from the first rung to the last, per "
+            "step: the mesh is uniform, not adaptive).\n",
+            pow((double)rows[TRADEOFF_MESH_RUNGS - 1].triangles /
+                    (double)rows[0].triangles,
+                1.0 / (TRADEOFF_MESH_RUNGS - 1)),
+            pow(rows[TRADEOFF_MESH_RUNGS - 1].seconds / rows[0].seconds,
+                1.0 / (TRADEOFF_MESH_RUNGS - 1)));
+  if (svg[0]) {
+    char title[300];
+    snprintf(title, sizeof title, "%s: mesh error against time", name);
+    if (tradeoff_svg(rows, TRADEOFF_MESH_RUNGS, title, svg, err, errlen))
+      return -1;
+    fprintf(out, "\nplot written to %s\n", svg);
+  }
+  fflush(out);
+  return 0;
+}
+
 /* ---- the plot ---- */
 
 static void svg_escape(FILE *f, const char *s) {
@@ -346,7 +550,9 @@ int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
                  const char *path, char *err, size_t errlen) {
   double tmin = INFINITY, tmax = 0, emin = INFINITY, emax = 0;
   const int spp = n > 0 && rows[0].spp > 0;
+  const int mesh = n > 0 && !spp && rows[0].mesh;
 #define ERR(i, k) (spp ? (k ? 0.0 : rows[i].rms_rgb) : \
+                   mesh ? (k ? rows[i].certified : rows[i].max_dz) : \
                    (k ? rows[i].rms_dz : rows[i].max_dz))
   for (int i = 0; i < n; i++) {
     if (rows[i].seconds > 0) {
@@ -406,8 +612,13 @@ int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
   fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
              "fill=\"none\" stroke=\"black\"/>\n", L, T, pw, ph);
   fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">wall time "
-             "of the render, seconds (log)</text>\n", L + pw / 2, H - 18);
-  if (spp)
+             "of the %s, seconds (log)</text>\n", L + pw / 2, H - 18,
+          mesh ? "mesh" : "render");
+  if (mesh)
+    fprintf(f, "<text transform=\"translate(22 %.1f) rotate(-90)\" "
+               "text-anchor=\"middle\">distance of the mesh to the surface, "
+               "scene units (log)</text>\n", T + ph / 2);
+  else if (spp)
     fprintf(f, "<text transform=\"translate(22 %.1f) rotate(-90)\" "
                "text-anchor=\"middle\">RMS RGB error against %d samples/"
                "pixel (log)</text>\n", T + ph / 2, TRADEOFF_SPP_REF);
@@ -439,6 +650,14 @@ int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
         fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" "
                    "fill=\"%s\">%d spp</text>\n", x + 6, y - 5, colour[k],
                 rows[i].spp);
+      else if (mesh && k == 0) {
+        int right = x > L + pw - 160; /* keep the label inside the frame */
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" "
+                   "fill=\"%s\" text-anchor=\"%s\">tol %.2g, %zu triangles"
+                   "</text>\n", right ? x - 6 : x + 6, y + 14, colour[k],
+                right ? "end" : "start", rows[i].tol, rows[i].triangles);
+      } else if (mesh)
+        ;
       else
         fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" "
                    "fill=\"%s\">%.0e</text>\n", x + 6, y + (k ? 12 : -5),
@@ -446,7 +665,15 @@ int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
     }
   }
   /* Legend. */
-  if (spp) {
+  if (mesh) {
+    fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>"
+               "<text x=\"%.1f\" y=\"%.1f\">sampled maximum distance</text>\n"
+               "<rect x=\"%.1f\" y=\"%.1f\" width=\"7\" height=\"7\" "
+               "fill=\"%s\"/><text x=\"%.1f\" y=\"%.1f\">certified bound"
+               "</text>\n",
+            L + 16, T + 16, colour[0], L + 26, T + 20, L + 12.5, T + 32.5,
+            colour[1], L + 26, T + 40);
+  } else if (spp) {
     fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>"
                "<text x=\"%.1f\" y=\"%.1f\">RMS RGB error</text>\n"
                "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\">points "
@@ -489,7 +716,10 @@ static int capture(void *ctx, const Scene *s, const RenderSettings *rs,
   if (j->done) return 0; /* only the first render */
   j->done = 1;
   TradeoffRow rows[TRADEOFF_RUNGS];
-  if (j->opt->spp_ladder
+  memset(rows, 0, sizeof rows);
+  if (j->opt->mesh_ladder
+          ? tradeoff_mesh(s, j->opt, j->name, rows, err, errlen)
+      : j->opt->spp_ladder
           ? tradeoff_spp(s, rs, j->opt, j->name, rows, err, errlen)
           : tradeoff_scene(s, rs, j->opt, j->name, rows, err, errlen)) {
     j->failed = 1;
@@ -524,153 +754,6 @@ int tradeoff_file(Interp *I, const char *path, const TradeoffOptions *o) {
 
 /* ------------------------------------------------------------------ */
 /* 2. The true convolution                                             */
-
-csg_tape *conv_sharp_of(const dt_tape *t) {
-  csg_builder *b = csg_builder_new();
-  if (!b) return NULL;
-  int rc = 0;
-  for (int i = 0; i < t->ncode && !rc; i++) {
-    const dt_instr *c = &t->code[i];
-    switch (c->op) {
-    case DT_LEAF:
-      rc = csg_builder_plane(b, t->leaves[c->arg].n, t->leaves[c->arg].d);
-      break;
-    case DT_CONST:
-      rc = csg_builder_const(b, c->c > 0.5 ? CSG_ALL : CSG_EMPTY);
-      break;
-    case DT_SUM:
-    case DT_UNION: rc = csg_builder_op(b, CSG_UNION); break;
-    case DT_PRODUCT: rc = csg_builder_op(b, CSG_INTER); break;
-    case DT_DIFF: rc = csg_builder_op(b, CSG_DIFF); break;
-    case DT_RDIFF: rc = csg_builder_op(b, CSG_RDIFF); break;
-    default: rc = -1;
-    }
-  }
-  if (rc) {
-    csg_builder_free(b);
-    return NULL;
-  }
-  return csg_builder_finish(b, NULL);
-}
-
-typedef struct Chords {
-  const csg_tape *t;
-  double p[3], r;
-  double u[3], e1[3], e2[3]; /* chord direction and the disc's axes */
-  long evals;
-} Chords;
-
-/* Inside length of the chord at (a, b) of the disc. */
-static double chord_len(Chords *C, double a, double b) {
-  double h2 = C->r * C->r - a * a - b * b;
-  if (h2 <= 0) return 0;
-  double h = sqrt(h2);
-  double o[3];
-  for (int k = 0; k < 3; k++)
-    o[k] = C->p[k] + a * C->e1[k] + b * C->e2[k] - h * C->u[k];
-  csg_span sp[64];
-  C->evals++;
-  int n = csg_ray_spans(C->t, o, C->u, 0, 2 * h, sp, 64, NULL, 0);
-  double L = 0;
-  for (int i = 0; i < n; i++) {
-    double t0 = fmax(sp[i].t0, 0), t1 = fmin(sp[i].t1, 2 * h);
-    if (t1 > t0) L += t1 - t0;
-  }
-  return L;
-}
-
-/* Gauss-Kronrod 7-15 nodes and weights on [-1, 1]. */
-static const double gk_x[8] = {
-    0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
-    0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
-    0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
-    0.207784955007898467600689403773245, 0.0};
-static const double gk_wk[8] = {
-    0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
-    0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
-    0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
-    0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
-static const double gk_wg[4] = {
-    0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
-    0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
-
-typedef double (*Fn)(void *ctx, double x);
-
-static double gk15(Fn f, void *ctx, double a, double b, double *errest) {
-  double c = 0.5 * (a + b), h = 0.5 * (b - a);
-  double fc = f(ctx, c);
-  double k = fc * gk_wk[7], g = fc * gk_wg[3];
-  for (int i = 0; i < 7; i++) {
-    double f1 = f(ctx, c - h * gk_x[i]), f2 = f(ctx, c + h * gk_x[i]);
-    k += gk_wk[i] * (f1 + f2);
-    if (i % 2 == 1) g += gk_wg[i / 2] * (f1 + f2);
-  }
-  *errest = fabs((k - g) * h);
-  return k * h;
-}
-
-static double adapt(Fn f, void *ctx, double a, double b, double tol,
-                    double whole, int depth) {
-  double e, v = gk15(f, ctx, a, b, &e);
-  if (e <= tol || depth >= 30 || b - a < 1e-7 * whole) return v;
-  double m = 0.5 * (a + b);
-  return adapt(f, ctx, a, m, 0.5 * tol, whole, depth + 1) +
-         adapt(f, ctx, m, b, 0.5 * tol, whole, depth + 1);
-}
-
-typedef struct Inner {
-  Chords *C;
-  double b, w; /* the chord row b = r sin(theta), half-width w */
-  double tol;
-} Inner;
-
-/* a = w sin(phi): smooth at the disc's rim. */
-static double inner_fn(void *ctx, double phi) {
-  Inner *in = ctx;
-  return chord_len(in->C, in->w * sin(phi), in->b) * in->w * cos(phi);
-}
-
-static double outer_fn(void *ctx, double theta) {
-  Inner *in = ctx;
-  Inner row = *in;
-  row.b = in->C->r * sin(theta);
-  row.w = in->C->r * cos(theta);
-  if (row.w <= 0) return 0;
-  double v = adapt(inner_fn, &row, -M_PI / 2, M_PI / 2, in->tol, M_PI, 0);
-  return v * in->C->r * cos(theta);
-}
-
-double conv_fraction(const csg_tape *t, const double p[3], double r,
-                     double tol, long *evals) {
-  if (csg_is_empty(t)) return 0;
-  if (csg_is_all(t)) return 1;
-  Chords C;
-  memset(&C, 0, sizeof C);
-  C.t = t;
-  C.r = r;
-  memcpy(C.p, p, sizeof C.p);
-  /* A direction parallel to no face of the test objects, so the chord
-     length is continuous over the disc (kinks only). */
-  double u[3] = {0.3141592653, 0.5772156649, 0.7536512486};
-  double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-  for (int k = 0; k < 3; k++) C.u[k] = u[k] / lu;
-  double e1[3] = {C.u[1], -C.u[0], 0};
-  double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1]);
-  for (int k = 0; k < 3; k++) C.e1[k] = e1[k] / l1;
-  C.e2[0] = C.u[1] * C.e1[2] - C.u[2] * C.e1[1];
-  C.e2[1] = C.u[2] * C.e1[0] - C.u[0] * C.e1[2];
-  C.e2[2] = C.u[0] * C.e1[1] - C.u[1] * C.e1[0];
-  double V = 4.0 / 3.0 * M_PI * r * r * r;
-  Inner in = {&C, 0, 0, 0};
-  /* Outer error tol*V/2; each inner integral to a hundredth of
-     tol*V/(2*pi*r): their errors, weighted by r cos(theta) over pi, add
-     up to at most tol*V/200, small enough not to look like a kink to the
-     outer rule's error estimate. */
-  in.tol = 0.005 * tol * V / (M_PI * r);
-  double v = adapt(outer_fn, &in, -M_PI / 2, M_PI / 2, 0.5 * tol * V, M_PI, 0);
-  if (evals) *evals += C.evals;
-  return v / V;
-}
 
 /* ---- the report ---- */
 
@@ -819,49 +902,6 @@ static double quasi_cross(const dt_tape *t, const double o[3],
   return -1;
 }
 
-static double true_at(Obj *ob, const double o[3], const double d[3],
-                      double s, double tol) {
-  double p[3] = {o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]};
-  ob->points++;
-  return conv_fraction(ob->sharp, p, ob->r, tol, &ob->chords) - 0.5;
-}
-
-/* The crossing of the true field near s_guess: bracket by stepping r/8,
-   then Illinois regula falsi to 1e-7 r. -1 if no bracket within 2r. */
-static double true_cross(Obj *ob, const double o[3], const double d[3],
-                         double s_guess, double tol) {
-  double r = ob->r, a = s_guess, fa = true_at(ob, o, d, a, tol);
-  double b = a, fb = fa;
-  int dirn = fa < 0 ? 1 : -1;
-  for (int k = 0; k < 16; k++) {
-    b = a + dirn * r / 8;
-    if (b < 0) return -1;
-    fb = true_at(ob, o, d, b, tol);
-    if ((fa < 0) != (fb < 0)) break;
-    a = b;
-    fa = fb;
-  }
-  if ((fa < 0) == (fb < 0)) return -1;
-  int side = 0;
-  for (int it = 0; it < 60 && fabs(b - a) > 1e-7 * r; it++) {
-    double c = (a * fb - b * fa) / (fb - fa);
-    double fc = true_at(ob, o, d, c, tol);
-    if ((fc < 0) == (fb < 0)) {
-      b = c;
-      fb = fc;
-      if (side == -1) fa *= 0.5;
-      side = -1;
-    } else {
-      a = c;
-      fa = fc;
-      if (side == 1) fb *= 0.5;
-      side = 1;
-    }
-    if (fc == 0) return c;
-  }
-  return 0.5 * (a + b);
-}
-
 int conv_report(FILE *out) {
   const double tol = 1e-6; /* fraction accuracy of the true convolution */
   enum { NOBJ = 8 };
@@ -915,7 +955,8 @@ int conv_report(FILE *out) {
       tq += now_seconds() - t0;
       if (sq < 0) continue;
       t0 = now_seconds();
-      double st = true_cross(ob, ob->o[k], ob->d[k], sq, tol);
+      double st = conv_crossing(ob->sharp, ob->r, ob->o[k], ob->d[k], sq,
+                                  tol, &ob->points, &ob->chords);
       tt += now_seconds() - t0;
       if (st < 0) continue;
       double dd = (sq - st) / ob->r;

@@ -15,7 +15,7 @@
  *    that lies inside. The true value is computed by integrating exact
  *    chord lengths (sharp CSG span lists, csg.h) over the disc of parallel
  *    chords through the ball with nested adaptive Gauss-Kronrod (7-15)
- *    quadrature; see conv_fraction for its accuracy.
+ *    quadrature (core/conv.h); see conv_fraction for its accuracy.
  *
  * Memory: nothing here keeps a caller's pointer after returning. The
  * scene and settings handed to the capture hook are borrowed for the
@@ -27,6 +27,7 @@
 #include <stdio.h>
 
 #include "core/csg.h"
+#include "core/conv.h"
 #include "core/density.h"
 
 /* Kept light (no value.h) so that repl.c can include it. */
@@ -43,6 +44,7 @@ typedef struct TradeoffOptions {
   const char *svg;      /* plot file (NULL: tradeoff.svg; "" for none) */
   FILE *out;            /* the table (NULL: stdout) */
   int spp_ladder;       /* 1: the samples-per-pixel ladder instead */
+  int mesh_ladder;      /* 1: the mesh-tolerance ladder instead */
 } TradeoffOptions;
 
 typedef struct TradeoffRow {
@@ -56,6 +58,11 @@ typedef struct TradeoffRow {
   double rms_rgb;       /* RMS RGB difference, all pixels */
   long changed;         /* hit vs miss, or a different surface */
   long both;            /* pixels hit on the same surface in both */
+  int mesh;             /* a row of the mesh ladder: tol is the mesh
+                           tolerance, max_dz and rms_dz the sampled
+                           distance of the mesh to the surface */
+  size_t triangles;     /* the mesh ladder: triangles made */
+  double certified;     /* the mesh ladder: the mesher's proven bound */
 } TradeoffRow;
 
 /* Render s at every rung and fill rows[TRADEOFF_RUNGS] (the last row, the
@@ -79,6 +86,23 @@ int tradeoff_spp(const struct Scene *s, const struct RenderSettings *base,
                  const TradeoffOptions *o, const char *name,
                  TradeoffRow *rows, char *err, size_t errlen);
 
+/* 4. The mesh-tolerance ladder (qcs tradeoff --mesh FILE): the bounded
+   part of s (the scene's root if it is bounded, else the bounded parts of
+   its unions: a floor is left out, and the report says so) meshed
+   (render/mesh.h) at tolerances of 1/10, 1/20, 1/40 and 1/80 of its
+   size, best wall time of the repeats (default 1); for each rung the
+   triangles, the time, the mesher's certified bound and a sampled
+   distance: from the centre and edge midpoints of up to
+   TRADEOFF_MESH_SAMPLES triangles along the triangle's normal to the
+   nearest crossing of the true surface (exact ray spans, scene/ray.h).
+   Fills rows[TRADEOFF_MESH_RUNGS]. Table to o->out, plot (error against
+   time) to o->svg. 0, or -1 with a message in err. */
+#define TRADEOFF_MESH_RUNGS 4
+#define TRADEOFF_MESH_SAMPLES 4000
+int tradeoff_mesh(const struct Scene *s, const TradeoffOptions *o,
+                  const char *name, TradeoffRow *rows, char *err,
+                  size_t errlen);
+
 /* Run the script path in I with its first render captured (or, if it
    renders nothing, its `scene`) and report its tradeoff. The other
    renders of the script are skipped. 0 on success, 1 on an error (already
@@ -89,20 +113,6 @@ int tradeoff_file(struct Interp *I, const char *path, const TradeoffOptions *o);
    with spp > 0 are plotted as the spp ladder (RMS RGB error). */
 int tradeoff_svg(const TradeoffRow *rows, int n, const char *title,
                  const char *path, char *err, size_t errlen);
-
-/* ---- the true convolution ---- */
-
-/* The sharp polyhedron a density tape describes (Product = Intersection,
-   Sum and Union = Union, Difference = set difference). Caller frees with
-   csg_tape_free. NULL on failure. */
-csg_tape *conv_sharp_of(const dt_tape *t);
-
-/* The fraction of the ball of radius r about p inside the sharp object t,
-   to an absolute accuracy of about tol (the quadrature's error estimate;
-   verified against exact values by the tests). *evals, if not NULL, is
-   increased by the number of chords cast. */
-double conv_fraction(const csg_tape *t, const double p[3], double r,
-                     double tol, long *evals);
 
 /* The convolution report: canonical objects and radii, the distance
    between the 0.5-isosurfaces of both fields along sample rays, and the

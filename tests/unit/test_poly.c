@@ -369,6 +369,40 @@ static void test_imposed(void)
   CHECK_NEAR("linear root (tol 1 ulp)", n == 1 ? got[0] : -1, 0.25, 1e-16);
 }
 
+/* The iteration counters a soft-object Trace prints: Laguerre finds each of
+ * the n roots of the deflated polynomials and polishes each on p, so an
+ * accepted solve takes at least 2n iterations (and at most the 80 of each
+ * call's limit), no Newton step; the cascade takes no Laguerre iteration
+ * and at least one bracket step per crossing; a solve settled by the range
+ * bound takes none. */
+static void test_steps(void)
+{
+  double re[6] = {1, 2, 3, 4, 5, 6}, c[7], got[6];
+  int n = expand(1, re, 6, NULL, NULL, 0, c);
+  poly_stats st = {0};
+  int k = poly_crossings(c, n, 0, 7, 1, 1, 0, got, &st);
+  CHECK("steps: Laguerre settles wilkinson 1..6 with 6 crossings",
+        k == 6 && st.laguerre == 1 && st.fallbacks == 0);
+  CHECK("steps: Laguerre takes 2n..160n iterations, no bracket step",
+        st.laguerre_steps >= 12 && st.laguerre_steps <= 160 * 6 &&
+        st.bracket_steps == 0);
+  poly_stats sc = {0};
+  k = poly_crossings(c, n, 0, 7, 1, 1, POLY_CASCADE_ONLY, got, &sc);
+  CHECK("steps: the cascade takes no Laguerre iteration, >= 1 step a root",
+        k == 6 && sc.laguerre_steps == 0 && sc.bracket_steps >= 6);
+  poly_stats sq = {0};
+  double far[3] = {2, 0, 1};  /* x^2 + 2 > 0 */
+  k = poly_crossings(far, 2, -1, 1, 1, 1, 0, got, &sq);
+  CHECK("steps: a solve settled by its range takes no iteration",
+        k == 0 && sq.quick == 1 && sq.laguerre_steps == 0 &&
+        sq.bracket_steps == 0);
+  poly_stats sl = {0};
+  double lin[2] = {-1, 4};
+  k = poly_crossings(lin, 1, 0, 1, 0, 1, 0, got, &sl);
+  CHECK("steps: a monotone p is bracketed, no Laguerre iteration",
+        k == 1 && sl.laguerre_steps == 0 && sl.bracket_steps >= 1);
+}
+
 int main(void)
 {
   check_prefix = "poly";
@@ -377,5 +411,6 @@ int main(void)
   test_multiple();
   test_random();
   test_imposed();
+  test_steps();
   CHECK_DONE();
 }
