@@ -44,6 +44,7 @@
 #include "core/density.h"
 #include "core/lg.h"
 #include "core/soft.h"
+#include "lang/error.h"
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/render.h"
@@ -1407,7 +1408,8 @@ static struct MHD_Daemon *start(View *v, const ViewOptions *o) {
     close(fd);
     return NULL;
   }
-  if (strcmp(addr, "127.0.0.1"))
+  /* 127.0.0.0/8 is this machine's loopback: no one else reaches it. */
+  if ((ntohl(sa.sin_addr.s_addr) >> 24) != 127)
     fprintf(stderr, "qcs: warning: view: listening on %s, not only on this "
             "machine: anyone who can reach it and has the URL can look at "
             "the scene and save pictures into its folder\n", addr);
@@ -1643,16 +1645,27 @@ int view_scene(Interp *src_I, Scene *s, const RenderSettings *rs,
 
 /* ---- :view EXPR ---- */
 
+/* The expression is evaluated as typed (an error points into it, named
+   ":view"), then rendered (captured) as `render` would. */
 static Value *view_item(Interp *I, void *ud) {
-  char text[4200];
-  snprintf(text, sizeof text, "render \"view.png\" (%s)", (const char *)ud);
-  interp_eval_expr(I, "<view>", text);
+  Value *obj = interp_eval_expr(I, ":view", (const char *)ud);
+  Pos none = {0};
+  if (!compile_is_object(I, obj))
+    qcs_error(none, ":view shows a scene object (Union, Rounded, Halfspace, "
+              "SoftObject or a density tree); %.200s is "
+              "not one", (const char *)ud);
+  render_value(I, NULL, "view.png", obj, none);
   return NULL;
 }
 
 int view_expr(Interp *I, const char *expr, const ViewOptions *o) {
   if (strlen(expr) > 4000) {
     fprintf(stderr, "error: :view: the expression is too long\n");
+    return -1;
+  }
+  if (!strcmp(expr, "scene") && !interp_has_global(I, "scene")) {
+    fprintf(stderr, "error: :view: no `scene` is defined: define one, or "
+            "give the object to show (:view EXPR)\n");
     return -1;
   }
   RenderOverrides *old = render_get_overrides(I), ov;

@@ -15,6 +15,18 @@ SHOT = sys.argv[sys.argv.index("--screenshot") + 1] if "--screenshot" in sys.arg
 results = []
 
 
+def sanitizer_build():
+    """A sanitizer build (QCS_TSAN=1, or the binary carries ASan's or TSan's
+    runtime) renders many times slower: it gets longer waits."""
+    if os.environ.get("QCS_TSAN"): return True
+    try: data = open(QCS, "rb").read()
+    except OSError: return False
+    return b"__asan_init" in data or b"__tsan_init" in data
+
+
+SLOW = sanitizer_build()
+
+
 def report(name, ok, why=""):
     line = ("ok %s" % name) if ok else ("FAIL %s: %s" % (name, why))
     print(line, flush=True)
@@ -109,6 +121,7 @@ class WS:
 
 
 def wait_for(pred, secs):
+    if SLOW: secs *= 3
     t0 = time.time()
     while time.time() - t0 < secs:
         v = pred()
@@ -281,10 +294,10 @@ def browser_tests(host, port, token, scene, defs):
         report("view-copy-camera", copied == cam and (w1, h1) == (w2, h2) and diff == 0 and a2 != b,
                "copied %r (shown %r), %d pixels differ from qcs -o" % (copied, cam, diff))
         # reset key: back to the scene's own camera, identical to qcs -o again
+        n0 = qv()["frames"]
         ws.call("Input.dispatchKeyEvent", type="keyDown", key="r", text="r")
         ws.call("Input.dispatchKeyEvent", type="keyUp", key="r")
-        time.sleep(0.05)
-        wait_for(lambda: (qv() or {}).get("lastStep") == 1, 5)
+        wait_for(lambda: (qv() or {}).get("frames", 0) > n0 and qv()["lastStep"] == 1, 30 if SLOW else 10)
         time.sleep(0.2)
         w1, h1, a = png_pixels(canvas_png())
         report("view-reset-identical", a == b, "after r the picture differs from qcs -o")
@@ -356,15 +369,16 @@ def browser_tests(host, port, token, scene, defs):
         png_before_save = canvas_png()
         t0 = time.time()
         save(src.replace(R_LINE, R_LINE.replace("0.07 in", "0.2 in")))
-        # A test asserts the picture, not the speed: the latency budget (a
-        # first frame within 50 ms, the full one within 0.2 s) is measured
-        # by make bench (bench/view_bench.py); here the new full picture
-        # must come (10 s allows a sanitizer build) and differ from the old.
-        ok = wait_for(lambda: (qv() or {}).get("version", 0) > v0 and qv()["lastStep"] == 1, 10)
+        # The issue's promise: the new picture on the page within 1 s of the
+        # save (a sanitizer build, many times slower, gets 10 s). The
+        # latency budget proper (a first frame within 50 ms, the full one
+        # within 0.2 s) is measured by make bench (bench/view_bench.py).
+        limit = 10 if SLOW else 1.0
+        ok = wait_for(lambda: (qv() or {}).get("version", 0) > v0 and qv()["lastStep"] == 1, limit)
         dt = time.time() - t0
         after_good = canvas_png()
-        report("view-follow", bool(ok) and after_good != png_before_save,
-               "no new full picture %.2f s after the save, or the same one" % dt)
+        report("view-follow", bool(ok) and dt <= limit and after_good != png_before_save,
+               "no new full picture within %g s of the save (%.2f s), or the same one" % (limit, dt))
         print("# view: new full picture %.3f s after the save" % dt)
         # an error: the message and the last good picture
         save(src.replace(R_LINE, R_LINE.replace("0.07 in", "0.07 + in")))
