@@ -639,16 +639,26 @@ static int param_table(Interp *I, VParam *out) {
 /* Applies the page's values to I (interp_set_param: what depends on them
    is evaluated again, lazily). A value I no longer takes (the parameter
    is gone from the file, or its range no longer holds it) is dropped,
-   with a line saying so. Returns how many were applied. */
+   with a line saying so. A value the parameter already has is left
+   alone (what depends on it keeps its values). Returns how many were
+   applied. */
 static int apply_wishes(View *v, Interp *I) {
   Wish w[MAX_PARAMS];
   pthread_mutex_lock(&v->mu);
   int n = v->nwish;
   memcpy(w, v->wish, (size_t)n * sizeof *w);
   pthread_mutex_unlock(&v->mu);
+  InterpParam now[MAX_PARAMS];
+  int nnow = n > 0 ? interp_param_list(I, now, MAX_PARAMS) : 0;
+  if (nnow > MAX_PARAMS) nnow = MAX_PARAMS;
   int applied = 0;
   for (int i = 0; i < n; i++) {
     char err[300];
+    int same = 0;
+    for (int j = 0; j < nnow; j++)
+      if (!strcmp(now[j].name, w[i].name))
+        same = now[j].numeric && now[j].value == w[i].x;
+    if (same) continue;
     if (interp_set_param(I, w[i].name, w[i].x, err, sizeof err) == RUN_OK) {
       applied++;
       continue;
