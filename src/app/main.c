@@ -424,7 +424,8 @@ static void view_usage(FILE *out) {
         "Serve a live view of what FILE renders (or its `scene`) in the "
         "browser:\nopen the printed URL. The picture follows the file on "
         "every save; drag to\norbit, shift-drag to pan, wheel to zoom, "
-        "click to probe a pixel. Listens on\n127.0.0.1 and a free port "
+        "click to probe a pixel; the file's\nparameters (`param`) get "
+        "sliders, whose values stay over saves. Listens on\n127.0.0.1 and a free port "
         "unless --listen says otherwise. Ctrl-C stops it.\n", out);
 }
 

@@ -9,6 +9,10 @@
  *                           409: another camera was asked for meanwhile
  *   GET  /probe?CAM&x=&y=   JSON: the probes of pixel (x, y)'s ray
  *   POST /save?CAM&fmt=png|exr  the full picture into the scene's folder
+ *   POST /param?name=N&value=X  the declared parameter N set to the number
+ *                           X (a slider): re-evaluated on the interpreter's
+ *                           thread, /state then answers the new version
+ *   POST /param?reset=1     every parameter back to the command line's
  * CAM is own=1 (the scene's camera) or eye=X,Y,Z&at=X,Y,Z&up=X,Y,Z&fov=F,
  * plus shadows=0|1 and ch=colour|depth|normal|cost. */
 #include "app/view.h"
@@ -40,6 +44,7 @@
 #include "core/density.h"
 #include "core/lg.h"
 #include "core/soft.h"
+#include "lang/error.h"
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/render.h"
@@ -51,7 +56,8 @@
    functions this file calls, through a table of their own types. */
 #define MHD_FUNCS(X)                                                          \
   X(MHD_start_daemon) X(MHD_stop_daemon) X(MHD_get_daemon_info)               \
-  X(MHD_lookup_connection_value) X(MHD_create_response_from_buffer)           \
+  X(MHD_lookup_connection_value) X(MHD_lookup_connection_value_n)           \
+  X(MHD_create_response_from_buffer)           \
   X(MHD_add_response_header) X(MHD_queue_response) X(MHD_destroy_response)
 static struct {
 #define X(f) __typeof__(f) *f;
@@ -85,6 +91,7 @@ static int mhd_load(void) {
 #define MHD_stop_daemon (mhd.MHD_stop_daemon)
 #define MHD_get_daemon_info (mhd.MHD_get_daemon_info)
 #define MHD_lookup_connection_value (mhd.MHD_lookup_connection_value)
+#define MHD_lookup_connection_value_n (mhd.MHD_lookup_connection_value_n)
 #define MHD_create_response_from_buffer (mhd.MHD_create_response_from_buffer)
 #define MHD_add_response_header (mhd.MHD_add_response_header)
 #define MHD_queue_response (mhd.MHD_queue_response)
@@ -95,6 +102,8 @@ static int mhd_load(void) {
 static const int rung_step[RUNGS] = {8, 4, 2, 1};
 #define MAX_EVENTS 4000   /* trace events kept for one probe */
 #define PLOT_SAMPLES 200
+#define MAX_PARAMS 64     /* parameters shown as controls */
+#define PARAM_NAME 64     /* bytes of a parameter's name, with its 0 */
 
 static double now(void) {
   struct timespec ts;
@@ -205,6 +214,21 @@ typedef struct Frame {
   size_t len;
 } Frame;
 
+/* A declared parameter as the page shows it (a slider or a number box). */
+typedef struct VParam {
+  char name[PARAM_NAME];
+  char text[80];           /* the default's source text */
+  char doc[300];
+  int has_range, numeric;
+  double lo, hi, value;    /* value: the one the picture was made with */
+} VParam;
+
+/* A value asked for by the page, kept across saves of the file. */
+typedef struct Wish {
+  char name[PARAM_NAME];
+  double x;
+} Wish;
+
 typedef struct View {
   pthread_mutex_t mu;
   pthread_cond_t cv;       /* anything changed: a frame, a version, quit */
@@ -233,6 +257,15 @@ typedef struct View {
   pthread_mutex_t save_mu;
   int saves;
   atomic_long requests, refused;
+  VParam params[MAX_PARAMS]; /* of the last good evaluation */
+  int nparams;
+  Wish wish[MAX_PARAMS];   /* the page's values, applied by evaluate */
+  int nwish;
+  int wish_dirty;          /* the page asked since the last evaluate */
+  int wish_reset;          /* ... for the command line's values again */
+  int wake[2];             /* a pipe: wakes the interpreter's thread */
+  Interp *live;            /* the interpreter of the last good evaluation
+                              (the interpreter's thread only) */
 } View;
 
 static void snap_release(View *v, Snap *sn) {
@@ -447,7 +480,8 @@ static const char *kind_name(ScKind k) {
 
 /* Makes a snapshot of s (taken) and publishes it; the node positions are
    read here, on the interpreter's thread. */
-static int publish(View *v, Scene *s, const RenderSettings *rs) {
+static int publish(View *v, Scene *s, const RenderSettings *rs,
+                   const VParam *params, int nparams) {
   Snap *sn = calloc(1, sizeof *sn);
   if (!sn) {
     scene_free(s);
@@ -490,6 +524,9 @@ static int publish(View *v, Scene *s, const RenderSettings *rs) {
   sn->gen = old ? old->gen + 1 : 1;
   v->snap = sn;
   v->version++;
+  if (nparams > MAX_PARAMS) nparams = MAX_PARAMS;
+  if (nparams > 0) memcpy(v->params, params, (size_t)nparams * sizeof *params);
+  v->nparams = nparams;
   free(v->error);
   v->error = NULL;
   atomic_store(&v->cancel, 1);
@@ -541,21 +578,22 @@ static void deps_clear(View *v) {
   v->ndeps = 0;
 }
 
-static void evaluate(View *v, const ViewOptions *o) {
-  Interp *I = o->new_interp ? o->new_interp(o->ud) : bind_interp_new();
-  Capture cap = {0};
-  RenderOverrides ov;
-  memset(&ov, 0, sizeof ov);
-  ov.capture = capture;
-  ov.capture_ctx = &cap;
-  ov.keep = 1;
-  render_set_overrides(I, &ov);
+/* Runs the file (or, rerun, the scripts' expressions again) in I with
+   the renders captured and stderr into text; the scene is ov->kept. */
+static RunStatus run_captured(View *v, Interp *I, int rerun, Capture *cap,
+                              RenderOverrides *ov, char *text, size_t len) {
+  memset(cap, 0, sizeof *cap);
+  memset(ov, 0, sizeof *ov);
+  ov->capture = capture;
+  ov->capture_ctx = cap;
+  ov->keep = 1;
+  render_set_overrides(I, ov);
   fflush(stderr);
   int saved = dup(2);
   FILE *tmp = tmpfile();
   if (tmp && saved >= 0) dup2(fileno(tmp), 2);
-  RunStatus st = interp_run_file(I, v->file);
-  if (st == RUN_OK && ov.renders == 0) {
+  RunStatus st = rerun ? interp_rerun(I) : interp_run_file(I, v->file);
+  if (st == RUN_OK && ov->renders == 0) {
     if (interp_has_global(I, "scene"))
       st = render_lang_scene(I, "view.png");
     else {
@@ -567,33 +605,153 @@ static void evaluate(View *v, const ViewOptions *o) {
   fflush(stderr);
   if (tmp && saved >= 0) dup2(saved, 2);
   if (saved >= 0) close(saved);
-  char text[8192] = "";
+  size_t have = strlen(text);
   if (tmp) {
     rewind(tmp);
-    size_t n = fread(text, 1, sizeof text - 1, tmp);
-    text[n] = 0;
+    size_t n = fread(text + have, 1, len - 1 - have, tmp);
+    text[have + n] = 0;
     fclose(tmp);
   }
-  if (text[0] && !o->quiet) fputs(text, stderr);
   render_set_overrides(I, NULL);
-  deps_clear(v);
-  interp_files_read(I, add_dep, v);
+  return st;
+}
+
+/* The parameters I declares, for the page; their number. */
+static int param_table(Interp *I, VParam *out) {
+  InterpParam ip[MAX_PARAMS];
+  int n = interp_param_list(I, ip, MAX_PARAMS);
+  if (n > MAX_PARAMS) n = MAX_PARAMS;
+  for (int i = 0; i < n; i++) {
+    VParam *p = &out[i];
+    memset(p, 0, sizeof *p);
+    snprintf(p->name, sizeof p->name, "%s", ip[i].name);
+    snprintf(p->text, sizeof p->text, "%s", ip[i].text ? ip[i].text : "");
+    snprintf(p->doc, sizeof p->doc, "%s", ip[i].doc ? ip[i].doc : "");
+    p->has_range = ip[i].has_range;
+    p->lo = ip[i].lo;
+    p->hi = ip[i].hi;
+    p->numeric = ip[i].numeric;
+    p->value = ip[i].value;
+  }
+  return n < 0 ? 0 : n;
+}
+
+/* Applies the page's values to I (interp_set_param: what depends on them
+   is evaluated again, lazily). A value I no longer takes (the parameter
+   is gone from the file, or its range no longer holds it) is dropped,
+   with a line saying so. A value the parameter already has is left
+   alone (what depends on it keeps its values). Returns how many were
+   applied. */
+static int apply_wishes(View *v, Interp *I) {
+  Wish w[MAX_PARAMS];
+  pthread_mutex_lock(&v->mu);
+  int n = v->nwish;
+  memcpy(w, v->wish, (size_t)n * sizeof *w);
+  pthread_mutex_unlock(&v->mu);
+  InterpParam now[MAX_PARAMS];
+  int nnow = n > 0 ? interp_param_list(I, now, MAX_PARAMS) : 0;
+  if (nnow > MAX_PARAMS) nnow = MAX_PARAMS;
+  int applied = 0;
+  for (int i = 0; i < n; i++) {
+    char err[300];
+    int same = 0;
+    for (int j = 0; j < nnow; j++)
+      if (!strcmp(now[j].name, w[i].name))
+        same = now[j].numeric && now[j].value == w[i].x;
+    if (same) continue;
+    if (interp_set_param(I, w[i].name, w[i].x, err, sizeof err) == RUN_OK) {
+      applied++;
+      continue;
+    }
+    printf("qcs view: %s: the page's %s = %.17g no longer applies (%s)\n",
+           v->file, w[i].name, w[i].x, err);
+    pthread_mutex_lock(&v->mu);
+    for (int j = 0; j < v->nwish; j++)
+      if (!strcmp(v->wish[j].name, w[i].name)) {
+        v->wish[j] = v->wish[--v->nwish];
+        break;
+      }
+    pthread_mutex_unlock(&v->mu);
+  }
+  return applied;
+}
+
+/* Evaluates the file and publishes the scene it renders (or its
+   `scene`), or the error text. fresh: the file changed (or the page
+   asked for the command line's values): a new interpreter runs it, then
+   the page's values are applied. Otherwise (a slider moved) the live
+   interpreter re-binds the parameters and runs the scripts' expressions
+   again: only the definitions that depend on them are evaluated anew. */
+static void evaluate(View *v, const ViewOptions *o, int fresh) {
+  pthread_mutex_lock(&v->mu);
+  v->wish_dirty = 0;
+  if (v->wish_reset) {
+    v->wish_reset = 0;
+    v->nwish = 0;
+    fresh = 1;
+  }
+  int nwish = v->nwish;
+  pthread_mutex_unlock(&v->mu);
+  if (!v->live) fresh = 1;
+  Interp *I = fresh ? (o->new_interp ? o->new_interp(o->ud)
+                                     : bind_interp_new())
+                    : v->live;
+  Capture cap;
+  RenderOverrides ov;
+  char text[8192] = "";
+  RunStatus st;
+  if (fresh) {
+    st = run_captured(v, I, 0, &cap, &ov, text, sizeof text);
+    deps_clear(v);
+    interp_files_read(I, add_dep, v);
+    if (st == RUN_OK && nwish > 0 && apply_wishes(v, I) > 0) {
+      scene_free(ov.kept);
+      st = run_captured(v, I, 1, &cap, &ov, text, sizeof text);
+    }
+  } else {
+    apply_wishes(v, I);
+    st = run_captured(v, I, 1, &cap, &ov, text, sizeof text);
+  }
+  if (text[0] && !o->quiet) fputs(text, stderr);
   if (st == RUN_OK && ov.kept && cap.got) {
-    publish(v, ov.kept, &cap.rs);
+    static VParam params[MAX_PARAMS];
+    int np = param_table(I, params);
+    publish(v, ov.kept, &cap.rs, params, np);
+    if (I != v->live) {
+      if (v->live) interp_free(v->live);
+      v->live = I;
+    }
     printf("qcs view: %s: shown (version %u)\n", v->file, v->version);
   } else {
     scene_free(ov.kept);
     if (st == RUN_OK) snprintf(text, sizeof text, "%s: error: no scene", v->file);
     publish_error(v, text);
-    printf("qcs view: %s: error (the last good picture stays)\n", v->file);
+    /* A file in error has no live interpreter: a slider then runs the
+       file again, and shows its error again. */
+    if (fresh) {
+      if (v->live && v->live != I) interp_free(v->live);
+      interp_free(I);
+      v->live = NULL;
+    }
+    int had = v->snap != NULL; /* written by this thread only */
+    printf("qcs view: %s: error (%s)\n", v->file,
+           had ? "the last good picture stays" : "no picture yet");
   }
   fflush(stdout);
 }
 
 /* ---- requests ---- */
 
+/* The query argument name, or NULL: absent, or with a NUL byte inside
+   (%00: its C string would say less than the request did). */
 static const char *arg(struct MHD_Connection *c, const char *name) {
-  return MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, name);
+  const char *val = NULL;
+  size_t len = 0;
+  if (MHD_lookup_connection_value_n(c, MHD_GET_ARGUMENT_KIND, name,
+                                    strlen(name), &val, &len) != MHD_YES ||
+      !val || strlen(val) != len)
+    return NULL;
+  return val;
 }
 
 static int parse_vec(const char *s, double out[3]) {
@@ -733,7 +891,26 @@ static enum MHD_Result do_state(View *v, struct MHD_Connection *c) {
     buf_printf(&b, ",\"fov\":");
     buf_num(&b, sn->fov);
   }
-  buf_printf(&b, "}");
+  buf_printf(&b, ",\"params\":[");
+  for (int i = 0; i < v->nparams; i++) {
+    const VParam *p = &v->params[i];
+    buf_printf(&b, "%s{\"name\":", i ? "," : "");
+    buf_json_str(&b, p->name);
+    buf_printf(&b, ",\"default\":");
+    buf_json_str(&b, p->text);
+    buf_printf(&b, ",\"doc\":");
+    buf_json_str(&b, p->doc);
+    buf_printf(&b, ",\"numeric\":%d,\"value\":", p->numeric);
+    buf_num(&b, p->value);
+    if (p->has_range) {
+      buf_printf(&b, ",\"lo\":");
+      buf_num(&b, p->lo);
+      buf_printf(&b, ",\"hi\":");
+      buf_num(&b, p->hi);
+    }
+    buf_printf(&b, "}");
+  }
+  buf_printf(&b, "],\"set\":%d}", v->nwish);
   pthread_mutex_unlock(&v->mu);
   return send_json(c, &b);
 }
@@ -999,6 +1176,82 @@ static enum MHD_Result do_save(View *v, struct MHD_Connection *c) {
   return send_json(c, &b);
 }
 
+/* ---- a parameter's value from the page ---- */
+
+static void wake_main(View *v) {
+  char c = 1;
+  if (v->wake[1] >= 0) {
+    ssize_t w = write(v->wake[1], &c, 1); /* full: a wake-up is pending */
+    (void)w;
+  }
+}
+
+static enum MHD_Result do_param(View *v, struct MHD_Connection *c) {
+  const char *reset = arg(c, "reset"), *name = arg(c, "name"),
+             *val = arg(c, "value");
+  if (v->wake[1] < 0)
+    return send_text(c, 404, "this view has no parameters (qcs view FILE "
+                     "has: :view shows one scene)");
+  if (reset) {
+    if (strcmp(reset, "1") || name || val)
+      return send_text(c, 400, "reset=1 alone");
+    pthread_mutex_lock(&v->mu);
+    v->wish_reset = 1;
+    v->wish_dirty = 1;
+    pthread_mutex_unlock(&v->mu);
+    wake_main(v);
+    return send_buf(c, 200, "application/json", "{\"reset\":1}", 11, NULL,
+                    NULL);
+  }
+  if (!name || !val || strlen(name) >= PARAM_NAME || strlen(val) > 40)
+    return send_text(c, 400, "give name=NAME (a declared parameter) and "
+                     "value=NUMBER");
+  char *end;
+  double x = strtod(val, &end);
+  if (end == val || *end || !isfinite(x))
+    return send_text(c, 400, "value must be a finite number");
+  char err[400];
+  pthread_mutex_lock(&v->mu);
+  const VParam *p = NULL;
+  for (int i = 0; i < v->nparams && !p; i++)
+    if (!strcmp(v->params[i].name, name)) p = &v->params[i];
+  if (!p) {
+    pthread_mutex_unlock(&v->mu);
+    return send_text(c, 400, "no such parameter: the file declares none of "
+                     "that name");
+  }
+  if (!p->numeric) {
+    snprintf(err, sizeof err, "parameter %s does not take a number (its "
+             "default is %.80s)", p->name, p->text);
+    pthread_mutex_unlock(&v->mu);
+    return send_text(c, 400, err);
+  }
+  if (p->has_range && !(x >= p->lo && x <= p->hi)) {
+    snprintf(err, sizeof err, "%.17g is outside the range [%.17g, %.17g] of "
+             "parameter %s", x, p->lo, p->hi, p->name);
+    pthread_mutex_unlock(&v->mu);
+    return send_text(c, 400, err);
+  }
+  int i = 0;
+  while (i < v->nwish && strcmp(v->wish[i].name, name)) i++;
+  if (i == v->nwish) {
+    if (v->nwish == MAX_PARAMS) { /* cannot be: names are the table's */
+      pthread_mutex_unlock(&v->mu);
+      return send_text(c, 500, "too many parameters");
+    }
+    snprintf(v->wish[i].name, sizeof v->wish[i].name, "%s", name);
+    v->nwish++;
+  }
+  v->wish[i].x = x;
+  v->wish_dirty = 1;
+  unsigned ver = v->version;
+  pthread_mutex_unlock(&v->mu);
+  wake_main(v);
+  Buf b = {0};
+  buf_printf(&b, "{\"asked\":%u}", ver);
+  return send_json(c, &b);
+}
+
 /* ---- the gate: every request passes here ---- */
 
 static int token_ok(const View *v, const char *t) {
@@ -1059,7 +1312,11 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *c,
     if (!post) return send_text(c, 405, "/save wants POST");
     return do_save(v, c);
   }
-  if (!get) return send_text(c, 405, "only GET (and POST /save)");
+  if (!strcmp(url, "/param")) {
+    if (!post) return send_text(c, 405, "/param wants POST");
+    return do_param(v, c);
+  }
+  if (!get) return send_text(c, 405, "only GET (and POST /save, /param)");
   if (!strcmp(url, "/"))
     return send_buf(c, 200, "text/html; charset=utf-8", qcs_view_page,
                     sizeof qcs_view_page - 1, NULL, NULL);
@@ -1161,7 +1418,8 @@ static struct MHD_Daemon *start(View *v, const ViewOptions *o) {
     close(fd);
     return NULL;
   }
-  if (strcmp(addr, "127.0.0.1"))
+  /* 127.0.0.0/8 is this machine's loopback: no one else reaches it. */
+  if ((ntohl(sa.sin_addr.s_addr) >> 24) != 127)
     fprintf(stderr, "qcs: warning: view: listening on %s, not only on this "
             "machine: anyone who can reach it and has the URL can look at "
             "the scene and save pictures into its folder\n", addr);
@@ -1178,6 +1436,7 @@ static void view_init(View *v, const ViewOptions *o) {
   pthread_cond_init(&v->cv, NULL);
   pthread_cond_init(&v->work, NULL);
   v->threads = o->threads;
+  v->wake[0] = v->wake[1] = -1;
 }
 
 static void view_finish(View *v, struct MHD_Daemon *d, pthread_t *rt) {
@@ -1191,6 +1450,10 @@ static void view_finish(View *v, struct MHD_Daemon *d, pthread_t *rt) {
   if (rt) pthread_join(*rt, NULL);
   frames_clear(v);
   deps_clear(v);
+  if (v->live) interp_free(v->live);
+  v->live = NULL;
+  if (v->wake[0] >= 0) close(v->wake[0]);
+  if (v->wake[1] >= 0) close(v->wake[1]);
   if (v->snap) snap_free(v->snap);
   free(v->error);
   pthread_mutex_destroy(&v->mu);
@@ -1245,12 +1508,30 @@ int view_file(const char *file, const ViewOptions *o) {
   snprintf(v.stem, sizeof v.stem, "%s", base);
   char *dot = strrchr(v.stem, '.');
   if (dot && dot != v.stem) *dot = 0;
+  struct stat fst;
+  int bad = stat(file, &fst) != 0 ? errno : S_ISREG(fst.st_mode) ? 0 : -1;
+  if (bad) {
+    fprintf(stderr, "qcs: error: view: %s: %s\n", file,
+            bad == ENOENT ? "no such file (qcs view follows an existing "
+                            "scene file)"
+            : bad < 0     ? "not a regular file"
+                          : strerror(bad));
+    return 1;
+  }
   int ino = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
   int main_wd = ino < 0 ? -1 : inotify_add_watch(ino, v.dir, WATCH_MASK);
   if (ino < 0 || main_wd < 0) {
     fprintf(stderr, "qcs: error: view: cannot watch %s: %s\n", v.dir,
             strerror(errno));
     if (ino >= 0) close(ino);
+    return 1;
+  }
+  if (pipe(v.wake) || fcntl(v.wake[0], F_SETFL, O_NONBLOCK) ||
+      fcntl(v.wake[1], F_SETFL, O_NONBLOCK) ||
+      fcntl(v.wake[0], F_SETFD, FD_CLOEXEC) ||
+      fcntl(v.wake[1], F_SETFD, FD_CLOEXEC)) {
+    fprintf(stderr, "qcs: error: view: %s\n", strerror(errno));
+    close(ino);
     return 1;
   }
   struct sigaction sa;
@@ -1273,13 +1554,22 @@ int view_file(const char *file, const ViewOptions *o) {
     return 1;
   }
   static Watched watched[MAX_WATCHED];
-  evaluate(&v, o);
+  evaluate(&v, o, 1);
   int nwatched = watch_deps(&v, ino, watched);
   double pending = 0; /* when a change was seen, 0: none */
   int gone = 0;
   while (!stop_flag) {
-    struct pollfd pfd = {ino, POLLIN, 0};
-    poll(&pfd, 1, pending > 0 ? 10 : 200);
+    struct pollfd pfd[2] = {{ino, POLLIN, 0}, {v.wake[0], POLLIN, 0}};
+    poll(pfd, 2, pending > 0 ? 10 : 200);
+    char drain[64];
+    while (read(v.wake[0], drain, sizeof drain) > 0) {
+    }
+    pthread_mutex_lock(&v.mu);
+    int asked = v.wish_dirty;
+    pthread_mutex_unlock(&v.mu);
+    /* The page's values: applied at once, unless a save is pending (its
+       evaluation applies them too). */
+    if (asked && pending == 0) evaluate(&v, o, 0);
     char buf[8192] __attribute__((aligned(__alignof__(struct inotify_event))));
     ssize_t n;
     while ((n = read(ino, buf, sizeof buf)) > 0) {
@@ -1308,7 +1598,7 @@ int view_file(const char *file, const ViewOptions *o) {
                  "renamed); waiting for it to come back", v.file);
         publish_error(&v, msg);
       } else {
-        evaluate(&v, o);
+        evaluate(&v, o, 1);
         nwatched = watch_deps(&v, ino, watched);
       }
     }
@@ -1342,7 +1632,7 @@ int view_scene(Interp *src_I, Scene *s, const RenderSettings *rs,
     view_finish(&v, NULL, &rt);
     return -1;
   }
-  publish(&v, s, rs);
+  publish(&v, s, rs, NULL, 0);
   printf("press Enter (or Ctrl-C) to stop serving\n");
   fflush(stdout);
   struct sigaction sa, old_int;
@@ -1365,16 +1655,27 @@ int view_scene(Interp *src_I, Scene *s, const RenderSettings *rs,
 
 /* ---- :view EXPR ---- */
 
+/* The expression is evaluated as typed (an error points into it, named
+   ":view"), then rendered (captured) as `render` would. */
 static Value *view_item(Interp *I, void *ud) {
-  char text[4200];
-  snprintf(text, sizeof text, "render \"view.png\" (%s)", (const char *)ud);
-  interp_eval_expr(I, "<view>", text);
+  Value *obj = interp_eval_expr(I, ":view", (const char *)ud);
+  Pos none = {0};
+  if (!compile_is_object(I, obj))
+    qcs_error(none, ":view shows a scene object (Union, Rounded, Halfspace, "
+              "SoftObject or a density tree); %.200s is "
+              "not one", (const char *)ud);
+  render_value(I, NULL, "view.png", obj, none);
   return NULL;
 }
 
 int view_expr(Interp *I, const char *expr, const ViewOptions *o) {
   if (strlen(expr) > 4000) {
     fprintf(stderr, "error: :view: the expression is too long\n");
+    return -1;
+  }
+  if (!strcmp(expr, "scene") && !interp_has_global(I, "scene")) {
+    fprintf(stderr, "error: :view: no `scene` is defined: define one, or "
+            "give the object to show (:view EXPR)\n");
     return -1;
   }
   RenderOverrides *old = render_get_overrides(I), ov;

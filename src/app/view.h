@@ -15,6 +15,15 @@
  * touch a Value. A new camera cancels the frame being rendered at once
  * (render_scene's cancel flag, read per tile).
  *
+ * Parameters. The interpreter of the last good evaluation stays alive (on
+ * the caller's thread). A slider's value, checked by the server thread
+ * against the published table of declared parameters (name, finite,
+ * within range), is stored and the caller's thread woken through a pipe;
+ * it re-binds the parameter (interp_set_param: only what depends on it is
+ * evaluated again), re-runs the scripts' expressions and publishes. A save
+ * of the file evaluates it in a new interpreter and applies the values
+ * again.
+ *
  * Security. 127.0.0.1 only unless --listen says otherwise; a random token
  * in the URL is required on every request; a Host or Origin header that
  * names another host is refused (DNS rebinding). Nothing is written but

@@ -10,6 +10,7 @@
 #include <errno.h>
 #include <gc.h>
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -965,14 +966,13 @@ RunStatus interp_params(Interp *I, const char *path, FILE *out) {
 
 /* ---- animation ---- */
 
-void interp_set_frame(Interp *I, double frame, double clock) {
-  Sym *sf = sym_intern(I, "frame", 5), *sc = sym_intern(I, "clock", 5);
-  if (!sf->user) sf->global = val_num(frame);
-  if (!sc->user) sc->global = val_num(clock);
-  /* What depends on frame or clock, through any chain of globals: marked
-     by passes until nothing changes (cycles among globals are fine). */
+/* Re-evaluates the user's top-level definitions that depend on any of the
+   symbols seeds (through any chain of globals; the seeds themselves are
+   left as they are): marked by passes until nothing changes (cycles
+   among globals are fine). */
+static void rebind_dependents(Interp *I, Sym **seeds, int nseeds) {
   int epoch = ++I->anim_epoch, changed = 1;
-  sf->anim_mark = sc->anim_mark = epoch * 2 + 1;
+  for (int i = 0; i < nseeds; i++) seeds[i]->anim_mark = epoch * 2 + 1;
   while (changed) {
     changed = 0;
     for (size_t h = 0; h < I->symcap; h++)
@@ -987,11 +987,102 @@ void interp_set_frame(Interp *I, double frame, double clock) {
       }
   }
   for (size_t h = 0; h < I->symcap; h++)
-    for (Sym *s = I->symtab[h]; s; s = s->next)
+    for (Sym *s = I->symtab[h]; s; s = s->next) {
+      int seed = 0;
+      for (int i = 0; i < nseeds; i++) seed |= s == seeds[i];
       if (s->anim_mark == epoch * 2 + 1 && s->def && s->def->arity == 0 &&
-          !s->overridden && s != sf && s != sc)
+          !s->overridden && !seed)
         s->global = eval_global_value(I, s->def);
+    }
 }
+
+void interp_set_frame(Interp *I, double frame, double clock) {
+  Sym *sf = sym_intern(I, "frame", 5), *sc = sym_intern(I, "clock", 5);
+  if (!sf->user) sf->global = val_num(frame);
+  if (!sc->user) sc->global = val_num(clock);
+  Sym *seeds[2] = {sf, sc};
+  rebind_dependents(I, seeds, 2);
+}
+
+int interp_param_list(Interp *I, InterpParam *out, int max) {
+  int nforcing = I->nforcing;
+  volatile int n = 0;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    for (int i = 0; i < I->nparams; i++) {
+      Sym *s = I->params[i];
+      if (!s->param) continue;
+      if (n < max) {
+        InterpParam *p = &out[n];
+        memset(p, 0, sizeof *p);
+        p->name = s->name;
+        p->text = s->param->text;
+        p->doc = s->param->doc;
+        if (s->param->lo) {
+          p->has_range = 1;
+          param_range(I, s->param, &p->lo, &p->hi);
+        }
+        Value *v = force(I, s->global);
+        p->numeric = v->kind == V_NUM;
+        p->value = p->numeric ? v->u.num : NAN;
+      }
+      n++;
+    }
+    err_pop(&f);
+    return n;
+  }
+  err_pop(&f);
+  report_error(I);
+  unwind(I, nforcing);
+  return -1;
+}
+
+RunStatus interp_set_param(Interp *I, const char *name, double x, char *err,
+                           size_t errlen) {
+  Sym *s = NULL;
+  for (int i = 0; i < I->nparams && !s; i++)
+    if (I->params[i]->param && !strcmp(I->params[i]->name, name))
+      s = I->params[i];
+  if (!s) {
+    snprintf(err, errlen, "no parameter %s is declared", name);
+    return RUN_ERROR;
+  }
+  if (!isfinite(x)) {
+    snprintf(err, errlen, "parameter %s takes a finite number", name);
+    return RUN_ERROR;
+  }
+  InterpParam p;
+  int nforcing = I->nforcing;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    p.has_range = s->param->lo != NULL;
+    if (p.has_range) param_range(I, s->param, &p.lo, &p.hi);
+    Value *v = force(I, s->global);
+    p.numeric = v->kind == V_NUM;
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    report_error(I);
+    unwind(I, nforcing);
+    snprintf(err, errlen, "parameter %s: its range or value is in error",
+             name);
+    return RUN_ERROR;
+  }
+  if (!p.numeric) {
+    snprintf(err, errlen, "parameter %s does not take a number", name);
+    return RUN_ERROR;
+  }
+  if (p.has_range && !(x >= p.lo && x <= p.hi)) {
+    snprintf(err, errlen, "%.17g is outside the range [%.17g, %.17g] of "
+             "parameter %s", x, p.lo, p.hi, name);
+    return RUN_ERROR;
+  }
+  s->global = val_num(x);
+  rebind_dependents(I, &s, 1);
+  return RUN_OK;
+}
+
+void interp_free(Interp *I) { GC_FREE(I); }
 
 RunStatus interp_rerun(Interp *I) {
   int nforcing = I->nforcing;

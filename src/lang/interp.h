@@ -104,6 +104,30 @@ void interp_set_frame(Interp *I, double frame, double clock);
    frame of an animation); they were recorded as the scripts ran. */
 RunStatus interp_rerun(Interp *I);
 
+/* A declared parameter, as a front end shows it (qcs view's sliders):
+   strings belong to the interpreter's heap and live as long as it. */
+typedef struct InterpParam {
+  const char *name, *text, *doc; /* text: the default's source; doc or NULL */
+  int has_range;
+  double lo, hi;                 /* the range, when has_range */
+  int numeric;                   /* the current value is a number ... */
+  double value;                  /* ... this one */
+} InterpParam;
+/* The parameters the scripts run so far declared, in order: up to max
+   into out; returns their number (-1: an error evaluating a range or a
+   value, reported). */
+int interp_param_list(Interp *I, InterpParam *out, int max);
+/* Re-binds the declared parameter name to the number x and re-evaluates
+   the top-level definitions that depend on it, as interp_set_frame does
+   for frame (the others keep their values); interp_rerun then runs the
+   scripts' expressions again. x must be finite, within the parameter's
+   range, and the parameter's value a number. RUN_ERROR with the reason in
+   err (nothing changed) otherwise. */
+RunStatus interp_set_param(Interp *I, const char *name, double x, char *err,
+                           size_t errlen);
+/* Frees an interpreter (its values are collected once unreachable). */
+void interp_free(Interp *I);
+
 /* Show values instead of printing them: show(I, v, pos, ud) is called for
    each value of a MODE_REPL entry and returns 1 if it showed it (the REPL's
    pictures of scene objects); NULL: print everything. */

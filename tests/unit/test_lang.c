@@ -1,6 +1,7 @@
 /* test_lang.c: unit tests of the lexer, the parser, the evaluator and the
  * printer, through their C interfaces. */
 #include <gc.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -291,6 +292,78 @@ static void test_files_read(void) {
   rmdir(dir);
 }
 
+/* The number a global holds (forced), or NAN. */
+static double global_num(Interp *J, const char *name) {
+  Sym *s = sym_intern(J, name, (int)strlen(name));
+  double x = NAN;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    Value *v = s->global ? force(J, s->global) : NULL;
+    if (v && v->kind == V_NUM) x = v->u.num;
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+  }
+  return x;
+}
+
+/* interp_param_list and interp_set_param (qcs view's sliders): the table,
+   the checks, and only the dependents evaluated again */
+static void test_set_param(void) {
+  char path[] = "/tmp/qcs-test-param-XXXXXX";
+  int fd = mkstemp(path);
+  if (fd < 0) {
+    CHECK("set param: a temporary file", 0);
+    return;
+  }
+  const char *text = "param a = 2 in [0, 10] \"the a\"\nparam s = \"text\"\n"
+                     "param u = 5\nb = a * 10;\nc = 7 + 1;\nd = b + u;\n";
+  ssize_t w = write(fd, text, strlen(text));
+  close(fd);
+  Interp *J = bind_interp_new();
+  char probe;
+  interp_set_stack(J, &probe, 4u << 20);
+  RunStatus st = w > 0 ? interp_run_file(J, path) : RUN_ERROR;
+  remove(path);
+  InterpParam p[8];
+  int n = interp_param_list(J, p, 8);
+  CHECK("set param: the table", st == RUN_OK && n == 3 &&
+        !strcmp(p[0].name, "a") && p[0].has_range && p[0].lo == 0 &&
+        p[0].hi == 10 && p[0].numeric && p[0].value == 2 &&
+        !strcmp(p[0].doc, "the a") && !strcmp(p[0].text, "2") &&
+        !strcmp(p[1].name, "s") && !p[1].numeric && !p[1].has_range &&
+        !strcmp(p[2].name, "u") && p[2].numeric && !p[2].has_range);
+  if (st != RUN_OK || n != 3) return;
+  CHECK("set param: before", global_num(J, "d") == 25 &&
+        global_num(J, "c") == 8);
+  Value *c0 = sym_intern(J, "c", 1)->global, *b0 = sym_intern(J, "b", 1)->global;
+  char err[300];
+  st = interp_set_param(J, "a", 3.5, err, sizeof err);
+  CHECK("set param: a = 3.5 re-binds what depends on a",
+        st == RUN_OK && global_num(J, "d") == 40 && global_num(J, "b") == 35 &&
+        sym_intern(J, "b", 1)->global != b0);
+  CHECK("set param: what does not depend on a keeps its value",
+        sym_intern(J, "c", 1)->global == c0 && global_num(J, "c") == 8);
+  CHECK("set param: a number without a range",
+        interp_set_param(J, "u", -1e9, err, sizeof err) == RUN_OK &&
+        global_num(J, "d") == 35 - 1e9);
+  CHECK("set param: out of range refused, nothing changed",
+        interp_set_param(J, "a", 10.5, err, sizeof err) == RUN_ERROR &&
+        strstr(err, "outside the range [0, 10]") && global_num(J, "b") == 35);
+  CHECK("set param: NaN and infinity refused",
+        interp_set_param(J, "a", NAN, err, sizeof err) == RUN_ERROR &&
+        interp_set_param(J, "u", INFINITY, err, sizeof err) == RUN_ERROR &&
+        global_num(J, "d") == 35 - 1e9);
+  CHECK("set param: not a parameter",
+        interp_set_param(J, "c", 1, err, sizeof err) == RUN_ERROR &&
+        strstr(err, "no parameter c") &&
+        interp_set_param(J, "nosuch", 1, err, sizeof err) == RUN_ERROR);
+  CHECK("set param: a parameter whose value is not a number",
+        interp_set_param(J, "s", 1, err, sizeof err) == RUN_ERROR &&
+        strstr(err, "does not take a number"));
+  interp_free(J);
+}
+
 int main(void) {
   check_prefix = "lang";
   I = bind_interp_new();
@@ -301,5 +374,6 @@ int main(void) {
   test_eval();
   test_print();
   test_files_read();
+  test_set_param();
   CHECK_DONE();
 }

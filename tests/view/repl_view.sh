@@ -6,7 +6,7 @@
 #   usage: repl_view.sh QCS WORKDIR
 QCS=$1; tmp=$2
 case $QCS in /*) ;; *) QCS=$PWD/$QCS ;; esac
-CHECKS="view-repl-url view-repl-fetch view-repl-token view-repl-enter view-repl-defs"
+CHECKS="view-repl-url view-repl-fetch view-repl-token view-repl-enter view-repl-defs view-repl-errors"
 if ! command -v tmux >/dev/null 2>&1; then
   for c in $CHECKS; do echo "skip $c: tmux is not installed"; done; exit 0
 fi
@@ -46,7 +46,7 @@ enter '^qcs> ' 'sc = Union UnitCube (Halfspace ((0, 1, 0), 0))' >/dev/null
 if enter 'qcs view: http://' ':view sc' 400; then ok view-repl-url
 else
   fail view-repl-url "$(why ':view sc printed no URL')"
-  for c in view-repl-fetch view-repl-token view-repl-enter view-repl-defs; do echo "skip $c: no URL"; done
+  for c in view-repl-fetch view-repl-token view-repl-enter view-repl-defs view-repl-errors; do echo "skip $c: no URL"; done
   exit 0
 fi
 url=$(pane | grep -oE 'http://[0-9.]+:[0-9]+/\?t=[0-9a-f]+' | tail -n 1)
@@ -65,3 +65,8 @@ else fail view-repl-enter "$(why 'Enter did not give the prompt back, or the ser
 if enter '^42$' 'keep + 1' && enter '^qcs> ' ':view nosuchname' && enter '^43$' 'keep + 2'; then
   ok view-repl-defs
 else fail view-repl-defs "$(why 'the definitions did not survive :view')"; fi
+# errors name what was typed: no internal "<view>" source
+if enter '^qcs> ' ':view' && pane | grep -q 'no `scene` is defined' &&
+   pane | grep -q "^:view:1:1: error: unknown name 'nosuchname'" && ! pane | grep -q '<view>'; then
+  ok view-repl-errors
+else fail view-repl-errors "$(why ':view without a scene, or with an unknown name, was not said plainly')"; fi

@@ -15,6 +15,18 @@ SHOT = sys.argv[sys.argv.index("--screenshot") + 1] if "--screenshot" in sys.arg
 results = []
 
 
+def sanitizer_build():
+    """A sanitizer build (QCS_TSAN=1, or the binary carries ASan's or TSan's
+    runtime) renders many times slower: it gets longer waits."""
+    if os.environ.get("QCS_TSAN"): return True
+    try: data = open(QCS, "rb").read()
+    except OSError: return False
+    return b"__asan_init" in data or b"__tsan_init" in data
+
+
+SLOW = sanitizer_build()
+
+
 def report(name, ok, why=""):
     line = ("ok %s" % name) if ok else ("FAIL %s: %s" % (name, why))
     print(line, flush=True)
@@ -109,6 +121,7 @@ class WS:
 
 
 def wait_for(pred, secs):
+    if SLOW: secs *= 3
     t0 = time.time()
     while time.time() - t0 < secs:
         v = pred()
@@ -118,10 +131,21 @@ def wait_for(pred, secs):
 
 
 # ---- the server ----
-def start_view(scene):
-    out = open(os.path.join(WORK, "view.out"), "w")
+# The viewer runs with LeakSanitizer on (an ASan build checks for leaks at
+# exit; other builds ignore the variable), whatever the rest of the test
+# set says: check_stop reads its report.
+def viewer_env():
+    env = dict(os.environ)
+    opts = [o for o in env.get("ASAN_OPTIONS", "").split(":") if o and not o.startswith("detect_leaks=")]
+    env["ASAN_OPTIONS"] = ":".join(opts + ["detect_leaks=1"])
+    return env
+
+
+def start_view(scene, tag="view"):
+    out = open(os.path.join(WORK, tag + ".out"), "w")
     p = subprocess.Popen([QCS, "view", "--threads", "2", scene], stdout=subprocess.PIPE,
-                         stderr=open(os.path.join(WORK, "view.err"), "w"), text=True)
+                         stderr=open(os.path.join(WORK, tag + ".err"), "w"), text=True, env=viewer_env())
+    p.tag = tag
     url = None
     t0 = time.time()
     while time.time() - t0 < 10:
@@ -169,7 +193,7 @@ def browser_tests(host, port, token, scene, defs):
     br = subprocess.Popen([chrome, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
                            "--no-first-run", "--disable-background-networking", "--disable-component-update",
                            "--disable-sync", "--force-color-profile=srgb", "--user-data-dir=" + prof,
-                           "--remote-debugging-port=0", "--window-size=1200,600", url],
+                           "--remote-debugging-port=0", "--window-size=" + ("1480,700" if SHOT else "1200,600"), url],
                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         portfile = os.path.join(prof, "DevToolsActivePort")
@@ -270,10 +294,10 @@ def browser_tests(host, port, token, scene, defs):
         report("view-copy-camera", copied == cam and (w1, h1) == (w2, h2) and diff == 0 and a2 != b,
                "copied %r (shown %r), %d pixels differ from qcs -o" % (copied, cam, diff))
         # reset key: back to the scene's own camera, identical to qcs -o again
+        n0 = qv()["frames"]
         ws.call("Input.dispatchKeyEvent", type="keyDown", key="r", text="r")
         ws.call("Input.dispatchKeyEvent", type="keyUp", key="r")
-        time.sleep(0.05)
-        wait_for(lambda: (qv() or {}).get("lastStep") == 1, 5)
+        wait_for(lambda: (qv() or {}).get("frames", 0) > n0 and qv()["lastStep"] == 1, 30 if SLOW else 10)
         time.sleep(0.2)
         w1, h1, a = png_pixels(canvas_png())
         report("view-reset-identical", a == b, "after r the picture differs from qcs -o")
@@ -334,31 +358,34 @@ def browser_tests(host, port, token, scene, defs):
                    (seen[ch] == b if ch == "colour" else seen[ch] != b),
                    "settled %r, status %r" % (ok, st))
         report("view-channels-distinct", len(set(seen.values())) == 4, "%d distinct pictures" % len(set(seen.values())))
-        # follow the file: an editor's save (write a temporary, rename over)
-        v0 = qv()["version"]
         src = open(scene).read()
         def save(text):
-            # an edit that changed nothing would test nothing
-            if text == src and os.path.exists(scene):
-                raise RuntimeError("the test's edit of %s matched nothing" % scene)
             tmp = scene + ".swp"
             open(tmp, "w").write(text)
             os.rename(tmp, scene)
+        params_tests(ws, qv, canvas_png, host, port, token, scene, src, save, b)
+        # follow the file: an editor's save (write a temporary, rename over)
+        v0 = qv()["version"]
         png_before_save = canvas_png()
         t0 = time.time()
-        save(src.replace("param r = 0.07 in", "param r = 0.2 in"))
-        # A test asserts the picture, not the speed: the latency budget (a
-        # first frame within 50 ms, the full one within 0.2 s) is measured
-        # by make bench (bench/view_bench.py); here the new full picture
-        # must come (10 s allows a sanitizer build) and differ from the old.
-        ok = wait_for(lambda: (qv() or {}).get("version", 0) > v0 and qv()["lastStep"] == 1, 10)
+        save(src.replace(R_LINE, R_LINE.replace("0.07 in", "0.2 in")))
+        # The issue's promise: the new picture on the page within 1 s of the
+        # save (its first, coarse frame; a sanitizer build, many times
+        # slower, gets 10 s), then the full one. The latency budget proper
+        # (a first frame within 50 ms, the full one within 0.2 s, on a
+        # quiet machine) is measured by make bench (bench/view_bench.py).
+        limit = 10 if SLOW else 1.0
+        seen = wait_for(lambda: (qv() or {}).get("version", 0) > v0, limit)
         dt = time.time() - t0
+        ok = wait_for(lambda: (qv() or {}).get("version", 0) > v0 and qv()["lastStep"] == 1, 10)
+        dt_full = time.time() - t0
         after_good = canvas_png()
-        report("view-follow", bool(ok) and after_good != png_before_save,
-               "no new full picture %.2f s after the save, or the same one" % dt)
-        print("# view: new full picture %.3f s after the save" % dt)
+        report("view-follow", bool(seen) and dt <= limit and bool(ok) and after_good != png_before_save,
+               "the new picture %.2f s after the save (at most %g s), the full one %.2f s, %s"
+               % (dt, limit, dt_full, "the same as before" if after_good == png_before_save else "changed"))
+        print("# view: new picture %.3f s after the save, the full one %.3f s" % (dt, dt_full))
         # an error: the message and the last good picture
-        save(src.replace("param r = 0.07 in", "param r = 0.07 + in"))
+        save(src.replace(R_LINE, R_LINE.replace("0.07 in", "0.07 + in")))
         err = wait_for(lambda: (qv() or {}).get("error"), 5)
         shown = ws.js("getComputedStyle(document.getElementById('err')).display")
         report("view-error", bool(err) and re.search(r"figure12\.qcs:\d+:\d+: error:", err) is not None
@@ -377,6 +404,99 @@ def browser_tests(host, port, token, scene, defs):
         shutil.rmtree(prof, ignore_errors=True)
 
 
+# ---- the parameters' controls ----
+# figure12's radius and the floor's height, declared as parameters in the
+# test's copy (on the lines they replace, so the line numbers stay).
+R_EXAMPLE = 'param r = 0.07 in [0, 0.25] "the rounding radius of the rounded objects";'
+R_LINE = 'param r = 0.07 in [0.01, 0.3] "the smoothing radius"; param lift = 0 "the height of the floor"'
+FLOOR_LINE = "floor = Halfspace ((0, 1, 0), lift);"
+
+
+def params_tests(ws, qv, canvas_png, host, port, token, scene, src, save, ref_default):
+    hdr = {"Host": "%s:%d" % (host, port)}
+    def server_state():
+        try: return json.loads(http_get(host, port, "/state?t=" + token, hdr)[2])
+        except Exception: return {}
+    def settled(v0):
+        """The page shows the full picture of the server's latest version (> v0)."""
+        def ok():
+            st, q = server_state(), qv() or {}
+            return (st.get("version", -1) > v0 and q.get("version") == st["version"] and
+                    q.get("lastStep") == 1 and st) or None
+        return wait_for(ok, 15)
+    def diff_with(args):
+        ref = os.path.join(WORK, "param-ref.png")
+        if os.path.exists(ref): os.unlink(ref)
+        subprocess.run([QCS, "-o", ref] + args + [scene], capture_output=True, timeout=60)
+        try:
+            w1, h1, a = png_pixels(canvas_png())
+            w2, h2, b = png_pixels(open(ref, "rb").read())
+        except Exception as e:
+            return repr(e)
+        if (w1, h1) != (w2, h2): return "%dx%d vs %dx%d" % (w1, h1, w2, h2)
+        return sum(1 for i in range(0, len(a), 3) if a[i:i + 3] != b[i:i + 3])
+    ps = (qv() or {}).get("params") or []
+    ctl = json.loads(ws.js("JSON.stringify(['param-r', 'param-r-num', 'param-lift'].map(id => { "
+                           "const e = document.getElementById(id); return e ? [e.type, e.min, e.max, e.title] : null; }))"))
+    report("view-param-controls", [p["name"] for p in ps] == ["r", "lift"] and ctl[0] is not None
+           and ctl[0][:3] == ["range", "0.01", "0.3"] and "the smoothing radius" in ctl[0][3]
+           and ctl[1] is not None and ctl[1][0] == "number" and ctl[2] is not None and ctl[2][0] == "number"
+           and ctl[2][1] == "" and "the height of the floor" in ctl[2][3],
+           "params %r, controls %r" % ([p["name"] for p in ps], ctl))
+    # drag the slider's thumb with the mouse, from the default to 3/4
+    sb = json.loads(ws.js("JSON.stringify(document.getElementById('param-r').getBoundingClientRect())"))
+    v0 = server_state().get("version", 0)
+    x_from = sb["x"] + sb["width"] * (0.07 - 0.01) / 0.29
+    y = sb["y"] + sb["height"] / 2
+    ws.call("Input.dispatchMouseEvent", type="mousePressed", x=x_from, y=y, button="left", clickCount=1)
+    for i in range(1, 11):
+        ws.call("Input.dispatchMouseEvent", type="mouseMoved", x=x_from + (sb["x"] + 0.75 * sb["width"] - x_from) * i / 10,
+                y=y, button="left")
+        time.sleep(0.03)
+    ws.call("Input.dispatchMouseEvent", type="mouseReleased", x=sb["x"] + 0.75 * sb["width"], y=y, button="left", clickCount=1)
+    time.sleep(0.3)
+    st = settled(v0)
+    rv = [p["value"] for p in (st or {}).get("params", []) if p["name"] == "r"]
+    shown = ws.js("document.getElementById('param-r').value")
+    d = diff_with(["--set", "r=%r" % rv[0]]) if rv else "no value"
+    report("view-param-slider", bool(st) and not st.get("error") and rv and 0.15 < rv[0] < 0.3
+           and float(shown) == rv[0] and d == 0,
+           "state %r, slider shows %r, against qcs -o --set r=%r: %r pixels differ" % (st, shown, rv, d))
+    # the number box of a parameter without a range: typed in, committed
+    v0 = server_state().get("version", 0)
+    ws.js("(e => { e.focus(); e.select(); })(document.getElementById('param-lift'))")
+    ws.call("Input.insertText", text="-0.25")
+    ws.js("document.getElementById('param-lift').blur()")
+    st = settled(v0)
+    d = diff_with(["--set", "r=%r" % rv[0], "--set", "lift=-0.25"]) if rv else "no value"
+    report("view-param-number", bool(st) and d == 0, "state %r, %r pixels differ from qcs -o --set" % (st, d))
+    # the values survive a save of the file (an edit elsewhere)
+    v0 = server_state().get("version", 0)
+    save(src + "\n// an edit\n")
+    st = settled(v0)
+    d = diff_with(["--set", "r=%r" % rv[0], "--set", "lift=-0.25"]) if rv else "no value"
+    shown = ws.js("document.getElementById('param-r').value")
+    report("view-param-save", bool(st) and not st.get("error") and d == 0 and rv and float(shown) == rv[0],
+           "state %r, slider %r, %r pixels differ" % (st, shown, d))
+    # a value the server refuses is said, and changes nothing
+    v0 = server_state().get("version", 0)
+    ws.js("(e => { e.value = '7'; e.dispatchEvent(new Event('change')); })(document.getElementById('param-r-num'))")
+    said = wait_for(lambda: "outside the range" in (ws.js("document.getElementById('status').textContent") or ""), 5)
+    report("view-param-refused", bool(said) and server_state().get("version") == v0,
+           "status %r" % ws.js("document.getElementById('status').textContent"))
+    # reset: the file's own values, the picture of qcs -o again
+    v0 = server_state().get("version", 0)
+    ws.js("document.getElementById('paramreset').click()")
+    st = settled(v0)
+    time.sleep(0.1)
+    a = png_pixels(canvas_png())[2]
+    vals = [(p["name"], p["value"]) for p in (st or {}).get("params", [])]
+    report("view-param-reset", bool(st) and a == ref_default and vals == [("r", 0.07), ("lift", 0)]
+           and float(ws.js("document.getElementById('param-r').value")) == 0.07,
+           "values %r, equal to qcs -o: %s" % (vals, a == ref_default))
+    save(src)
+
+
 # ---- imports are followed ----
 def imports_test():
     d = os.path.join(WORK, "imp")
@@ -389,7 +509,7 @@ def imports_test():
     main = os.path.join(d, "main.qcs")
     save(main, 'import "parts/part.qcs"\nscene = Union part (Halfspace ((0, 1, 0), 0));\n'
          'renderWith [Size 120 80, Camera (2, 3, 5) (0.5, 0.5, 0.5) 35, Light (-3, 8, 6)] "main.png" scene\n')
-    p, url = start_view(main)
+    p, url = start_view(main, "view-imports")
     if not url:
         report("view-import-start", False, "no URL printed")
         p.kill()
@@ -418,9 +538,7 @@ def imports_test():
         back = wait_for(lambda: state().get("error") is None and frame() == pic0, 10)
         report("view-import-back", bool(back), "state %r" % state())
     finally:
-        p.send_signal(2)
-        try: p.wait(10)
-        except subprocess.TimeoutExpired: p.kill()
+        check_stop(p, "view-import-stop")
 
 
 # ---- the load test ----
@@ -430,7 +548,8 @@ def load_test(host, port, token, total=10000, clients=50):
     lock = threading.Lock()
     count = [0]
     def one(rng):
-        kind = rng.randrange(10)
+        kind = rng.randrange(13)
+        method = "POST" if kind in (10, 11) else "GET"
         t = token
         cam = "eye=%g,%g,%g&at=2,0.5,0&up=0,1,0&fov=%g" % (rng.uniform(-5, 8), rng.uniform(0.5, 6), rng.uniform(-5, 8), rng.uniform(20, 60))
         if kind == 0: path, hdr, want = "/state?t=" + t, {}, {200}
@@ -442,6 +561,24 @@ def load_test(host, port, token, total=10000, clients=50):
         elif kind == 6: path, hdr, want = "/frame?t=%s&eye=1,1,1&at=0,0,0&up=0,1,0&fov=0" % t, {}, {400}
         elif kind == 7: path, hdr, want = "/state?t=" + t, {"Origin": "http://evil.example"}, {403}
         elif kind == 8: path, hdr, want = "/../../etc/passwd?t=" + t, {}, {404}
+        elif kind == 10: path, hdr, want = "/param?t=%s&name=r&value=%r" % (t, rng.uniform(0.01, 0.3)), {}, {200}
+        elif kind == 11:
+            # hostile parameters: unknown names, NaN, infinities, out of
+            # range, a wrong kind, oversized, malformed, GET
+            q, want = rng.choice([("name=nosuch&value=1", {400}), ("name=r&value=nan", {400}),
+                                  ("name=r&value=inf", {400}), ("name=r&value=-1e308", {400}),
+                                  ("name=r&value=0.31", {400}), ("name=r&value=0.2x", {400}),
+                                  ("name=r&value=", {400}), ("name=r", {400}), ("value=0.1", {400}),
+                                  ("name=" + "r" * 5000 + "&value=0.1", {400, 414}),
+                                  ("name=r&value=" + "1" * 3000, {400, 414}),
+                                  ("name=r%00x&value=0.1", {400}), ("reset=2", {400}),
+                                  ("name=__proto__&value=1", {400}), ("name=lift&value=1e400", {400})])
+            path, hdr = "/param?t=%s&%s" % (t, q), {}
+        elif kind == 12:
+            path, hdr, want, method = rng.choice([
+                ("/param?t=%s&name=r&value=0.1" % t, {}, {405}, "GET"),
+                ("/param?name=r&value=0.1", {}, {403}, "POST"),
+                ("/param?t=%s&name=r&value=0.1" % t, {"Origin": "http://evil.example"}, {403}, "POST")])
         else:
             # raw garbage, or a client that vanishes mid-request
             try:
@@ -455,7 +592,7 @@ def load_test(host, port, token, total=10000, clients=50):
         hdr.setdefault("Host", good_host)
         for attempt in range(3):
             try:
-                st, _, body = http_get(host, port, path, hdr, timeout=15)
+                st, _, body = http_get(host, port, path, hdr, timeout=15, method=method)
                 break
             except (ConnectionError, OSError) as e:
                 st, body = None, str(e)
@@ -485,7 +622,10 @@ def main():
     os.makedirs(WORK, exist_ok=True)
     here = os.path.dirname(os.path.abspath(__file__))
     scene = os.path.join(WORK, "figure12.qcs")
-    shutil.copy(os.path.join(here, "..", "..", "examples", "figure12.qcs"), scene)
+    text = open(os.path.join(here, "..", "..", "examples", "figure12.qcs")).read()
+    assert R_EXAMPLE + "\n" in text and "floor = Halfspace ((0, 1, 0), 0);" in text
+    open(scene, "w").write(text.replace(R_EXAMPLE, R_LINE)
+                           .replace("floor = Halfspace ((0, 1, 0), 0);", FLOOR_LINE))
     defs = os.path.join(WORK, "defs.qcs")
     open(defs, "w").write("".join(l for l in open(scene) if not l.startswith("renderWith")))
     imports_test()
@@ -515,16 +655,28 @@ def main():
         wrong, dt = load_test(host, port, token)
         rss1 = int(open("/proc/%d/statm" % p.pid).read().split()[1]) * 4
         alive = p.poll() is None
-        report("view-load-test", alive and not wrong, "alive %s, %d wrong answers, first %r" % (alive, len(wrong), wrong[:2]))
+        try: after = json.loads(http_get(host, port, "/state?t=" + token, {"Host": "%s:%d" % (host, port)})[2])
+        except Exception as e: after = {"error": repr(e)}
+        report("view-load-test", alive and not wrong and after.get("error") is None,
+               "alive %s, %d wrong answers, first %r; error after: %r" % (alive, len(wrong), wrong[:2], after.get("error")))
         print("# view: 10000 requests from 50 clients in %.1f s; RSS %d kB before, %d kB after" % (dt, rss0, rss1))
     finally:
-        p.send_signal(2)
-        try:
-            rc = p.wait(10)
-            report("view-stop", rc == 0, "exit status %s" % rc)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            report("view-stop", False, "did not stop on SIGINT within 10 s")
+        check_stop(p, "view-stop")
+
+
+def check_stop(p, name):
+    """SIGINT stops the viewer with status 0 and, in an ASan build, no leak
+    reported (LeakSanitizer fails the exit status and writes a report)."""
+    p.send_signal(2)
+    try:
+        rc = p.wait(30)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        report(name, False, "did not stop on SIGINT within 30 s")
+        return
+    err = open(os.path.join(WORK, p.tag + ".err"), errors="replace").read()
+    leak = re.search(r"LeakSanitizer.*|SUMMARY: \w+Sanitizer.*", err)
+    report(name, rc == 0 and not leak, "exit status %s, %s" % (rc, leak.group(0) if leak else "no sanitizer report"))
 
 
 main()
