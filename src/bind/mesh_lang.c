@@ -20,8 +20,10 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
   fprintf(f, "qcs: mesh %s: %zu triangles, %zu vertices in %.2f s\n", path,
           r->triangles, r->vertices, r->seconds);
   fprintf(f, "  octree: %ld cells visited, %ld proven empty, %ld proven "
-          "full, %ld finest cells meshed (depth %d, cell %.4g)\n", r->cells,
-          r->empty, r->full, r->leaves, r->depth, r->h);
+          "full, %ld surface cells meshed: %ld proven one plane, %ld proven "
+          "smooth enough, %ld at the finest level (depth %d, cell %.4g)\n",
+          r->cells, r->empty, r->full, r->leaves, r->planar, r->smooth,
+          r->leaves - r->planar - r->smooth, r->depth, r->h);
   fprintf(f, "  distance to the surface: certified <= %.4g (requested %.4g; vertices within "
           "%.2g of the surface)\n", r->certified, e, r->vtol);
   fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",

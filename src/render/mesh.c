@@ -77,7 +77,7 @@ static void hfree(hmap *h) {
 
 /* ---- proofs over a box -------------------------------------------------- */
 
-enum { T_OUT = 0, T_IN = 1, T_MIX = 2 };
+enum { T_OUT = 0, T_IN = 1, T_MIX = 2, T_ONE = 3 };
 
 /* The range of n.x - d over the box. */
 static void plane_range(const double n[3], double d, const double lo[3],
@@ -176,19 +176,19 @@ static int leaf_box(const ScNode *nd, const double lo[3], const double hi[3]) {
   case SC_HALFSPACE: {
     double rl, rh;
     plane_range(nd->n, nd->d, lo, hi, &rl, &rh);
-    return rh < 0 ? T_IN : (rl > 0 ? T_OUT : T_MIX);
+    return rh < 0 ? T_IN : (rl > 0 ? T_OUT : T_ONE);
   }
   case SC_ROUNDED: {
     if (nd->outer && csg_box(nd->outer, lo, hi) == T_OUT) return T_OUT;
     if (nd->inner && csg_box(nd->inner, lo, hi) == T_IN) return T_IN;
     double dl, dh;
     dt_box(nd->tape, lo, hi, &dl, &dh);
-    return dh < 0.5 ? T_OUT : (dl > 0.5 ? T_IN : T_MIX);
+    return dh < 0.5 ? T_OUT : (dl > 0.5 ? T_IN : T_ONE);
   }
   case SC_SOFT: {
     double fl, fh, mg = soft_magic(nd->soft);
     soft_field_box(nd->soft, lo, hi, &fl, &fh);
-    return fh < mg ? T_OUT : (fl > mg ? T_IN : T_MIX);
+    return fh < mg ? T_OUT : (fl > mg ? T_IN : T_ONE);
   }
   case SC_EMPTY: return T_OUT;
   case SC_ALL: return T_IN;
@@ -196,57 +196,275 @@ static int leaf_box(const ScNode *nd, const double lo[3], const double hi[3]) {
   }
 }
 
-/* The node over the box, children first (st has room for the subtree). */
+/* Nodes a and b have the same surface: the same node, or two halfspaces
+   on one plane (either side). */
+static int same_surface(const Scene *s, int a, int b) {
+  if (a == b) return 1;
+  const ScNode *x = &s->nodes[a], *y = &s->nodes[b];
+  if (x->kind != SC_HALFSPACE || y->kind != SC_HALFSPACE) return 0;
+  int same = 1, opp = 1;
+  for (int i = 0; i < 3; i++) {
+    same &= x->n[i] == y->n[i];
+    opp &= x->n[i] == -y->n[i];
+  }
+  return (same && x->d == y->d) || (opp && x->d == -y->d);
+}
+
+/* A set operation on classes. T_ONE (undecided, but the solid in the box
+   is decided by one node's inside test, so the surface there is that
+   node's) carries its node in *o. */
+static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
+                  int *o) {
+  int ra, rb; /* the classes that decide alone */
+  switch (k) {
+  case SC_UNION:
+    if (a == T_IN || b == T_IN) return T_IN;
+    ra = b == T_OUT;
+    rb = a == T_OUT;
+    break;
+  case SC_INTER:
+    if (a == T_OUT || b == T_OUT) return T_OUT;
+    ra = b == T_IN;
+    rb = a == T_IN;
+    break;
+  default: /* a - b */
+    if (a == T_OUT || b == T_IN) return T_OUT;
+    if (a == T_IN && b == T_OUT) return T_IN;
+    ra = b == T_OUT;
+    rb = a == T_IN;
+    break;
+  }
+  if (ra) { /* the result is a */
+    *o = oa;
+    return a;
+  }
+  if (rb) { /* the result is b, or the complement of b */
+    *o = ob;
+    return b;
+  }
+  if (a == T_ONE && b == T_ONE && same_surface(s, oa, ob)) {
+    *o = oa;
+    return T_ONE;
+  }
+  return T_MIX;
+}
+
+/* The node over the box, children first (st and one have room for the
+   subtree); *onep is the node deciding a T_ONE result. */
 static int scene_box(const Scene *s, int node, const double lo[3],
-                     const double hi[3], unsigned char *st) {
+                     const double hi[3], unsigned char *st, int *one,
+                     int *onep) {
   int f = s->nodes[node].first;
   for (int i = f; i <= node; i++) {
     const ScNode *nd = &s->nodes[i];
-    int r;
+    int r, o = i;
     switch (nd->kind) {
-    case SC_UNION: r = tri_op(0, st[nd->a - f], st[nd->b - f]); break;
-    case SC_INTER: r = tri_op(1, st[nd->a - f], st[nd->b - f]); break;
-    case SC_DIFF: r = tri_op(2, st[nd->a - f], st[nd->b - f]); break;
+    case SC_UNION:
+    case SC_INTER:
+    case SC_DIFF:
+      r = set_op(s, nd->kind, st[nd->a - f], one[nd->a - f], st[nd->b - f],
+                 one[nd->b - f], &o);
+      break;
     default: r = leaf_box(nd, lo, hi); break;
     }
     st[i - f] = (unsigned char)r;
+    one[i - f] = o;
   }
+  *onep = one[node - f];
   return st[node - f];
+}
+
+/* ---- the gradient of a density tape over a box -------------------------- */
+
+/* Over a box the gradient of a density tape is sum_k c_k n_k over its
+   leaves k whose filter meets the box (n_k the leaf's unit normal), with
+   c_k = d rho / d s_k bounded by forward-mode interval arithmetic: a leaf's
+   own derivative 3/4 (alpha^2 - 1) / r over its alpha range, the product
+   and union rules with the operands' value ranges. Keeping one interval
+   per leaf, not per axis, keeps a lone leaf's gradient exactly along its
+   normal, so a flat face of a rounded solid is seen to be flat. */
+#define GR_MAX 16
+
+typedef struct {
+  double l, h;             /* the value range */
+  int n;                   /* leaves whose filter meets the box */
+  int leaf[GR_MAX];
+  double cl[GR_MAX], ch[GR_MAX];
+} GrIv;
+
+/* r = sx x + sy y on the coefficients (sx, sy intervals); -1 when more
+   than GR_MAX leaves are live. */
+static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
+                  const GrIv *y, double syl, double syh) {
+  GrIv o;
+  o.n = 0;
+  for (int i = 0; i < x->n; i++) {
+    o.leaf[o.n] = x->leaf[i];
+    iv_mul(sxl, sxh, x->cl[i], x->ch[i], &o.cl[o.n], &o.ch[o.n]);
+    o.n++;
+  }
+  for (int i = 0; i < y->n; i++) {
+    double l, h;
+    iv_mul(syl, syh, y->cl[i], y->ch[i], &l, &h);
+    int j = 0;
+    while (j < o.n && o.leaf[j] != y->leaf[i]) j++;
+    if (j == o.n) {
+      if (o.n == GR_MAX) return -1;
+      o.leaf[o.n] = y->leaf[i];
+      o.cl[o.n] = l;
+      o.ch[o.n] = h;
+      o.n++;
+    } else {
+      iv_add(o.cl[j], o.ch[j], l, h, &o.cl[j], &o.ch[j]);
+    }
+  }
+  o.l = r->l;
+  o.h = r->h;
+  *r = o;
+  return 0;
+}
+
+typedef struct {
+  int planar;              /* one live leaf: the 0.5 level is a plane */
+  double w;                /* |grad - g0| <= w over the box */
+  double gmin;             /* grad . n0 >= gmin > 0 over the box */
+} GrBound;
+
+/* The gradient bound of t over [lo, hi]: 0 when found (*b), -1 when the
+   tape is not smooth there (a sharp leaf crosses it, too many live leaves,
+   or no direction n0 with a positive lower bound). */
+static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
+                    GrIv *st, GrBound *b) {
+  int sp = 0, step = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    GrIv *x = &st[sp];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double rl, rh;
+      plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
+      x->n = 0;
+      if (lf->r <= 0) {
+        x->l = rh < 0 ? 1 : 0;
+        x->h = rl > 0 ? 0 : 1;
+        if (rl <= 0 && rh >= 0) { /* a step crossing the box */
+          step = 1;
+          x->leaf[0] = in->arg;
+          x->cl[0] = x->ch[0] = 0;
+          x->n = 1;
+        }
+      } else {
+        double al = rl / lf->r, ah = rh / lf->r;
+        x->l = dt_halfspace_a(ah);
+        x->h = dt_halfspace_a(al);
+        if (al < 1 && ah > -1) {
+          double a0 = fmax(al, -1), a1 = fmin(ah, 1);
+          double m0 = a0 <= 0 && a1 >= 0 ? 0 : fmin(a0 * a0, a1 * a1);
+          double m1 = fmax(a0 * a0, a1 * a1);
+          x->leaf[0] = in->arg;
+          x->cl[0] = 0.75 * (m0 - 1) / lf->r;
+          x->ch[0] = 0.75 * (m1 - 1) / lf->r;
+          x->n = 1;
+        }
+      }
+      sp++;
+    } else if (in->op == DT_CONST) {
+      x->l = x->h = in->c;
+      x->n = 0;
+      sp++;
+    } else {
+      sp--;
+      GrIv *a = &st[sp - 1], *y = &st[sp];
+      double l, h;
+      dt_range_op(in->op, a->l, a->h, y->l, y->h, &l, &h);
+      int rc;
+      switch (in->op) {
+      case DT_SUM: rc = gr_lin(a, a, 1, 1, y, 1, 1); break;
+      case DT_DIFF: rc = gr_lin(a, a, 1, 1, y, -1, -1); break;
+      case DT_RDIFF: rc = gr_lin(a, a, -1, -1, y, 1, 1); break;
+      case DT_PRODUCT: rc = gr_lin(a, a, y->l, y->h, y, a->l, a->h); break;
+      default: /* x + y - x y */
+        rc = gr_lin(a, a, 1 - y->h, 1 - y->l, y, 1 - a->h, 1 - a->l);
+        break;
+      }
+      if (rc < 0) return -1;
+      a->l = l;
+      a->h = h;
+    }
+  }
+  const GrIv *r = &st[0];
+  memset(b, 0, sizeof *b);
+  if (r->n == 1) {
+    b->planar = 1;
+    return 0;
+  }
+  if (step || r->n == 0) return -1;
+  double g0[3] = {0, 0, 0}, w = 0;
+  for (int i = 0; i < r->n; i++) {
+    const double *n = t->leaves[r->leaf[i]].n;
+    double c = 0.5 * (r->cl[i] + r->ch[i]);
+    for (int q = 0; q < 3; q++) g0[q] += c * n[q];
+    w += 0.5 * (r->ch[i] - r->cl[i]);
+  }
+  double len = sqrt(vec3_dot(g0, g0));
+  if (!(len > 0) || !isfinite(len)) return -1;
+  double al = 0, ah = 0;
+  for (int i = 0; i < r->n; i++) {
+    double k = vec3_dot(t->leaves[r->leaf[i]].n, g0) / len, l, h;
+    iv_mul(k, k, r->cl[i], r->ch[i], &l, &h);
+    al += l;
+    ah += h;
+  }
+  double gmin = al > 0 ? al : (ah < 0 ? -ah : 0);
+  if (!(gmin > 0) || !isfinite(w)) return -1;
+  b->w = w * (1 + 1e-9) + 1e-300;
+  b->gmin = gmin * (1 - 1e-9);
+  return 0;
 }
 
 /* ---- the mesher's state --------------------------------------------------- */
 
+/* A surface leaf of the octree and how its triangles are certified. */
+enum { LEAF_PLANE, LEAF_SMOOTH, LEAF_FINE };
+
+typedef struct {
+  uint32_t q[3];           /* its lowest corner, in units of its side */
+  unsigned char level, kind;
+  double w, gmin;          /* LEAF_SMOOTH: the gradient bound */
+} Leaf;
+
 typedef struct {
   const Scene *s;
   int node;
-  double org[3], h;        /* grid point (i, j, k) is org + h (i, j, k) */
+  double org[3], h;        /* finest grid point (i, j, k) is org + h (i, j, k) */
   double clo[3], chi[3];   /* the clip box: outside it is outside */
+  double tol, vtol;
   int depth;
-  unsigned char *st;       /* scene_box scratch */
-  uint32_t *leaves;        /* 3 per finest cell: its lowest grid point */
+  unsigned char *st;       /* scene_box scratch: classes */
+  int *one;                /* scene_box scratch: T_ONE's node */
+  GrIv *gst;               /* grad_box scratch */
+  Leaf *leaves;
   size_t nleaves, capleaves;
   size_t max_cells;
-  hmap sign;               /* grid point -> inside */
-  hmap vert;               /* grid edge -> mesh vertex */
+  hmap split;              /* (level, cell) -> 1 for every split cell */
+  hmap pt;                 /* point (doubled finest coordinates) -> index */
+  uint32_t *pc;            /* its coordinates */
+  unsigned char *ps;       /* its sign: 1 inside */
+  size_t np, capp, capps;
+  hmap vert;               /* point pair -> mesh vertex */
   double *v;
   size_t nv, capv;
   int *t;
   size_t nt, capt;
+  int *fl;                 /* scratch: a face's boundary loop */
+  size_t nfl, capfl;
+  int *ft;                 /* scratch: a cell's face triangles */
+  size_t nft, capft;
+  const Leaf *cur;         /* the leaf being meshed */
   RayCtx *ray;
   MeshReport *rep;
   int err;                 /* MESH_E* */
 } Mesher;
-
-static void grid_point(const Mesher *m, uint32_t i, uint32_t j, uint32_t k,
-                       double p[3]) {
-  p[0] = m->org[0] + m->h * i;
-  p[1] = m->org[1] + m->h * j;
-  p[2] = m->org[2] + m->h * k;
-}
-
-static uint64_t vkey(uint32_t i, uint32_t j, uint32_t k) {
-  return (uint64_t)i | (uint64_t)j << 20 | (uint64_t)k << 40;
-}
 
 static int in_clip(const Mesher *m, const double p[3]) {
   for (int i = 0; i < 3; i++)
@@ -254,19 +472,75 @@ static int in_clip(const Mesher *m, const double p[3]) {
   return 1;
 }
 
-/* Classify the cell of side 2^(depth - level) finest cells at (i, j, k). */
+static int grow(void **p, size_t *cap, size_t need, size_t size) {
+  if (need <= *cap) return 0;
+  size_t nc = *cap ? *cap : 1024;
+  while (nc < need) nc *= 2;
+  void *g = realloc(*p, nc * size);
+  if (!g) return -1;
+  *p = g;
+  *cap = nc;
+  return 0;
+}
+
+static uint64_t ckey(int level, uint64_t i, uint64_t j, uint64_t k) {
+  return (uint64_t)level << 57 | i << 38 | j << 19 | k;
+}
+
+/* Cell (i, j, k) of the level exists in the tree and is split. */
+static int is_split(const Mesher *m, int level, int64_t i, int64_t j,
+                    int64_t k) {
+  int64_t n = (int64_t)1 << level;
+  if (i < 0 || j < 0 || k < 0 || i >= n || j >= n || k >= n) return 0;
+  return hget(&m->split, ckey(level, (uint64_t)i, (uint64_t)j, (uint64_t)k)) >= 0;
+}
+
+/* The point at doubled finest coordinates c, with its sign: its index, or
+   -1 when memory runs out. */
+static int point(Mesher *m, const uint32_t c[3]) {
+  uint64_t key = (uint64_t)c[0] | (uint64_t)c[1] << 21 | (uint64_t)c[2] << 42;
+  int v = hget(&m->pt, key);
+  if (v >= 0) return v;
+  if (grow((void **)&m->pc, &m->capp, 3 * (m->np + 1), sizeof *m->pc) < 0 ||
+      grow((void **)&m->ps, &m->capps, m->np + 1, 1) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  double p[3];
+  for (int i = 0; i < 3; i++) p[i] = m->org[i] + 0.5 * m->h * c[i];
+  int s = in_clip(m, p) ? scene_inside(m->s, m->node, p) : 0;
+  v = (int)m->np;
+  if (s < 0 || hput(&m->pt, key, v) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  memcpy(m->pc + 3 * m->np, c, 3 * sizeof *c);
+  m->ps[m->np++] = (unsigned char)s;
+  return v;
+}
+
+/* Classify the cell (i, j, k) of the level (in units of its side) and
+   either drop it (proven empty or full), keep it as a surface leaf, or
+   split it. A leaf is kept above the finest level when its error is
+   proven within the tolerance: the surface in the box is one plane
+   (LEAF_PLANE), or one rounded node whose gradient bound over the box
+   grown by the tolerance makes the triangles close enough (LEAF_SMOOTH,
+   see mesh.h). */
 static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
-  uint32_t n = 1u << (m->depth - level);
-  double lo[3], hi[3];
-  grid_point(m, i, j, k, lo);
-  grid_point(m, i + n, j + n, k + n, hi);
+  double side = ldexp(m->h, m->depth - level), lo[3], hi[3];
+  uint32_t q[3] = {i, j, k};
+  for (int a = 0; a < 3; a++) {
+    lo[a] = m->org[a] + side * q[a];
+    hi[a] = m->org[a] + side * (q[a] + 1);
+  }
   m->rep->cells++;
   int clip_out = 0, clip_in = 1;
   for (int a = 0; a < 3; a++) {
     if (hi[a] <= m->clo[a] || lo[a] >= m->chi[a]) clip_out = 1;
     if (lo[a] <= m->clo[a] || hi[a] >= m->chi[a]) clip_in = 0;
   }
-  int c = clip_out ? T_OUT : scene_box(m->s, m->node, lo, hi, m->st);
+  int one = -1;
+  int c = clip_out ? T_OUT : scene_box(m->s, m->node, lo, hi, m->st, m->one, &one);
   if (c == T_IN && !clip_in) c = T_MIX;
   if (c == T_OUT) {
     m->rep->empty++;
@@ -276,49 +550,58 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     m->rep->full++;
     return 0;
   }
-  if (level == m->depth) {
+  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0};
+  int leaf = level == m->depth;
+  if (c == T_ONE && clip_in) {
+    const ScNode *nd = &m->s->nodes[one];
+    if (nd->kind == SC_HALFSPACE) {
+      lf.kind = LEAF_PLANE;
+      leaf = 1;
+    } else if (nd->kind == SC_ROUNDED) {
+      double gl[3], gh[3];
+      GrBound b;
+      for (int a = 0; a < 3; a++) {
+        gl[a] = lo[a] - m->tol;
+        gh[a] = hi[a] + m->tol;
+      }
+      if (grad_box(nd->tape, gl, gh, m->gst, &b) == 0) {
+        double d = sqrt(3.0) * side;
+        if (b.planar) {
+          lf.kind = LEAF_PLANE;
+          leaf = 1;
+        } else if (m->vtol + b.w * (d + 2 * m->vtol) / b.gmin <= m->tol) {
+          lf.kind = LEAF_SMOOTH;
+          lf.w = b.w;
+          lf.gmin = b.gmin;
+          leaf = 1;
+        }
+      }
+    }
+  }
+  if (leaf) {
     if (m->nleaves >= m->max_cells) {
       m->err = MESH_ELIMIT;
       return -1;
     }
-    if (m->nleaves == m->capleaves) {
-      size_t nc = m->capleaves ? 2 * m->capleaves : 4096;
-      uint32_t *g = realloc(m->leaves, 3 * nc * sizeof *g);
-      if (!g) {
-        m->err = MESH_ENOMEM;
-        return -1;
-      }
-      m->leaves = g;
-      m->capleaves = nc;
+    if (grow((void **)&m->leaves, &m->capleaves, m->nleaves + 1,
+             sizeof *m->leaves) < 0) {
+      m->err = MESH_ENOMEM;
+      return -1;
     }
-    m->leaves[3 * m->nleaves] = i;
-    m->leaves[3 * m->nleaves + 1] = j;
-    m->leaves[3 * m->nleaves + 2] = k;
-    m->nleaves++;
+    m->leaves[m->nleaves++] = lf;
+    if (lf.kind == LEAF_PLANE) m->rep->planar++;
+    else if (lf.kind == LEAF_SMOOTH) m->rep->smooth++;
     return 0;
   }
-  uint32_t hn = n / 2;
-  for (int q = 0; q < 8; q++)
-    if (walk(m, i + (q & 1 ? hn : 0), j + (q & 2 ? hn : 0),
-             k + (q & 4 ? hn : 0), level + 1) < 0)
-      return -1;
-  return 0;
-}
-
-/* The sign of grid point (i, j, k), cached: 1 inside, 0 outside, -1 on
-   failure. */
-static int corner(Mesher *m, uint32_t i, uint32_t j, uint32_t k) {
-  uint64_t key = vkey(i, j, k);
-  int v = hget(&m->sign, key);
-  if (v >= 0) return v;
-  double p[3];
-  grid_point(m, i, j, k, p);
-  v = in_clip(m, p) ? scene_inside(m->s, m->node, p) : 0;
-  if (v < 0 || hput(&m->sign, key, v) < 0) {
+  if (hput(&m->split, ckey(level, i, j, k), 1) < 0) {
     m->err = MESH_ENOMEM;
     return -1;
   }
-  return v;
+  for (int c8 = 0; c8 < 8; c8++)
+    if (walk(m, 2 * i + (uint32_t)(c8 & 1), 2 * j + (uint32_t)(c8 >> 1 & 1),
+             2 * k + (uint32_t)(c8 >> 2 & 1), level + 1) < 0)
+      return -1;
+  return 0;
 }
 
 /* Inside at o + t d (the clipped solid). */
@@ -332,6 +615,7 @@ static int inside_at(Mesher *m, const double o[3], const double d[3],
 static double crossing(Mesher *m, const double a[3], const double b[3],
                        int sa) {
   double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  double len = sqrt(vec3_dot(d, d));
   /* the clip box's slab along the edge */
   double t0 = 0, t1 = 1;
   for (int i = 0; i < 3; i++) {
@@ -356,7 +640,7 @@ static double crossing(Mesher *m, const double a[3], const double b[3],
   }
   if (isnan(best)) { /* bisection on the point classification */
     double lo = 0, hi = 1;
-    for (int it = 0; it < 60 && (hi - lo) * m->h > m->rep->vtol * 0.5; it++) {
+    for (int it = 0; it < 80 && (hi - lo) * len > m->vtol * 0.5; it++) {
       double mid = 0.5 * (lo + hi);
       int s = inside_at(m, a, d, mid);
       if (s < 0) break;
@@ -366,36 +650,33 @@ static double crossing(Mesher *m, const double a[3], const double b[3],
     best = 0.5 * (lo + hi);
     m->rep->bisected++;
   }
-  const double edge = 1.0 / 1048576; /* keep off the grid points */
+  /* keep off the corners (no repeated vertex position), by far less than
+     the vertices' tolerance */
+  double edge = fmin(1.0 / 1048576, 0.01 * m->vtol / len);
   if (best < edge) best = edge;
   if (best > 1 - edge) best = 1 - edge;
   return best;
 }
 
-/* The mesh vertex on the grid edge from corner ca to cb of the cell at
-   base (masks: bit 0 x, 1 y, 2 z; one mask holds the other). */
-static int edge_vertex(Mesher *m, const uint32_t base[3], int ca, int cb,
-                       const int sg[8]) {
-  int lo = ca & cb, dir = ca ^ cb, hi = lo | dir;
-  uint32_t i = base[0] + (uint32_t)(lo & 1), j = base[1] + (uint32_t)(lo >> 1 & 1),
-           k = base[2] + (uint32_t)(lo >> 2 & 1);
-  uint64_t key = vkey(i, j, k) << 3 | (uint64_t)dir;
+/* The mesh vertex on the segment between points pa and pb (signs differ). */
+static int edge_vertex(Mesher *m, int pa, int pb) {
+  if (pa > pb) {
+    int x = pa;
+    pa = pb;
+    pb = x;
+  }
+  uint64_t key = (uint64_t)pa << 32 | (uint64_t)pb;
   int v = hget(&m->vert, key);
   if (v >= 0) return v;
   double a[3], b[3];
-  grid_point(m, i, j, k, a);
-  grid_point(m, base[0] + (uint32_t)(hi & 1), base[1] + (uint32_t)(hi >> 1 & 1),
-             base[2] + (uint32_t)(hi >> 2 & 1), b);
-  double t = crossing(m, a, b, sg[lo]);
-  if (m->nv == m->capv) {
-    size_t nc = m->capv ? 2 * m->capv : 4096;
-    double *g = realloc(m->v, 3 * nc * sizeof *g);
-    if (!g) {
-      m->err = MESH_ENOMEM;
-      return -1;
-    }
-    m->v = g;
-    m->capv = nc;
+  for (int q = 0; q < 3; q++) {
+    a[q] = m->org[q] + 0.5 * m->h * m->pc[3 * pa + q];
+    b[q] = m->org[q] + 0.5 * m->h * m->pc[3 * pb + q];
+  }
+  double t = crossing(m, a, b, m->ps[pa]);
+  if (grow((void **)&m->v, &m->capv, 3 * (m->nv + 1), sizeof *m->v) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
   }
   double *p = m->v + 3 * m->nv;
   for (int q = 0; q < 3; q++) p[q] = a[q] + t * (b[q] - a[q]);
@@ -408,95 +689,9 @@ static int edge_vertex(Mesher *m, const uint32_t base[3], int ca, int cb,
   return v;
 }
 
-static int emit(Mesher *m, int a, int b, int c) {
-  if (a < 0 || b < 0 || c < 0) return -1;
-  if (m->nt == m->capt) {
-    size_t nc = m->capt ? 2 * m->capt : 4096;
-    int *g = realloc(m->t, 3 * nc * sizeof *g);
-    if (!g) {
-      m->err = MESH_ENOMEM;
-      return -1;
-    }
-    m->t = g;
-    m->capt = nc;
-  }
-  m->t[3 * m->nt] = a;
-  m->t[3 * m->nt + 1] = b;
-  m->t[3 * m->nt + 2] = c;
-  m->nt++;
-  return 0;
-}
-
-/* The Kuhn split: 6 tetrahedra around the diagonal 0 - 7, each ordered to
-   positive orientation. */
-static const int kuhn[6][4] = {
-    {0, 1, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, /* even permutations */
-    {0, 1, 7, 5}, {0, 4, 7, 6}, {0, 2, 7, 3}, /* odd, last two swapped */
-};
-
 static double dist3(const double *a, const double *b) {
   double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
   return sqrt(x * x + y * y + z * z);
-}
-
-static int parity4(const int p[4]) {
-  int inv = 0;
-  for (int i = 0; i < 4; i++)
-    for (int j = i + 1; j < 4; j++) inv += p[i] > p[j];
-  return inv & 1;
-}
-
-/* Triangles of one positively oriented tetrahedron (corner masks c). When
-   count is set, only count them. */
-static int tet(Mesher *m, const uint32_t base[3], const int c[4],
-               const int sg[8], size_t *count) {
-  static const int lone[4][4] = {
-      {0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
-  int in[4], n = 0;
-  for (int i = 0; i < 4; i++) n += in[i] = sg[c[i]];
-  if (n == 0 || n == 4) return 0;
-  if (n == 1 || n == 3) {
-    if (count) return (void)(*count += 1), 0;
-    int i = 0;
-    while (in[i] != (n == 1)) i++;
-    const int *p = lone[i];
-    int e1 = edge_vertex(m, base, c[p[0]], c[p[1]], sg);
-    int e2 = edge_vertex(m, base, c[p[0]], c[p[2]], sg);
-    int e3 = edge_vertex(m, base, c[p[0]], c[p[3]], sg);
-    return n == 1 ? emit(m, e1, e2, e3) : emit(m, e1, e3, e2);
-  }
-  if (count) return (void)(*count += 2), 0;
-  int p[4], a = 0, b = 2;
-  for (int i = 0; i < 4; i++) {
-    if (in[i]) p[a++] = i;
-    else p[b++] = i;
-  }
-  if (parity4(p)) {
-    int x = p[2];
-    p[2] = p[3];
-    p[3] = x;
-  }
-  int q0 = edge_vertex(m, base, c[p[0]], c[p[2]], sg);
-  int q1 = edge_vertex(m, base, c[p[0]], c[p[3]], sg);
-  int q2 = edge_vertex(m, base, c[p[1]], c[p[3]], sg);
-  int q3 = edge_vertex(m, base, c[p[1]], c[p[2]], sg);
-  if (q0 < 0 || q1 < 0 || q2 < 0 || q3 < 0) return -1;
-  if (dist3(m->v + 3 * q0, m->v + 3 * q2) <= dist3(m->v + 3 * q1, m->v + 3 * q3))
-    return emit(m, q0, q1, q2) < 0 ? -1 : emit(m, q0, q2, q3);
-  return emit(m, q1, q2, q3) < 0 ? -1 : emit(m, q1, q3, q0);
-}
-
-static int cell(Mesher *m, size_t leaf, size_t *count) {
-  const uint32_t *b = m->leaves + 3 * leaf;
-  int sg[8];
-  for (int q = 0; q < 8; q++) {
-    sg[q] = corner(m, b[0] + (uint32_t)(q & 1), b[1] + (uint32_t)(q >> 1 & 1),
-                   b[2] + (uint32_t)(q >> 2 & 1));
-    if (sg[q] < 0) return -1;
-  }
-  for (int t = 0; t < 6; t++)
-    if (tet(m, b, kuhn[t], sg, count) < 0) return -1;
-  return 0;
 }
 
 /* The covering radius of a triangle by its vertices: the circumradius if
@@ -513,6 +708,245 @@ static double cover_radius(const double *a, const double *b, const double *c) {
   if (!(area2 > 0)) return l; /* degenerate: the longest side bounds it */
   double r = la * lb * lc / (2 * area2);
   return r < l ? r : l;
+}
+
+/* The proven distance bound of a triangle of the current leaf (mesh.h). */
+static double tri_bound(const Mesher *m, int a, int b, int c) {
+  const double *pa = m->v + 3 * a, *pb = m->v + 3 * b, *pc = m->v + 3 * c;
+  switch (m->cur->kind) {
+  case LEAF_PLANE: return m->vtol;
+  case LEAF_SMOOTH: {
+    double d = fmax(dist3(pa, pb), fmax(dist3(pb, pc), dist3(pa, pc)));
+    return m->vtol + m->cur->w * (d + 2 * m->vtol) / m->cur->gmin;
+  }
+  default: return m->vtol + cover_radius(pa, pb, pc);
+  }
+}
+
+static int emit(Mesher *m, int a, int b, int c) {
+  if (a < 0 || b < 0 || c < 0) return -1;
+  if (grow((void **)&m->t, &m->capt, 3 * (m->nt + 1), sizeof *m->t) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->t[3 * m->nt] = a;
+  m->t[3 * m->nt + 1] = b;
+  m->t[3 * m->nt + 2] = c;
+  m->nt++;
+  double e = tri_bound(m, a, b, c);
+  if (e > m->rep->certified) m->rep->certified = e;
+  return 0;
+}
+
+static int parity4(const int p[4]) {
+  int inv = 0;
+  for (int i = 0; i < 4; i++)
+    for (int j = i + 1; j < 4; j++) inv += p[i] > p[j];
+  return inv & 1;
+}
+
+/* Marching tetrahedra: the triangles of the positively oriented
+   tetrahedron on points c. When count is set, only count them. */
+static int tet(Mesher *m, const int c[4], size_t *count) {
+  static const int lone[4][4] = {
+      {0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+  int in[4], n = 0;
+  for (int i = 0; i < 4; i++) n += in[i] = m->ps[c[i]];
+  if (n == 0 || n == 4) return 0;
+  if (n == 1 || n == 3) {
+    if (count) return (void)(*count += 1), 0;
+    int i = 0;
+    while (in[i] != (n == 1)) i++;
+    const int *p = lone[i];
+    int e1 = edge_vertex(m, c[p[0]], c[p[1]]);
+    int e2 = edge_vertex(m, c[p[0]], c[p[2]]);
+    int e3 = edge_vertex(m, c[p[0]], c[p[3]]);
+    return n == 1 ? emit(m, e1, e2, e3) : emit(m, e1, e3, e2);
+  }
+  if (count) return (void)(*count += 2), 0;
+  int p[4], a = 0, b = 2;
+  for (int i = 0; i < 4; i++) {
+    if (in[i]) p[a++] = i;
+    else p[b++] = i;
+  }
+  if (parity4(p)) {
+    int x = p[2];
+    p[2] = p[3];
+    p[3] = x;
+  }
+  int q0 = edge_vertex(m, c[p[0]], c[p[2]]);
+  int q1 = edge_vertex(m, c[p[0]], c[p[3]]);
+  int q2 = edge_vertex(m, c[p[1]], c[p[3]]);
+  int q3 = edge_vertex(m, c[p[1]], c[p[2]]);
+  if (q0 < 0 || q1 < 0 || q2 < 0 || q3 < 0) return -1;
+  if (dist3(m->v + 3 * q0, m->v + 3 * q2) <= dist3(m->v + 3 * q1, m->v + 3 * q3))
+    return emit(m, q0, q1, q2) < 0 ? -1 : emit(m, q0, q2, q3);
+  return emit(m, q1, q2, q3) < 0 ? -1 : emit(m, q1, q3, q0);
+}
+
+/* ---- a conforming tetrahedral mesh of the octree's surface leaves ----------
+
+   A leaf whose six faces are plain (the cell across a face is not split
+   and no edge carries a corner of a smaller cell) is cut into the 6 Kuhn
+   tetrahedra around its main diagonal, as a uniform grid would be. Any
+   other leaf gets a point at its centre and one tetrahedron from it to
+   each triangle of its faces: a face whose neighbour is split is cut into
+   its four quarters (recursively); a leaf face is cut along its diagonal
+   from its lowest to its highest corner if it has only its 4 corners (the
+   diagonal the Kuhn split of both cells uses), else fanned from its
+   centre to its corners and to every corner of a smaller cell on its
+   edges. Both cells sharing a face compute the same cut from the same
+   global facts (which cells are split), so the tetrahedra meet face to
+   face and the level set of the signs is closed across cells of any
+   sizes. A corner of a smaller cell lies on an edge of a cell of level l
+   exactly when one of the 4 cells of level l around that edge is split. */
+
+static int fl_push(Mesher *m, int p) {
+  if (p < 0) return -1;
+  if (grow((void **)&m->fl, &m->capfl, m->nfl + 1, sizeof *m->fl) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->fl[m->nfl++] = p;
+  return 0;
+}
+
+/* The corners of smaller cells strictly inside the edge of level l from
+   corner c (level-l units) along axis a, pushed in order from c, or from
+   the far end when rev. */
+static int edge_points(Mesher *m, int l, const int64_t c[3], int a, int rev) {
+  int b = (a + 1) % 3, e = (a + 2) % 3, split = 0;
+  for (int u = 0; u < 2 && !split; u++)
+    for (int w = 0; w < 2 && !split; w++) {
+      int64_t q[3] = {c[0], c[1], c[2]};
+      q[b] -= u;
+      q[e] -= w;
+      split = is_split(m, l, q[0], q[1], q[2]);
+    }
+  if (!split) return 0;
+  int64_t h0[3] = {2 * c[0], 2 * c[1], 2 * c[2]}, h1[3];
+  memcpy(h1, h0, sizeof h1);
+  h1[a] += 1;
+  uint32_t mid[3];
+  for (int i = 0; i < 3; i++)
+    mid[i] = (uint32_t)(h1[i] << (m->depth - l));
+  const int64_t *first = rev ? h1 : h0, *second = rev ? h0 : h1;
+  if (edge_points(m, l + 1, first, a, rev) < 0) return -1;
+  if (fl_push(m, point(m, mid)) < 0) return -1;
+  return edge_points(m, l + 1, second, a, rev);
+}
+
+static int ft_push(Mesher *m, int a, int b, int c) {
+  if (grow((void **)&m->ft, &m->capft, m->nft + 3, sizeof *m->ft) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->ft[m->nft++] = a;
+  m->ft[m->nft++] = b;
+  m->ft[m->nft++] = c;
+  return 0;
+}
+
+/* The triangles of the face of cell q (level l) on axis a, side s (0 low,
+   1 high), counter-clockwise seen from outside the cell; *plain is cleared
+   unless the face is one leaf face with its 4 corners only. */
+static int face(Mesher *m, int l, const int64_t q[3], int a, int s,
+                int *plain) {
+  int64_t nb[3] = {q[0], q[1], q[2]};
+  nb[a] += s ? 1 : -1;
+  int b = (a + 1) % 3, e = (a + 2) % 3;
+  if (is_split(m, l, nb[0], nb[1], nb[2])) {
+    *plain = 0;
+    for (int u = 0; u < 2; u++)
+      for (int w = 0; w < 2; w++) {
+        int64_t ch[3];
+        ch[a] = 2 * q[a] + s;
+        ch[b] = 2 * q[b] + u;
+        ch[e] = 2 * q[e] + w;
+        int dummy = 1;
+        if (face(m, l + 1, ch, a, s, &dummy) < 0) return -1;
+      }
+    return 0;
+  }
+  /* the loop (0,0) (1,0) (1,1) (0,1) in (b, e) is counter-clockwise seen
+     from +a; from -a it runs the other way */
+  static const int cu[4] = {0, 1, 1, 0}, cw[4] = {0, 0, 1, 1};
+  m->nfl = 0;
+  for (int r = 0; r < 4; r++) {
+    int k0 = s ? r : (4 - r) % 4, k1 = s ? (r + 1) % 4 : (3 - r) % 4;
+    int64_t p0[3], p1[3];
+    p0[a] = p1[a] = q[a] + s;
+    p0[b] = q[b] + cu[k0];
+    p0[e] = q[e] + cw[k0];
+    p1[b] = q[b] + cu[k1];
+    p1[e] = q[e] + cw[k1];
+    uint32_t dc[3];
+    for (int i = 0; i < 3; i++) dc[i] = (uint32_t)(p0[i] << (m->depth - l + 1));
+    if (fl_push(m, point(m, dc)) < 0) return -1;
+    int ax = p0[b] != p1[b] ? b : e, rev = p1[ax] < p0[ax];
+    const int64_t *lowc = rev ? p1 : p0;
+    if (edge_points(m, l, lowc, ax, rev) < 0) return -1;
+  }
+  size_t n = m->nfl;
+  if (n == 4) {
+    /* loop[0] is corner (0,0) and loop[2] is (1,1) either way round */
+    if (ft_push(m, m->fl[0], m->fl[1], m->fl[2]) < 0) return -1;
+    return ft_push(m, m->fl[0], m->fl[2], m->fl[3]);
+  }
+  *plain = 0;
+  uint32_t fc[3];
+  fc[a] = (uint32_t)((q[a] + s) << (m->depth - l + 1));
+  fc[b] = (uint32_t)((2 * q[b] + 1) << (m->depth - l));
+  fc[e] = (uint32_t)((2 * q[e] + 1) << (m->depth - l));
+  int cp = point(m, fc);
+  if (cp < 0) return -1;
+  for (size_t i = 0; i < n; i++)
+    if (ft_push(m, cp, m->fl[i], m->fl[(i + 1) % n]) < 0) return -1;
+  return 0;
+}
+
+/* The Kuhn split: 6 tetrahedra around the diagonal 0 - 7, each ordered to
+   positive orientation (corner masks: bit 0 x, 1 y, 2 z). */
+static const int kuhn[6][4] = {
+    {0, 1, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, /* even permutations */
+    {0, 1, 7, 5}, {0, 4, 7, 6}, {0, 2, 7, 3}, /* odd, last two swapped */
+};
+
+static int cell(Mesher *m, size_t leaf, size_t *count) {
+  const Leaf *lf = &m->leaves[leaf];
+  m->cur = lf;
+  int l = lf->level, plain = 1;
+  int64_t q[3] = {lf->q[0], lf->q[1], lf->q[2]};
+  m->nft = 0;
+  if (l < m->depth)
+    for (int a = 0; a < 3; a++)
+      for (int s = 0; s < 2; s++)
+        if (face(m, l, q, a, s, &plain) < 0) return -1;
+  if (plain) {
+    int c[8];
+    for (int k = 0; k < 8; k++) {
+      uint32_t dc[3];
+      for (int i = 0; i < 3; i++)
+        dc[i] = (uint32_t)((q[i] + (k >> i & 1)) << (m->depth - l + 1));
+      if ((c[k] = point(m, dc)) < 0) return -1;
+    }
+    for (int t = 0; t < 6; t++) {
+      int p[4] = {c[kuhn[t][0]], c[kuhn[t][1]], c[kuhn[t][2]], c[kuhn[t][3]]};
+      if (tet(m, p, count) < 0) return -1;
+    }
+    return 0;
+  }
+  uint32_t cc[3];
+  for (int i = 0; i < 3; i++) cc[i] = (uint32_t)((2 * q[i] + 1) << (m->depth - l));
+  int cp = point(m, cc);
+  if (cp < 0) return -1;
+  for (size_t i = 0; i < m->nft; i += 3) {
+    /* (a, b, c) counter-clockwise from outside, the centre inside:
+       (a, c, b, centre) is positive */
+    int p[4] = {m->ft[i], m->ft[i + 2], m->ft[i + 1], cp};
+    if (tet(m, p, count) < 0) return -1;
+  }
+  return 0;
 }
 
 /* The node of node's subtree that makes it unbounded. */
@@ -593,31 +1027,36 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
   m.node = node;
   m.depth = depth;
   m.h = L / ldexp(1, depth);
+  m.tol = e;
+  m.vtol = vtol;
   m.rep = rep;
   m.max_cells = ms->max_cells ? ms->max_cells : (size_t)1 << 24;
   for (int i = 0; i < 3; i++) {
     double c = 0.5 * (lo[i] + hi[i]);
     m.org[i] = c - 0.5 * L;
-    /* the clip box: the object's box, a little enlarged (never cutting
-       a bounded object), or the user's box */
-    m.clo[i] = ms->has_bounds && ms->lo[i] >= lo[i] ? lo[i] : lo[i] - 0.5 * ht;
-    m.chi[i] = ms->has_bounds && ms->hi[i] <= hi[i] ? hi[i] : hi[i] + 0.5 * ht;
+    /* the clip box: the user's box where it cuts the object, else no
+       clip (the object's box is conservative; a clip there would keep
+       the cells at its faces from being proven plane) */
+    m.clo[i] = ms->has_bounds && ms->lo[i] >= lo[i] ? lo[i] : -HUGE_VAL;
+    m.chi[i] = ms->has_bounds && ms->hi[i] <= hi[i] ? hi[i] : HUGE_VAL;
   }
   rep->depth = depth;
   rep->h = m.h;
   rep->vtol = vtol;
   int nsub = node - s->nodes[node].first + 1;
   m.st = malloc((size_t)nsub);
+  m.one = malloc((size_t)nsub * sizeof *m.one);
+  m.gst = malloc(DT_STACK_MAX * sizeof *m.gst);
   m.ray = ray_ctx_new(s, vtol);
   int rc = MESH_OK;
-  if (!m.st || !m.ray) {
+  if (!m.st || !m.one || !m.gst || !m.ray) {
     rc = MESH_ENOMEM;
     goto done;
   }
   if (walk(&m, 0, 0, 0, 0) < 0) {
     rc = m.err;
     if (rc == MESH_ELIMIT)
-      snprintf(err, errlen, "the mesh needs more than %zu finest octree "
+      snprintf(err, errlen, "the mesh needs more than %zu surface octree "
                "cells (limit max-cells): give a larger tolerance than %g",
                m.max_cells, e);
     goto done;
@@ -657,13 +1096,6 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
     rc = MESH_ENOMEM;
     goto done;
   }
-  double cert = 0;
-  for (size_t i = 0; i < m.nt; i++) {
-    const int *t = m.t + 3 * i;
-    double r = cover_radius(m.v + 3 * t[0], m.v + 3 * t[1], m.v + 3 * t[2]);
-    if (r > cert) cert = r;
-  }
-  rep->certified = cert + vtol;
   Mesh *me = malloc(sizeof *me);
   if (!me) {
     rc = MESH_ENOMEM;
@@ -696,10 +1128,17 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
 done:
   if (rc == MESH_ENOMEM) snprintf(err, errlen, "out of memory while meshing");
   free(m.st);
+  free(m.one);
+  free(m.gst);
   free(m.leaves);
   free(m.v);
   free(m.t);
-  hfree(&m.sign);
+  free(m.pc);
+  free(m.ps);
+  free(m.fl);
+  free(m.ft);
+  hfree(&m.split);
+  hfree(&m.pt);
   hfree(&m.vert);
   if (m.ray) ray_ctx_free(m.ray);
   clock_gettime(CLOCK_MONOTONIC, &t1);

@@ -51,7 +51,7 @@ typedef struct MeshSettings {
                               object needs it) */
   double lo[3], hi[3];
   size_t max_triangles;    /* refuse a mesh with more (0: no limit) */
-  size_t max_cells;        /* refuse an octree with more finest cells */
+  size_t max_cells;        /* refuse an octree with more surface cells */
 } MeshSettings;
 
 typedef struct Mesh {
@@ -64,7 +64,10 @@ typedef struct Mesh {
 typedef struct MeshReport {
   long cells;              /* octree cells visited */
   long empty, full;        /* of them proven outside / inside */
-  long leaves;             /* finest cells meshed */
+  long leaves;             /* surface cells meshed (at any level) */
+  long planar, smooth;     /* of them kept above the finest level: the
+                              surface proven one plane, or proven close
+                              enough by the gradient bound */
   int depth;               /* finest level */
   double h;                /* finest cell side */
   double vtol;             /* the vertices' distance bound */
