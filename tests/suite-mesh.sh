@@ -43,7 +43,7 @@ for t in 0 "0/0" 1e-300; do
   elif grep -q "tolerance" "$tmp/err" && [ ! -e "$tmp/t.stl" ]; then echo "ok mesh: tolerance $t refused"
   else echo "FAIL mesh: tolerance $t: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 done
-printf 'meshWith [MaxTriangles 1000] "big.stl" UnitCube\n' > "$tmp/big.qcs"
+printf 'meshWith [MaxTriangles 1000] "big.stl" (Rounded 0.2 UnitCube)\n' > "$tmp/big.qcs"
 if (cd "$tmp" && "$top/$QCS" big.qcs > out 2> err); then echo "FAIL mesh: MaxTriangles ignored"
 elif grep -q "max-triangles" "$tmp/err" && [ ! -e "$tmp/big.stl" ]; then echo "ok mesh: MaxTriangles refuses, no file"
 else echo "FAIL mesh: MaxTriangles: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi

@@ -21,9 +21,14 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           r->triangles, r->vertices, r->seconds);
   fprintf(f, "  octree: %ld cells visited, %ld proven empty, %ld proven "
           "full, %ld surface cells meshed: %ld proven one plane, %ld proven "
-          "smooth enough, %ld at the finest level (depth %d, cell %.4g)\n",
+          "smooth enough, %ld sharp (a CSG of planes, meshed exactly), %ld at "
+          "the finest level (depth %d, cell %.4g)\n",
           r->cells, r->empty, r->full, r->leaves, r->planar, r->smooth,
-          r->leaves - r->planar - r->smooth, r->depth, r->h);
+          r->sharp, r->leaves - r->planar - r->smooth - r->sharp, r->depth,
+          r->h);
+  if (r->sharp_off)
+    fprintf(f, "  sharp cells given up: two of them decided a degenerate "
+            "case apart; the mesh was made again without them\n");
   fprintf(f, "  distance to the surface: certified <= %.4g (requested %.4g; vertices within "
           "%.2g of the surface)\n", r->certified, e, r->vtol);
   fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",

@@ -75,9 +75,64 @@ static void hfree(hmap *h) {
   free(h->v);
 }
 
+/* ---- a hash map from 4 x 64-bit keys to ints ------------------------------ */
+
+typedef struct {
+  uint64_t *k;             /* 4 per slot */
+  int *v;                  /* -1: free */
+  size_t cap, n;
+} kmap;
+
+static size_t kslot(const kmap *h, const uint64_t *key) {
+  uint64_t x = 0;
+  for (int i = 0; i < 4; i++) {
+    x ^= key[i] + 0x9E3779B97F4A7C15ull + (x << 6) + (x >> 2);
+    x *= 0xBF58476D1CE4E5B9ull;
+  }
+  x ^= x >> 31;
+  size_t i = (size_t)x & (h->cap - 1);
+  while (h->v[i] >= 0 && memcmp(h->k + 4 * i, key, 4 * sizeof *key))
+    i = (i + 1) & (h->cap - 1);
+  return i;
+}
+
+static int kmap_get(const kmap *h, const uint64_t *key) {
+  return h->cap ? h->v[kslot(h, key)] : -1;
+}
+
+static int kmap_put(kmap *h, const uint64_t *key, int v) {
+  if (2 * (h->n + 1) > h->cap) {
+    size_t nc = h->cap ? 2 * h->cap : 1024;
+    kmap g = {malloc(4 * nc * sizeof *g.k), malloc(nc * sizeof *g.v), nc, h->n};
+    if (!g.k || !g.v) {
+      free(g.k);
+      free(g.v);
+      return -1;
+    }
+    for (size_t i = 0; i < nc; i++) g.v[i] = -1;
+    for (size_t i = 0; i < h->cap; i++)
+      if (h->v[i] >= 0) {
+        size_t j = kslot(&g, h->k + 4 * i);
+        memcpy(g.k + 4 * j, h->k + 4 * i, 4 * sizeof *g.k);
+        g.v[j] = h->v[i];
+      }
+    free(h->k);
+    free(h->v);
+    *h = g;
+  }
+  size_t i = kslot(h, key);
+  if (h->v[i] < 0) h->n++;
+  memcpy(h->k + 4 * i, key, 4 * sizeof *key);
+  h->v[i] = v;
+  return 0;
+}
+
 /* ---- proofs over a box -------------------------------------------------- */
 
-enum { T_OUT = 0, T_IN = 1, T_MIX = 2, T_ONE = 3 };
+/* T_ONE: undecided, but the solid in the box is decided by one node's
+   inside test; T_PL: undecided, and every undecided leaf below is a sharp
+   halfspace. */
+enum { T_OUT = 0, T_IN = 1, T_MIX = 2, T_ONE = 3, T_PL = 4 };
 
 /* The range of n.x - d over the box. */
 static void plane_range(const double n[3], double d, const double lo[3],
@@ -246,6 +301,9 @@ static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
     *o = oa;
     return T_ONE;
   }
+  if ((a == T_PL || (a == T_ONE && s->nodes[oa].kind == SC_HALFSPACE)) &&
+      (b == T_PL || (b == T_ONE && s->nodes[ob].kind == SC_HALFSPACE)))
+    return T_PL;
   return T_MIX;
 }
 
@@ -425,13 +483,19 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
 /* ---- the mesher's state --------------------------------------------------- */
 
 /* A surface leaf of the octree and how its triangles are certified. */
-enum { LEAF_PLANE, LEAF_SMOOTH, LEAF_FINE };
+enum { LEAF_PLANE, LEAF_SMOOTH, LEAF_FINE, LEAF_EXACT };
+
+/* The most planes a sharp cell (LEAF_EXACT) may hold. */
+#define PL_MAX 8
 
 typedef struct {
   uint32_t q[3];           /* its lowest corner, in units of its side */
   unsigned char level, kind;
+  int pl0, npl;            /* LEAF_EXACT: its planes, pls[pl0 .. + npl) */
   double w, gmin;          /* LEAF_SMOOTH: the gradient bound */
 } Leaf;
+
+struct ExTet;
 
 typedef struct {
   const Scene *s;
@@ -461,6 +525,13 @@ typedef struct {
   int *ft;                 /* scratch: a cell's face triangles */
   size_t nft, capft;
   const Leaf *cur;         /* the leaf being meshed */
+  int sharp;               /* make LEAF_EXACT cells */
+  int *pls;                /* the planes of the sharp cells (node indices) */
+  size_t npls, cappls;
+  int *plmap;              /* per node of the subtree: 2 (plane) + flip */
+  unsigned char *pv;       /* pl_eval scratch */
+  struct ExTet *ex;        /* exact_tet scratch */
+  kmap vert2;              /* named corners of sharp cells -> mesh vertex */
   RayCtx *ray;
   MeshReport *rep;
   int err;                 /* MESH_E* */
@@ -550,7 +621,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     m->rep->full++;
     return 0;
   }
-  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0};
+  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0};
   int leaf = level == m->depth;
   if (c == T_ONE && clip_in) {
     const ScNode *nd = &m->s->nodes[one];
@@ -578,6 +649,30 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
       }
     }
   }
+  if (c == T_PL && clip_in && m->sharp) {
+    /* the distinct planes of the undecided halfspaces */
+    int f = m->s->nodes[m->node].first, n0 = (int)m->npls, n = 0;
+    for (int x = f; x <= m->node && n <= PL_MAX; x++) {
+      if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+      int dup = 0;
+      for (int y = 0; y < n && !dup; y++) dup = same_surface(m->s, m->pls[n0 + y], x);
+      if (dup) continue;
+      if (grow((void **)&m->pls, &m->cappls, m->npls + 1, sizeof *m->pls) < 0) {
+        m->err = MESH_ENOMEM;
+        return -1;
+      }
+      m->pls[m->npls++] = x;
+      n++;
+    }
+    if (n <= PL_MAX) {
+      lf.kind = LEAF_EXACT;
+      lf.pl0 = n0;
+      lf.npl = n;
+      leaf = 1;
+    } else {
+      m->npls = (size_t)n0;
+    }
+  }
   if (leaf) {
     if (m->nleaves >= m->max_cells) {
       m->err = MESH_ELIMIT;
@@ -590,6 +685,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     }
     m->leaves[m->nleaves++] = lf;
     if (lf.kind == LEAF_PLANE) m->rep->planar++;
+    else if (lf.kind == LEAF_EXACT) m->rep->sharp++;
     else if (lf.kind == LEAF_SMOOTH) m->rep->smooth++;
     return 0;
   }
@@ -714,7 +810,8 @@ static double cover_radius(const double *a, const double *b, const double *c) {
 static double tri_bound(const Mesher *m, int a, int b, int c) {
   const double *pa = m->v + 3 * a, *pb = m->v + 3 * b, *pc = m->v + 3 * c;
   switch (m->cur->kind) {
-  case LEAF_PLANE: return m->vtol;
+  case LEAF_PLANE:
+  case LEAF_EXACT: return m->vtol;
   case LEAF_SMOOTH: {
     double d = fmax(dist3(pa, pb), fmax(dist3(pb, pc), dist3(pa, pc)));
     return m->vtol + m->cur->w * (d + 2 * m->vtol) / m->cur->gmin;
@@ -905,6 +1002,377 @@ static int face(Mesher *m, int l, const int64_t q[3], int a, int s,
   return 0;
 }
 
+/* ---- sharp cells: the exact surface of a CSG of planes in a tetrahedron ----
+
+   In a LEAF_EXACT cell the solid is decided by a Boolean combination of at
+   most PL_MAX halfspaces (all other nodes are proven in or out over the
+   box). In each tetrahedron the polygon of every plane i (plane i cut by
+   the tetrahedron) is split by every other plane into convex pieces; a
+   piece is surface exactly when the solid's value on it changes with the
+   side of plane i (the value is computed from the sides, combinatorially,
+   not from a sample), and it is oriented by which side is inside. The
+   pieces' corners are named by what defines them: a plane on a
+   tetrahedron edge, two planes on a tetrahedron face, three planes; the
+   neighbours that share an edge or a face compute the same names and the
+   same positions (from the sorted points and planes), so pieces meet edge
+   to edge across tetrahedra and across the crease between two planes, and
+   edges and corners of the solid are vertices and edges of the mesh. A
+   plane's single crossing on an edge whose ends differ is the same vertex
+   the marching cells make there (edge_vertex). The whole mesh is checked
+   for closure at the end; if rounding ever made two neighbours decide a
+   degenerate case differently, the mesh is made again without sharp cells
+   (mesh_scene). */
+#define PV_MAX 32
+#define PC_MAX 64
+#define LV_MAX 256
+
+typedef struct {
+  int n;
+  unsigned bits;           /* side of each plane: 1 inside */
+  int v[PV_MAX];           /* local vertices, counter-clockwise about +n_i */
+  int sup[PV_MAX];         /* support of edge v[q] -> v[q+1]: a plane
+                              (list index) or -1 - (tetrahedron face) */
+} Piece;
+
+typedef struct {
+  uint64_t key[4];
+  double x[3];
+  int kind, la, lb, plane; /* kind 0: plane on a tetrahedron edge */
+  int global;              /* mesh vertex, -1 until needed */
+} LVert;
+
+typedef struct ExTet {
+  Mesher *m;
+  const int *p;            /* the tetrahedron's 4 points */
+  double x[4][3];
+  double s[PL_MAX][4];     /* each plane's signed distance at the corners */
+  LVert lv[LV_MAX];
+  int nlv;
+  Piece pc[2][PC_MAX];
+  int bad;
+} ExTet;
+
+static void pl_plane(const Mesher *m, int j, double n[3], double *d) {
+  const ScNode *nd = &m->s->nodes[m->pls[m->cur->pl0 + j]];
+  memcpy(n, nd->n, 3 * sizeof *n);
+  *d = nd->d;
+}
+
+/* Solve rows a x = b (3 x 3) by Cramer's rule: 0, or -1 if near singular. */
+static int solve3(const double a[3][3], const double b[3], double x[3]) {
+  double c0[3], det;
+  double r1[3] = {a[1][0], a[1][1], a[1][2]}, r2[3] = {a[2][0], a[2][1], a[2][2]};
+  vec3_cross(r1, r2, c0);
+  det = vec3_dot(a[0], c0);
+  double sc = sqrt(vec3_dot(a[0], a[0]) * vec3_dot(r1, r1) * vec3_dot(r2, r2));
+  if (!(fabs(det) > 1e-9 * sc)) return -1;
+  for (int i = 0; i < 3; i++) {
+    double m[3][3];
+    memcpy(m, a, sizeof m);
+    for (int r = 0; r < 3; r++) m[r][i] = b[r];
+    double q1[3] = {m[1][0], m[1][1], m[1][2]}, q2[3] = {m[2][0], m[2][1], m[2][2]}, c[3];
+    vec3_cross(q1, q2, c);
+    x[i] = vec3_dot(m[0], c) / det;
+  }
+  return 0;
+}
+
+static int lv_find(ExTet *e, const uint64_t k[4]) {
+  for (int i = 0; i < e->nlv; i++)
+    if (!memcmp(e->lv[i].key, k, sizeof e->lv[i].key)) return i;
+  return -1;
+}
+
+static int lv_add(ExTet *e, const uint64_t k[4], const double x[3], int kind,
+                  int la, int lb, int plane) {
+  int i = lv_find(e, k);
+  if (i >= 0) return i;
+  if (e->nlv == LV_MAX) {
+    e->bad = 1;
+    return -1;
+  }
+  LVert *v = &e->lv[e->nlv];
+  memcpy(v->key, k, sizeof v->key);
+  memcpy(v->x, x, sizeof v->x);
+  v->kind = kind;
+  v->la = la;
+  v->lb = lb;
+  v->plane = plane;
+  v->global = -1;
+  return e->nlv++;
+}
+
+/* Plane i on the tetrahedron edge la - lb (its sides differ there). */
+static int ex_edge(ExTet *e, int i, int la, int lb) {
+  int pa = e->p[la], pb = e->p[lb];
+  if (pa > pb) {
+    int t = la;
+    la = lb;
+    lb = t;
+    pa = e->p[la];
+    pb = e->p[lb];
+  }
+  double sa = e->s[i][la], sb = e->s[i][lb], t = sa / (sa - sb), x[3];
+  for (int q = 0; q < 3; q++) x[q] = e->x[la][q] + t * (e->x[lb][q] - e->x[la][q]);
+  uint64_t k[4] = {5, (uint64_t)pa << 32 | (uint64_t)pb,
+                   (uint64_t)e->m->pls[e->m->cur->pl0 + i], 0};
+  return lv_add(e, k, x, 0, la, lb, i);
+}
+
+/* The vertex where piece edge (a, b) with support sup meets plane j. */
+static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
+  const Mesher *m = e->m;
+  uint64_t k[4];
+  double A[3][3], B[3], x[3];
+  pl_plane(m, i, A[0], &B[0]);
+  pl_plane(m, j, A[1], &B[1]);
+  uint64_t ni = (uint64_t)m->pls[m->cur->pl0 + i], nj = (uint64_t)m->pls[m->cur->pl0 + j];
+  if (ni > nj) {
+    uint64_t t = ni;
+    ni = nj;
+    nj = t;
+  }
+  if (sup >= 0) { /* three planes */
+    pl_plane(m, sup, A[2], &B[2]);
+    uint64_t n3[3] = {ni, nj, (uint64_t)m->pls[m->cur->pl0 + sup]};
+    for (int r = 0; r < 2; r++)
+      for (int c = 0; c < 2 - r; c++)
+        if (n3[c] > n3[c + 1]) {
+          uint64_t t = n3[c];
+          n3[c] = n3[c + 1];
+          n3[c + 1] = t;
+        }
+    k[0] = 3;
+    k[1] = n3[0];
+    k[2] = n3[1];
+    k[3] = n3[2];
+    /* the rows in node order, so that every tetrahedron solves alike */
+    double R[3][3], Rb[3];
+    for (int r = 0; r < 3; r++) {
+      int li = n3[r] == (uint64_t)m->pls[m->cur->pl0 + i] ? i
+               : n3[r] == (uint64_t)m->pls[m->cur->pl0 + j] ? j : sup;
+      pl_plane(m, li, R[r], &Rb[r]);
+    }
+    memcpy(A, R, sizeof A);
+    memcpy(B, Rb, sizeof B);
+  } else { /* two planes on a tetrahedron face */
+    int ex = -1 - sup, f[3], nf = 0;
+    for (int q = 0; q < 4; q++)
+      if (q != ex) f[nf++] = q;
+    for (int r = 0; r < 2; r++)
+      for (int c = 0; c < 2 - r; c++)
+        if (e->p[f[c]] > e->p[f[c + 1]]) {
+          int t = f[c];
+          f[c] = f[c + 1];
+          f[c + 1] = t;
+        }
+    double u[3], w[3];
+    for (int q = 0; q < 3; q++) {
+      u[q] = e->x[f[1]][q] - e->x[f[0]][q];
+      w[q] = e->x[f[2]][q] - e->x[f[0]][q];
+    }
+    double fi[3], fj[3], bi, bj;
+    pl_plane(m, ni == (uint64_t)m->pls[m->cur->pl0 + i] ? i : j, fi, &bi);
+    pl_plane(m, ni == (uint64_t)m->pls[m->cur->pl0 + i] ? j : i, fj, &bj);
+    memcpy(A[0], fi, sizeof fi);
+    memcpy(A[1], fj, sizeof fj);
+    B[0] = bi;
+    B[1] = bj;
+    vec3_cross(u, w, A[2]);
+    B[2] = vec3_dot(A[2], e->x[f[0]]);
+    k[0] = 4;
+    k[1] = (uint64_t)e->p[f[0]] << 32 | (uint64_t)e->p[f[1]];
+    k[2] = (uint64_t)e->p[f[2]];
+    k[3] = ni << 32 | nj;
+  }
+  if (solve3(A, B, x) < 0) { /* near parallel: between the two ends */
+    double n[3], d;
+    pl_plane(m, j, n, &d);
+    double sa = vec3_dot(n, e->lv[a].x) - d, sb = vec3_dot(n, e->lv[b].x) - d;
+    double t = sa / (sa - sb);
+    for (int q = 0; q < 3; q++) x[q] = e->lv[a].x[q] + t * (e->lv[b].x[q] - e->lv[a].x[q]);
+  }
+  return lv_add(e, k, x, 1, -1, -1, -1);
+}
+
+/* The solid's value with each plane on the side its bit says (scene_box's
+   classes in m->st decide every other node). */
+static int pl_eval(const Mesher *m, unsigned bits) {
+  const Scene *s = m->s;
+  int f = s->nodes[m->node].first;
+  for (int i = f; i <= m->node; i++) {
+    const ScNode *nd = &s->nodes[i];
+    int c = m->st[i - f], v;
+    if (c == T_IN || c == T_OUT) v = c == T_IN;
+    else if (nd->kind == SC_HALFSPACE) {
+      int q = m->plmap[i - f];
+      v = (int)(bits >> (q >> 1) & 1) ^ (q & 1);
+    } else {
+      int a = m->pv[nd->a - f], b = m->pv[nd->b - f];
+      v = nd->kind == SC_UNION ? a | b : nd->kind == SC_INTER ? a & b : a & !b;
+    }
+    m->pv[i - f] = (unsigned char)v;
+  }
+  return m->pv[m->node - f];
+}
+
+static int lv_global(ExTet *e, int i) {
+  LVert *v = &e->lv[i];
+  if (v->global >= 0) return v->global;
+  Mesher *m = e->m;
+  if (v->kind == 0) {
+    int pa = e->p[v->la], pb = e->p[v->lb], crossing_planes = 0;
+    for (int j = 0; j < m->cur->npl; j++)
+      crossing_planes += (e->s[j][v->la] < 0) != (e->s[j][v->lb] < 0);
+    if (m->ps[pa] != m->ps[pb] && crossing_planes == 1)
+      return v->global = edge_vertex(m, pa, pb);
+  }
+  int g = kmap_get(&m->vert2, v->key);
+  if (g >= 0) return v->global = g;
+  if (grow((void **)&m->v, &m->capv, 3 * (m->nv + 1), sizeof *m->v) < 0 ||
+      kmap_put(&m->vert2, v->key, (int)m->nv) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  memcpy(m->v + 3 * m->nv, v->x, sizeof v->x);
+  return v->global = (int)m->nv++;
+}
+
+static void pc_push(Piece *p, int v, int sup, int *bad) {
+  if (p->n == PV_MAX) {
+    *bad = 1;
+    return;
+  }
+  p->v[p->n] = v;
+  p->sup[p->n++] = sup;
+}
+
+/* The exact surface in the positively oriented tetrahedron on points p. */
+static int exact_tet(Mesher *m, const int p[4], size_t *count) {
+  ExTet *e = m->ex;
+  e->m = m;
+  e->p = p;
+  e->nlv = 0;
+  e->bad = 0;
+  int k = m->cur->npl;
+  for (int q = 0; q < 4; q++)
+    for (int a = 0; a < 3; a++) e->x[q][a] = m->org[a] + 0.5 * m->h * m->pc[3 * p[q] + a];
+  for (int j = 0; j < k; j++) {
+    double n[3], d;
+    pl_plane(m, j, n, &d);
+    for (int q = 0; q < 4; q++) e->s[j][q] = vec3_dot(n, e->x[q]) - d;
+  }
+  static const int tedge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  for (int i = 0; i < k; i++) {
+    /* plane i's polygon: its crossings of the tetrahedron's edges */
+    int cv[4], ce[4][2], nc = 0;
+    for (int q = 0; q < 6; q++) {
+      int a = tedge[q][0], b = tedge[q][1];
+      if ((e->s[i][a] < 0) == (e->s[i][b] < 0)) continue;
+      if (nc == 4) return (void)(m->err = MESH_EINTERNAL), -1;
+      cv[nc] = ex_edge(e, i, a, b);
+      ce[nc][0] = a;
+      ce[nc][1] = b;
+      nc++;
+    }
+    if (nc < 3) continue;
+    if (e->bad) return (void)(m->err = MESH_EINTERNAL), -1;
+    /* order them counter-clockwise about +n_i */
+    double n[3], d, c[3] = {0, 0, 0}, u[3], w[3], ang[4];
+    pl_plane(m, i, n, &d);
+    for (int q = 0; q < nc; q++)
+      for (int a = 0; a < 3; a++) c[a] += e->lv[cv[q]].x[a] / nc;
+    for (int a = 0; a < 3; a++) u[a] = e->lv[cv[0]].x[a] - c[a];
+    vec3_cross(n, u, w);
+    for (int q = 0; q < nc; q++) {
+      double r[3];
+      for (int a = 0; a < 3; a++) r[a] = e->lv[cv[q]].x[a] - c[a];
+      ang[q] = atan2(vec3_dot(r, w), vec3_dot(r, u));
+    }
+    int ord[4] = {0, 1, 2, 3};
+    for (int r = 0; r < nc; r++)
+      for (int q = 0; q + 1 < nc - r; q++)
+        if (ang[ord[q]] > ang[ord[q + 1]]) {
+          int t = ord[q];
+          ord[q] = ord[q + 1];
+          ord[q + 1] = t;
+        }
+    Piece *cur = e->pc[0], *nxt = e->pc[1];
+    int np = 1;
+    cur[0].n = 0;
+    cur[0].bits = 0;
+    for (int q = 0; q < nc; q++) {
+      int a = ord[q], b = ord[(q + 1) % nc], ex = 0;
+      /* the face holding both edges misses one corner */
+      int seen[4] = {0, 0, 0, 0};
+      seen[ce[a][0]] = seen[ce[a][1]] = seen[ce[b][0]] = seen[ce[b][1]] = 1;
+      while (seen[ex]) ex++;
+      pc_push(&cur[0], cv[a], -1 - ex, &e->bad);
+    }
+    for (int j = 0; j < k; j++) {
+      if (j == i) continue;
+      double nj[3], dj;
+      pl_plane(m, j, nj, &dj);
+      int nn = 0;
+      for (int r = 0; r < np; r++) {
+        Piece *P = &cur[r];
+        int in[PV_MAX], nin = 0;
+        for (int q = 0; q < P->n; q++) nin += in[q] = vec3_dot(nj, e->lv[P->v[q]].x) - dj < 0;
+        if (nin == 0 || nin == P->n) {
+          if (nn == PC_MAX) return (void)(m->err = MESH_EINTERNAL), -1;
+          nxt[nn] = *P;
+          if (nin) nxt[nn].bits |= 1u << j;
+          nn++;
+          continue;
+        }
+        if (nn + 2 > PC_MAX) return (void)(m->err = MESH_EINTERNAL), -1;
+        Piece *I = &nxt[nn], *O = &nxt[nn + 1];
+        I->n = O->n = 0;
+        I->bits = P->bits | 1u << j;
+        O->bits = P->bits;
+        for (int q = 0; q < P->n; q++) {
+          int r2 = (q + 1) % P->n;
+          pc_push(in[q] ? I : O, P->v[q], P->sup[q], &e->bad);
+          if (in[q] != in[r2]) {
+            int x = ex_split(e, i, P->sup[q], j, P->v[q], P->v[r2]);
+            if (x < 0) return (void)(m->err = MESH_EINTERNAL), -1;
+            if (in[q]) {
+              pc_push(I, x, j, &e->bad);
+              pc_push(O, x, P->sup[q], &e->bad);
+            } else {
+              pc_push(O, x, j, &e->bad);
+              pc_push(I, x, P->sup[q], &e->bad);
+            }
+          }
+        }
+        nn += 2;
+      }
+      Piece *t = cur;
+      cur = nxt;
+      nxt = t;
+      np = nn;
+    }
+    if (e->bad) return (void)(m->err = MESH_EINTERNAL), -1;
+    for (int r = 0; r < np; r++) {
+      const Piece *P = &cur[r];
+      int vin = pl_eval(m, P->bits | 1u << i), vout = pl_eval(m, P->bits & ~(1u << i));
+      if (vin == vout || P->n < 3) continue;
+      if (count) {
+        *count += (size_t)(P->n - 2);
+        continue;
+      }
+      int g[PV_MAX];
+      for (int q = 0; q < P->n; q++)
+        if ((g[q] = lv_global(e, P->v[q])) < 0) return -1;
+      for (int q = 1; q + 1 < P->n; q++) {
+        int rc = vin ? emit(m, g[0], g[q], g[q + 1]) : emit(m, g[0], g[q + 1], g[q]);
+        if (rc < 0) return -1;
+      }
+    }
+  }
+  return 0;
+}
+
 /* The Kuhn split: 6 tetrahedra around the diagonal 0 - 7, each ordered to
    positive orientation (corner masks: bit 0 x, 1 y, 2 z). */
 static const int kuhn[6][4] = {
@@ -917,6 +1385,27 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
   m->cur = lf;
   int l = lf->level, plain = 1;
   int64_t q[3] = {lf->q[0], lf->q[1], lf->q[2]};
+  int (*mk)(Mesher *, const int *, size_t *) = tet;
+  if (lf->kind == LEAF_EXACT) {
+    /* the classes over this box again, for pl_eval, and each undecided
+       halfspace's plane in the cell's list */
+    double side = ldexp(m->h, m->depth - l), lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+      lo[a] = m->org[a] + side * (double)q[a];
+      hi[a] = lo[a] + side;
+    }
+    int one, f = m->s->nodes[m->node].first;
+    scene_box(m->s, m->node, lo, hi, m->st, m->one, &one);
+    for (int x = f; x <= m->node; x++) {
+      if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+      int y = 0;
+      while (y < lf->npl && !same_surface(m->s, m->pls[lf->pl0 + y], x)) y++;
+      if (y == lf->npl) return (void)(m->err = MESH_EINTERNAL), -1;
+      const ScNode *a = &m->s->nodes[x], *b = &m->s->nodes[m->pls[lf->pl0 + y]];
+      m->plmap[x - f] = 2 * y + (vec3_dot(a->n, b->n) < 0);
+    }
+    mk = exact_tet;
+  }
   m->nft = 0;
   if (l < m->depth)
     for (int a = 0; a < 3; a++)
@@ -932,7 +1421,7 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
     }
     for (int t = 0; t < 6; t++) {
       int p[4] = {c[kuhn[t][0]], c[kuhn[t][1]], c[kuhn[t][2]], c[kuhn[t][3]]};
-      if (tet(m, p, count) < 0) return -1;
+      if (mk(m, p, count) < 0) return -1;
     }
     return 0;
   }
@@ -944,7 +1433,7 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
     /* (a, b, c) counter-clockwise from outside, the centre inside:
        (a, c, b, centre) is positive */
     int p[4] = {m->ft[i], m->ft[i + 2], m->ft[i + 1], cp};
-    if (tet(m, p, count) < 0) return -1;
+    if (mk(m, p, count) < 0) return -1;
   }
   return 0;
 }
@@ -963,8 +1452,9 @@ static int unbounded_leaf(const Scene *s, int node) {
   }
 }
 
-int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
-               MeshReport *rep, int *bad_node, char *err, size_t errlen) {
+static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
+                    Mesh **out, MeshReport *rep, int *bad_node, char *err,
+                    size_t errlen, int sharp) {
   struct timespec t0, t1;
   clock_gettime(CLOCK_MONOTONIC, &t0);
   memset(rep, 0, sizeof *rep);
@@ -1012,7 +1502,7 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
     return MESH_ETOL;
   }
   double vtol = fmax(0.01 * e, 64 * RAY_TOL_FLOOR * scale);
-  double ht = e - vtol, L = size + 2 * ht;
+  double ht = e - vtol, L = size + 3 * ht;
   int depth = 0;
   while (L / ldexp(1, depth) > ht) depth++;
   if (depth > MAX_DEPTH) {
@@ -1029,11 +1519,17 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
   m.h = L / ldexp(1, depth);
   m.tol = e;
   m.vtol = vtol;
+  m.sharp = sharp;
   m.rep = rep;
   m.max_cells = ms->max_cells ? ms->max_cells : (size_t)1 << 24;
   for (int i = 0; i < 3; i++) {
     double c = 0.5 * (lo[i] + hi[i]);
-    m.org[i] = c - 0.5 * L;
+    /* off centre by a fraction of a cell unlike on each axis, so that a
+       centred object's diagonals and faces miss the grid's (a plane
+       through a grid point or along a tetrahedron's face is a degenerate
+       case for the sharp cells) */
+    static const double shift[3] = {0.1713, 0.2389, 0.3167};
+    m.org[i] = c - 0.5 * L + shift[i] * ht;
     /* the clip box: the user's box where it cuts the object, else no
        clip (the object's box is conservative; a clip there would keep
        the cells at its faces from being proven plane) */
@@ -1047,9 +1543,12 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
   m.st = malloc((size_t)nsub);
   m.one = malloc((size_t)nsub * sizeof *m.one);
   m.gst = malloc(DT_STACK_MAX * sizeof *m.gst);
+  m.plmap = malloc((size_t)nsub * sizeof *m.plmap);
+  m.pv = malloc((size_t)nsub);
+  m.ex = malloc(sizeof *m.ex);
   m.ray = ray_ctx_new(s, vtol);
   int rc = MESH_OK;
-  if (!m.st || !m.one || !m.gst || !m.ray) {
+  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.ex || !m.ray) {
     rc = MESH_ENOMEM;
     goto done;
   }
@@ -1130,6 +1629,12 @@ done:
   free(m.st);
   free(m.one);
   free(m.gst);
+  free(m.plmap);
+  free(m.pv);
+  free(m.ex);
+  free(m.pls);
+  free(m.vert2.k);
+  free(m.vert2.v);
   free(m.leaves);
   free(m.v);
   free(m.t);
@@ -1392,5 +1897,19 @@ int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
   }
   int rc = img_write_bytes(path, b.p, b.n, err, errlen);
   free(b.p);
+  return rc;
+}
+
+int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
+               MeshReport *rep, int *bad_node, char *err, size_t errlen) {
+  int rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, 1);
+  if (rc == MESH_EINTERNAL) {
+    /* a degenerate case decided differently by two sharp cells: the
+       marching cells alone are closed by construction */
+    double t = rep->seconds;
+    rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, 0);
+    rep->seconds += t;
+    rep->sharp_off = 1;
+  }
   return rc;
 }

@@ -68,6 +68,10 @@ typedef struct MeshReport {
   long planar, smooth;     /* of them kept above the finest level: the
                               surface proven one plane, or proven close
                               enough by the gradient bound */
+  long sharp;              /* of them meshed exactly: the solid there is a
+                              CSG of at most 8 planes (edges and corners
+                              kept) */
+  int sharp_off;           /* sharp cells were given up (see mesh.c) */
   int depth;               /* finest level */
   double h;                /* finest cell side */
   double vtol;             /* the vertices' distance bound */

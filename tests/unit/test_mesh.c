@@ -235,6 +235,8 @@ static void one(const char *name, const char *src, double tol, long euler,
   snprintf(buf, sizeof buf, "%s: certified error %.4g <= tolerance %.4g", name,
            rep.certified, tol);
   CHECK(buf, rep.certified <= tol);
+  snprintf(buf, sizeof buf, "%s: the sharp cells were kept", name);
+  CHECK(buf, !rep.sharp_off);
   double v = volume(m);
   snprintf(buf, sizeof buf, "%s: outward (signed volume %.4f > 0)", name, v);
   CHECK(buf, v > 0);
@@ -250,9 +252,10 @@ static void one(const char *name, const char *src, double tol, long euler,
     snprintf(buf, sizeof buf, "%s: ray crossings within tol of the mesh (worst %.3g)", name, w);
     CHECK(buf, w <= tol);
   }
-  printf("# %s: %zu triangles, %ld cells (%ld empty, %ld full, %ld meshed), "
-         "certified %.4g, %.3f s\n", name, rep.triangles, rep.cells, rep.empty,
-         rep.full, rep.leaves, rep.certified, rep.seconds);
+  printf("# %s: %zu triangles, %ld cells (%ld empty, %ld full, %ld meshed: "
+         "%ld plane, %ld smooth, %ld sharp), certified %.4g, %.3f s\n", name,
+         rep.triangles, rep.cells, rep.empty, rep.full, rep.leaves, rep.planar,
+         rep.smooth, rep.sharp, rep.certified, rep.seconds);
   mesh_free(m);
   scene_free(s);
 }
@@ -270,6 +273,8 @@ static void bad_input(void) {
     CHECK("bad tolerance refused", mesh_scene(s, s->root, &ms, &m, &rep, &bad, err,
                                               sizeof err) == MESH_ETOL && !m);
   }
+  scene_free(s);
+  s = compile("Rounded 0.2 UnitCube"); /* a sharp cube is 40 triangles */
   ms.tol = 0.05;
   ms.max_triangles = 100;
   CHECK("max-triangles refused before the crossings",
