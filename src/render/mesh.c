@@ -532,6 +532,17 @@ typedef struct {
   unsigned char *pv;       /* pl_eval scratch */
   struct ExTet *ex;        /* exact_tet scratch */
   kmap vert2;              /* named corners of sharp cells -> mesh vertex */
+  hmap crease;             /* (u, v) -> the surface's path between the
+                              edge vertices u < v on a sharp cell's face,
+                              poly[off] points then the points in order */
+  int *poly;
+  size_t npoly, cappoly;
+  kmap fpath;              /* (vertex, axis, plane) -> the next vertex of
+                              a sharp cell's surface along a cell face */
+  uint64_t *fstart;        /* the keys of fpath, in order */
+  size_t nfs, capfs;
+  unsigned char *uni;      /* per mesh vertex: made by edge_vertex */
+  size_t capuni;
   RayCtx *ray;
   MeshReport *rep;
   int err;                 /* MESH_E* */
@@ -774,6 +785,11 @@ static int edge_vertex(Mesher *m, int pa, int pb) {
     m->err = MESH_ENOMEM;
     return -1;
   }
+  if (grow((void **)&m->uni, &m->capuni, m->nv + 1, 1) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->uni[m->nv] = 1;
   double *p = m->v + 3 * m->nv;
   for (int q = 0; q < 3; q++) p[q] = a[q] + t * (b[q] - a[q]);
   v = (int)m->nv++;
@@ -842,6 +858,32 @@ static int parity4(const int p[4]) {
   return inv & 1;
 }
 
+/* A marching triangle whose edge (u, v) lies on a face where a sharp
+   neighbour put the crease point c between u and v is split there, so
+   the two sides meet edge to edge (c is on the surface and in the cell,
+   so the cell's proof still covers the pieces). */
+static int emit_split(Mesher *m, int a, int b, int c, int depth) {
+  if (a < 0 || b < 0 || c < 0) return -1;
+  if (m->crease.n && depth < 4) {
+    int t[3] = {a, b, c};
+    for (int e = 0; e < 3; e++) {
+      int u = t[e], v = t[(e + 1) % 3], w = t[(e + 2) % 3];
+      uint64_t key = u < v ? (uint64_t)u << 32 | (uint64_t)v
+                           : (uint64_t)v << 32 | (uint64_t)u;
+      int off = hget(&m->crease, key);
+      if (off < 0) continue;
+      int n = m->poly[off], prev = u;
+      for (int q = 0; q <= n; q++) {
+        int x = q == n ? v : m->poly[off + 1 + (u < v ? q : n - 1 - q)];
+        if (emit_split(m, prev, x, w, depth + 1) < 0) return -1;
+        prev = x;
+      }
+      return 0;
+    }
+  }
+  return emit(m, a, b, c);
+}
+
 /* Marching tetrahedra: the triangles of the positively oriented
    tetrahedron on points c. When count is set, only count them. */
 static int tet(Mesher *m, const int c[4], size_t *count) {
@@ -858,7 +900,7 @@ static int tet(Mesher *m, const int c[4], size_t *count) {
     int e1 = edge_vertex(m, c[p[0]], c[p[1]]);
     int e2 = edge_vertex(m, c[p[0]], c[p[2]]);
     int e3 = edge_vertex(m, c[p[0]], c[p[3]]);
-    return n == 1 ? emit(m, e1, e2, e3) : emit(m, e1, e3, e2);
+    return n == 1 ? emit_split(m, e1, e2, e3, 0) : emit_split(m, e1, e3, e2, 0);
   }
   if (count) return (void)(*count += 2), 0;
   int p[4], a = 0, b = 2;
@@ -877,8 +919,8 @@ static int tet(Mesher *m, const int c[4], size_t *count) {
   int q3 = edge_vertex(m, c[p[1]], c[p[2]]);
   if (q0 < 0 || q1 < 0 || q2 < 0 || q3 < 0) return -1;
   if (dist3(m->v + 3 * q0, m->v + 3 * q2) <= dist3(m->v + 3 * q1, m->v + 3 * q3))
-    return emit(m, q0, q1, q2) < 0 ? -1 : emit(m, q0, q2, q3);
-  return emit(m, q1, q2, q3) < 0 ? -1 : emit(m, q1, q3, q0);
+    return emit_split(m, q0, q1, q2, 0) < 0 ? -1 : emit_split(m, q0, q2, q3, 0);
+  return emit_split(m, q1, q2, q3, 0) < 0 ? -1 : emit_split(m, q1, q3, q0, 0);
 }
 
 /* ---- a conforming tetrahedral mesh of the octree's surface leaves ----------
@@ -1039,6 +1081,7 @@ typedef struct {
   double x[3];
   int kind, la, lb, plane; /* kind 0: plane on a tetrahedron edge */
   int global;              /* mesh vertex, -1 until needed */
+  int unified;             /* global is the marching cells' edge vertex */
 } LVert;
 
 typedef struct ExTet {
@@ -1049,6 +1092,8 @@ typedef struct ExTet {
   LVert lv[LV_MAX];
   int nlv;
   Piece pc[2][PC_MAX];
+  int fe[LV_MAX][3];       /* surface edges on the faces: face, from, to */
+  int nfe;
   int bad;
 } ExTet;
 
@@ -1099,6 +1144,7 @@ static int lv_add(ExTet *e, const uint64_t k[4], const double x[3], int kind,
   v->lb = lb;
   v->plane = plane;
   v->global = -1;
+  v->unified = 0;
   return e->nlv++;
 }
 
@@ -1221,11 +1267,38 @@ static int lv_global(ExTet *e, int i) {
   if (v->global >= 0) return v->global;
   Mesher *m = e->m;
   if (v->kind == 0) {
-    int pa = e->p[v->la], pb = e->p[v->lb], crossing_planes = 0;
-    for (int j = 0; j < m->cur->npl; j++)
-      crossing_planes += (e->s[j][v->la] < 0) != (e->s[j][v->lb] < 0);
-    if (m->ps[pa] != m->ps[pb] && crossing_planes == 1)
+    /* the solid's value along the edge, between the planes' crossings:
+       one change, with the ends' signs differing, is the one crossing a
+       marching neighbour finds there too */
+    int pa = e->p[v->la], pb = e->p[v->lb], k = m->cur->npl, nt = 0;
+    double t[PL_MAX + 1];
+    for (int j = 0; j < k; j++) {
+      double sa = e->s[j][v->la], sb = e->s[j][v->lb];
+      if ((sa < 0) != (sb < 0)) t[nt++] = sa / (sa - sb);
+    }
+    for (int r = 0; r < nt; r++)
+      for (int q = 0; q + 1 < nt - r; q++)
+        if (t[q] > t[q + 1]) {
+          double x = t[q];
+          t[q] = t[q + 1];
+          t[q + 1] = x;
+        }
+    int changes = 0, prev = -1;
+    for (int r = 0; r <= nt; r++) {
+      double u = 0.5 * ((r ? t[r - 1] : 0) + (r < nt ? t[r] : 1));
+      unsigned bits = 0;
+      for (int j = 0; j < k; j++) {
+        double sa = e->s[j][v->la], sb = e->s[j][v->lb];
+        if (sa + u * (sb - sa) < 0) bits |= 1u << j;
+      }
+      int val = pl_eval(m, bits);
+      changes += prev >= 0 && val != prev;
+      prev = val;
+    }
+    if (m->ps[pa] != m->ps[pb] && changes == 1) {
+      v->unified = 1;
       return v->global = edge_vertex(m, pa, pb);
+    }
   }
   int g = kmap_get(&m->vert2, v->key);
   if (g >= 0) return v->global = g;
@@ -1234,6 +1307,11 @@ static int lv_global(ExTet *e, int i) {
     m->err = MESH_ENOMEM;
     return -1;
   }
+  if (grow((void **)&m->uni, &m->capuni, m->nv + 1, 1) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->uni[m->nv] = 0;
   memcpy(m->v + 3 * m->nv, v->x, sizeof v->x);
   return v->global = (int)m->nv++;
 }
@@ -1253,6 +1331,7 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
   e->m = m;
   e->p = p;
   e->nlv = 0;
+  e->nfe = 0;
   e->bad = 0;
   int k = m->cur->npl;
   for (int q = 0; q < 4; q++)
@@ -1364,6 +1443,36 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
       int g[PV_MAX];
       for (int q = 0; q < P->n; q++)
         if ((g[q] = lv_global(e, P->v[q])) < 0) return -1;
+      /* its edges on the cell's faces, as the surface runs (paths) */
+      for (int q = 0; q < P->n; q++) {
+        if (P->sup[q] >= 0) continue;
+        int ex = -1 - P->sup[q], ax = -1;
+        for (int a = 0; a < 3 && ax < 0; a++) {
+          uint32_t c0 = UINT32_MAX;
+          int same = 1;
+          for (int r2 = 0; r2 < 4; r2++)
+            if (r2 != ex) {
+              uint32_t cc = m->pc[3 * p[r2] + a];
+              if (c0 == UINT32_MAX) c0 = cc;
+              else same &= cc == c0;
+            }
+          if (same) ax = a;
+        }
+        if (ax < 0) continue; /* inside the cell */
+        int ga = g[q], gb = g[(q + 1) % P->n];
+        if (!vin) {
+          int t = ga;
+          ga = gb;
+          gb = t;
+        }
+        uint64_t key[4] = {(uint64_t)ga, (uint64_t)ax,
+                           m->pc[3 * p[ex == 0 ? 1 : 0] + ax], 0};
+        if (kmap_get(&m->fpath, key) >= 0) continue;
+        if (kmap_put(&m->fpath, key, gb) < 0 ||
+            grow((void **)&m->fstart, &m->capfs, 4 * (m->nfs + 1), sizeof *m->fstart) < 0)
+          return (void)(m->err = MESH_ENOMEM), -1;
+        memcpy(m->fstart + 4 * m->nfs++, key, sizeof key);
+      }
       for (int q = 1; q + 1 < P->n; q++) {
         int rc = vin ? emit(m, g[0], g[q], g[q + 1]) : emit(m, g[0], g[q + 1], g[q]);
         if (rc < 0) return -1;
@@ -1450,6 +1559,54 @@ static int unbounded_leaf(const Scene *s, int node) {
       node = nd->b;
     else return node;
   }
+}
+
+/* The sharp cells' surface along each cell face, from one vertex that a
+   marching neighbour also makes (edge_vertex) to the next, through crease
+   points and double crossings: a marching triangle edge (u, v) on that
+   face is split into the same path (emit_split: a fan from the
+   triangle's third vertex over a simple path in the face's plane). */
+static int face_paths(Mesher *m) {
+  for (size_t f = 0; f < m->nfs; f++) {
+    uint64_t key[4];
+    memcpy(key, m->fstart + 4 * f, sizeof key);
+    int a = (int)key[0];
+    if (!m->uni[a]) continue;
+    size_t mark = m->npoly;
+    if (grow((void **)&m->poly, &m->cappoly, m->npoly + 1, sizeof *m->poly) < 0)
+      return (void)(m->err = MESH_ENOMEM), -1;
+    m->npoly++;
+    int cur = a, n = 0, ok = 1;
+    for (;;) {
+      key[0] = (uint64_t)cur;
+      int nx = kmap_get(&m->fpath, key);
+      if (nx < 0 || n > 1000) {
+        ok = 0;
+        break;
+      }
+      cur = nx;
+      if (m->uni[cur]) break;
+      if (grow((void **)&m->poly, &m->cappoly, m->npoly + 1, sizeof *m->poly) < 0)
+        return (void)(m->err = MESH_ENOMEM), -1;
+      m->poly[m->npoly++] = cur;
+      n++;
+    }
+    uint64_t pk = a < cur ? (uint64_t)a << 32 | (uint64_t)cur
+                          : (uint64_t)cur << 32 | (uint64_t)a;
+    if (!ok || n == 0 || hget(&m->crease, pk) >= 0) {
+      m->npoly = mark;
+      continue;
+    }
+    m->poly[mark] = n;
+    if (cur < a) /* stored from the lower index to the higher */
+      for (int q = 0; q < n / 2; q++) {
+        int t = m->poly[mark + 1 + (size_t)q];
+        m->poly[mark + 1 + (size_t)q] = m->poly[mark + (size_t)n - (size_t)q];
+        m->poly[mark + (size_t)n - (size_t)q] = t;
+      }
+    if (hput(&m->crease, pk, (int)mark) < 0) return (void)(m->err = MESH_ENOMEM), -1;
+  }
+  return 0;
 }
 
 static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
@@ -1586,11 +1743,19 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_ELIMIT;
     goto done;
   }
-  for (size_t l = 0; l < m.nleaves; l++)
-    if (cell(&m, l, NULL) < 0) {
+  /* the sharp cells first: their crease points split the marching
+     triangles next to them */
+  for (int pass = 0; pass < 2; pass++) {
+    for (size_t l = 0; l < m.nleaves; l++)
+      if ((m.leaves[l].kind == LEAF_EXACT) == !pass && cell(&m, l, NULL) < 0) {
+        rc = m.err;
+        goto done;
+      }
+    if (!pass && face_paths(&m) < 0) {
       rc = m.err;
       goto done;
     }
+  }
   if (m.ray->failed) {
     rc = MESH_ENOMEM;
     goto done;
@@ -1643,6 +1808,12 @@ done:
   free(m.fl);
   free(m.ft);
   hfree(&m.split);
+  hfree(&m.crease);
+  free(m.poly);
+  free(m.fpath.k);
+  free(m.fpath.v);
+  free(m.fstart);
+  free(m.uni);
   hfree(&m.pt);
   hfree(&m.vert);
   if (m.ray) ray_ctx_free(m.ray);
