@@ -55,6 +55,16 @@ static int do_mesh(const struct Scene *s, const MeshSettings *ms,
   }
   int rc = mesh_scene(s, s->root, &m2, &m, &rep, bad, err, errlen);
   if (rc) return rc;
+  size_t pl = strlen(path);
+  if (pl > 4 && (!strcmp(path + pl - 4, ".ply") || !strcmp(path + pl - 4, ".3mf"))) {
+    /* the renderer's default object colour where no Colour is given */
+    static const double grey[3] = {0.80, 0.78, 0.72};
+    if (mesh_colour(s, s->root, m, grey, 4 * rep.vtol) < 0) {
+      mesh_free(m);
+      snprintf(err, errlen, "out of memory while colouring the mesh");
+      return -1;
+    }
+  }
   rc = mesh_write(m, path, err, errlen);
   mesh_free(m);
   if (rc) return -1;
@@ -130,7 +140,8 @@ static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
     }
   }
   if (!mesh_is_mesh_path(path))
-    qcs_error(pos, "cannot write %s: a mesh is written as .stl or .obj", path);
+    qcs_error(pos, "cannot write %s: a mesh is written as .stl, .obj, .ply "
+              "or .3mf", path);
   char err[512];
   if (render_writable(path, err, sizeof err) < 0) qcs_error(pos, "%s", err);
   Scene *s = compile_scene(I, args[2], pos);
@@ -148,7 +159,8 @@ static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
 
 static const Builtin mesh_builtins[] = {
     {"meshWith", 3, bi_mesh_with,
-     "meshWith settings file object: a closed triangle mesh (.stl, .obj) "
+     "meshWith settings file object: a closed triangle mesh (.stl, .obj, "
+     ".ply, .3mf) "
      "within Tolerance e; e.g. meshWith [Tolerance 0.05, Quiet] "
      "\"cube.obj\" (Rounded 0.1 UnitCube)"},
 };

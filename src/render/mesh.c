@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <zip.h>
 
 #include "core/bounds.h"
 #include "core/interval.h"
@@ -1767,6 +1768,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   }
   me->nv = m.nv;
   me->nt = m.nt;
+  me->rgb = NULL;
   me->v = m.v;
   me->t = m.t;
   m.v = NULL;
@@ -1825,6 +1827,7 @@ done:
 
 void mesh_free(Mesh *m) {
   if (!m) return;
+  free(m->rgb);
   free(m->v);
   free(m->t);
   free(m);
@@ -1964,7 +1967,112 @@ static const char *ext_of(const char *path) {
 
 int mesh_is_mesh_path(const char *path) {
   const char *e = ext_of(path);
-  return !strcmp(e, "stl") || !strcmp(e, "obj");
+  return !strcmp(e, "stl") || !strcmp(e, "obj") || !strcmp(e, "ply") ||
+         !strcmp(e, "3mf");
+}
+
+/* ---- colours ------------------------------------------------------------ */
+
+/* The top-level union's parts with their inherited Colour (as the tracer
+   collects them). */
+static int collect_parts(const Scene *s, int root, int **parts,
+                         const double ***cols, int *n) {
+  int cap = 16, sp = 0, capst = 16;
+  int *st = malloc((size_t)capst * sizeof *st);
+  const double **stc = malloc((size_t)capst * sizeof *stc);
+  *parts = malloc((size_t)cap * sizeof **parts);
+  *cols = malloc((size_t)cap * sizeof **cols);
+  *n = 0;
+  if (!st || !stc || !*parts || !*cols) goto nomem;
+  st[sp] = root;
+  stc[sp++] = NULL;
+  while (sp) {
+    sp--;
+    int nd = st[sp];
+    const ScNode *x = &s->nodes[nd];
+    const double *c = x->has_colour ? x->colour : stc[sp];
+    if (x->kind == SC_UNION) {
+      if (sp + 2 > capst) {
+        capst *= 2;
+        int *g = realloc(st, (size_t)capst * sizeof *st);
+        if (g) st = g;
+        const double **gc = realloc(stc, (size_t)capst * sizeof *stc);
+        if (gc) stc = gc;
+        if (!g || !gc) goto nomem;
+      }
+      st[sp] = x->b;
+      stc[sp++] = c;
+      st[sp] = x->a;
+      stc[sp++] = c;
+      continue;
+    }
+    if (*n == cap) {
+      cap *= 2;
+      int *g = realloc(*parts, (size_t)cap * sizeof **parts);
+      if (g) *parts = g;
+      const double **gc = realloc(*cols, (size_t)cap * sizeof **cols);
+      if (gc) *cols = gc;
+      if (!g || !gc) goto nomem;
+    }
+    (*parts)[*n] = nd;
+    (*cols)[(*n)++] = c;
+  }
+  free(st);
+  free(stc);
+  return 0;
+nomem:
+  free(st);
+  free(stc);
+  free(*parts);
+  free(*cols);
+  *parts = NULL;
+  *cols = NULL;
+  return -1;
+}
+
+int mesh_colour(const Scene *s, int node, Mesh *m, const double def[3],
+                double inset) {
+  int *parts, np;
+  const double **cols;
+  if (collect_parts(s, node, &parts, &cols, &np) < 0) return -1;
+  double *vn = calloc(3 * (m->nv ? m->nv : 1), sizeof *vn);
+  float *rgb = malloc(3 * (m->nv ? m->nv : 1) * sizeof *rgb);
+  if (!vn || !rgb) {
+    free(vn);
+    free(rgb);
+    free(parts);
+    free(cols);
+    return -1;
+  }
+  for (size_t i = 0; i < m->nt; i++) {
+    const int *t = m->t + 3 * i;
+    const double *a = m->v + 3 * t[0], *b = m->v + 3 * t[1], *c = m->v + 3 * t[2];
+    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]}, n[3];
+    vec3_cross(u, w, n);
+    for (int k = 0; k < 3; k++)
+      for (int j = 0; j < 3; j++) vn[3 * (size_t)t[k] + (size_t)j] += n[j];
+  }
+  /* a vertex takes the colour of the first part holding a point just
+     inside the surface below it */
+  for (size_t i = 0; i < m->nv; i++) {
+    double *n = vn + 3 * i, l = sqrt(vec3_dot(n, n)), q[3];
+    for (int j = 0; j < 3; j++)
+      q[j] = m->v[3 * i + (size_t)j] - (l > 0 ? inset * n[j] / l : 0);
+    const double *c = def;
+    for (int k = 0; k < np; k++)
+      if (scene_inside(s, parts[k], q) == 1) {
+        if (cols[k]) c = cols[k];
+        break;
+      }
+    for (int j = 0; j < 3; j++) rgb[3 * i + (size_t)j] = (float)c[j];
+  }
+  free(vn);
+  free(parts);
+  free(cols);
+  free(m->rgb);
+  m->rgb = rgb;
+  return 0;
 }
 
 typedef struct {
@@ -2005,6 +2113,166 @@ static void tri_normal(const Mesh *m, size_t i, double n[3]) {
   double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
   double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
   vec3_cross(u, w, n);
+}
+
+static void put_le(buf *b, uint32_t u, int n) {
+  unsigned char q[4];
+  for (int i = 0; i < n; i++) q[i] = (unsigned char)(u >> (8 * i));
+  put(b, q, (size_t)n);
+}
+
+static unsigned char vcolour(const Mesh *m, size_t v, int k) {
+  static const float grey[3] = {0.80f, 0.78f, 0.72f};
+  return img_srgb8(m->rgb ? m->rgb[3 * v + (size_t)k] : grey[k]);
+}
+
+/* Binary little-endian PLY: float x y z, uchar red green blue (sRGB) per
+   vertex, a uchar-counted int list per face. */
+static void write_ply(const Mesh *m, buf *b) {
+  char head[400];
+  int len = snprintf(head, sizeof head,
+                     "ply\nformat binary_little_endian 1.0\ncomment written "
+                     "by qcs\nelement vertex %zu\nproperty float x\nproperty "
+                     "float y\nproperty float z\nproperty uchar red\nproperty "
+                     "uchar green\nproperty uchar blue\nelement face %zu\n"
+                     "property list uchar int vertex_indices\nend_header\n",
+                     m->nv, m->nt);
+  put(b, head, (size_t)len);
+  for (size_t i = 0; i < m->nv; i++) {
+    for (int k = 0; k < 3; k++) put_f32(b, m->v[3 * i + (size_t)k]);
+    unsigned char c[3];
+    for (int k = 0; k < 3; k++) c[k] = vcolour(m, i, k);
+    put(b, c, 3);
+  }
+  for (size_t i = 0; i < m->nt; i++) {
+    put(b, "\3", 1);
+    for (int k = 0; k < 3; k++) put_le(b, (uint32_t)m->t[3 * i + (size_t)k], 4);
+  }
+}
+
+static void put_str(buf *b, const char *s) { put(b, s, strlen(s)); }
+
+/* 3MF (core specification): the model XML with one base material per
+   distinct colour, each triangle taking its first vertex's; zipped in
+   memory by libzip and written whole by img_write_bytes. */
+static int write_3mf(const Mesh *m, const char *path, char *err,
+                     size_t errlen) {
+  buf x = {0};
+  char line[200];
+  /* the distinct colours */
+  uint32_t *pal = NULL;
+  int *tc = malloc((m->nt ? m->nt : 1) * sizeof *tc);
+  size_t npal = 0, cappal = 0;
+  hmap idx = {0};
+  int rc = -1;
+  if (!tc) goto nomem;
+  for (size_t i = 0; i < m->nt; i++) {
+    size_t v = (size_t)m->t[3 * i];
+    uint32_t c = (uint32_t)vcolour(m, v, 0) << 16 | (uint32_t)vcolour(m, v, 1) << 8 |
+                 vcolour(m, v, 2);
+    int k = hget(&idx, c);
+    if (k < 0) {
+      if (grow((void **)&pal, &cappal, npal + 1, sizeof *pal) < 0 ||
+          hput(&idx, c, (int)npal) < 0)
+        goto nomem;
+      pal[npal] = c;
+      k = (int)npal++;
+    }
+    tc[i] = k;
+  }
+  put_str(&x, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\""
+              "millimeter\" xml:lang=\"en-US\" xmlns=\"http://schemas."
+              "microsoft.com/3dmanufacturing/core/2015/02\">\n <metadata "
+              "name=\"Application\">qcs</metadata>\n <resources>\n  "
+              "<basematerials id=\"1\">\n");
+  for (size_t i = 0; i < npal; i++) {
+    snprintf(line, sizeof line, "   <base name=\"colour %zu\" displaycolor="
+             "\"#%06X\" />\n", i, (unsigned)pal[i]);
+    put_str(&x, line);
+  }
+  put_str(&x, "  </basematerials>\n  <object id=\"2\" type=\"model\" "
+              "pid=\"1\" pindex=\"0\">\n   <mesh>\n    <vertices>\n");
+  for (size_t i = 0; i < m->nv; i++) {
+    snprintf(line, sizeof line, "     <vertex x=\"%.9g\" y=\"%.9g\" z=\"%.9g\" />\n",
+             m->v[3 * i], m->v[3 * i + 1], m->v[3 * i + 2]);
+    put_str(&x, line);
+  }
+  put_str(&x, "    </vertices>\n    <triangles>\n");
+  for (size_t i = 0; i < m->nt; i++) {
+    const int *t = m->t + 3 * i;
+    snprintf(line, sizeof line, "     <triangle v1=\"%d\" v2=\"%d\" v3=\"%d\" "
+             "pid=\"1\" p1=\"%d\" />\n", t[0], t[1], t[2], tc[i]);
+    put_str(&x, line);
+  }
+  put_str(&x, "    </triangles>\n   </mesh>\n  </object>\n </resources>\n "
+              "<build>\n  <item objectid=\"2\" />\n </build>\n</model>\n");
+  if (x.bad) goto nomem;
+  static const char types[] =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Types xmlns=\"http://"
+      "schemas.openxmlformats.org/package/2006/content-types\">\n <Default "
+      "Extension=\"rels\" ContentType=\"application/vnd.openxmlformats-"
+      "package.relationships+xml\" />\n <Default Extension=\"model\" "
+      "ContentType=\"application/vnd.ms-package.3dmanufacturing-3dmodel+xml\""
+      " />\n</Types>\n";
+  static const char rels[] =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Relationships xmlns=\""
+      "http://schemas.openxmlformats.org/package/2006/relationships\">\n "
+      "<Relationship Target=\"/3D/3dmodel.model\" Id=\"rel0\" Type=\"http://"
+      "schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel\" />\n"
+      "</Relationships>\n";
+  zip_error_t ze;
+  zip_error_init(&ze);
+  zip_source_t *src = zip_source_buffer_create(NULL, 0, 0, &ze);
+  zip_t *za = src ? zip_open_from_source(src, ZIP_TRUNCATE, &ze) : NULL;
+  if (!za) {
+    if (src) zip_source_free(src);
+    zip_error_fini(&ze);
+    goto nomem;
+  }
+  zip_source_keep(src);
+  const char *names[3] = {"[Content_Types].xml", "_rels/.rels", "3D/3dmodel.model"};
+  const void *data[3] = {types, rels, x.p};
+  size_t lens[3] = {sizeof types - 1, sizeof rels - 1, x.n};
+  int zok = 1;
+  for (int i = 0; i < 3 && zok; i++) {
+    zip_source_t *fs = zip_source_buffer(za, data[i], lens[i], 0);
+    if (!fs || zip_file_add(za, names[i], fs, ZIP_FL_OVERWRITE) < 0) {
+      if (fs) zip_source_free(fs);
+      zok = 0;
+    }
+  }
+  if (!zok || zip_close(za) < 0) {
+    if (zok) zip_discard(za);
+    else zip_discard(za);
+    zip_source_free(src);
+    zip_error_fini(&ze);
+    goto nomem;
+  }
+  zip_stat_t st;
+  char *bytes = NULL;
+  if (zip_source_open(src) == 0) {
+    if (zip_source_stat(src, &st) == 0 && (st.valid & ZIP_STAT_SIZE) &&
+        (bytes = malloc(st.size ? (size_t)st.size : 1)) != NULL &&
+        zip_source_read(src, bytes, st.size) == (zip_int64_t)st.size)
+      rc = img_write_bytes(path, bytes, (size_t)st.size, err, errlen);
+    else rc = -2;
+    zip_source_close(src);
+  } else rc = -2;
+  free(bytes);
+  zip_source_free(src);
+  zip_error_fini(&ze);
+  if (rc == -2) goto nomem;
+  goto out;
+nomem:
+  snprintf(err, errlen, "cannot write %s: out of memory (or the zip "
+           "library failed)", path);
+  rc = -1;
+out:
+  free(x.p);
+  free(pal);
+  free(tc);
+  hfree(&idx);
+  return rc;
 }
 
 int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
@@ -2056,9 +2324,13 @@ int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
       put(&b, line, (size_t)len);
     }
     free(vn);
+  } else if (!strcmp(ext_of(path), "ply")) {
+    write_ply(m, &b);
+  } else if (!strcmp(ext_of(path), "3mf")) {
+    return write_3mf(m, path, err, errlen);
   } else {
-    snprintf(err, errlen, "cannot write %s: a mesh is written as .stl or "
-             ".obj", path);
+    snprintf(err, errlen, "cannot write %s: a mesh is written as .stl, "
+             ".obj, .ply or .3mf", path);
     return -1;
   }
   if (b.bad) {

@@ -59,6 +59,7 @@ typedef struct Mesh {
   double *v;               /* 3 nv coordinates */
   int *t;                  /* 3 nt vertex indices, counter-clockwise seen
                               from outside */
+  float *rgb;              /* 3 nv linear colours (mesh_colour), or NULL */
 } Mesh;
 
 typedef struct MeshReport {
@@ -111,9 +112,17 @@ typedef struct MeshCheck {
    else -1 (details in *c); -2 when memory runs out. */
 int mesh_check(const Mesh *m, MeshCheck *c);
 
-/* 1 if the file name asks for a mesh (.stl, .obj), else 0. */
+/* Colours m's vertices: each takes the Colour of the first part of the
+   scene's top-level union that holds the point inset below it along the
+   vertex normal (def where no part has a Colour). 0, or -1 out of memory. */
+int mesh_colour(const Scene *s, int node, Mesh *m, const double def[3],
+                double inset);
+
+/* 1 if the file name asks for a mesh (.stl, .obj, .ply, .3mf), else 0. */
 int mesh_is_mesh_path(const char *path);
-/* Writes m to path, binary STL or OBJ with vertex normals by extension,
-   whole or not at all (a temporary file renamed into place). */
+/* Writes m to path by extension: binary STL, OBJ with vertex normals,
+   binary PLY with per-vertex sRGB colour, or 3MF (a zip made in memory by
+   libzip, one base material per colour); whole or not at all (a
+   temporary file renamed into place). */
 int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen);
 #endif
