@@ -43,10 +43,56 @@ for t in 0 "0/0" 1e-300; do
   elif grep -q "tolerance" "$tmp/err" && [ ! -e "$tmp/t.stl" ]; then echo "ok mesh: tolerance $t refused"
   else echo "FAIL mesh: tolerance $t: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 done
-printf 'meshWith [MaxTriangles 1000] "big.stl" UnitCube\n' > "$tmp/big.qcs"
+printf 'meshWith [MaxTriangles 1000] "big.stl" (Rounded 0.2 UnitCube)\n' > "$tmp/big.qcs"
 if (cd "$tmp" && "$top/$QCS" big.qcs > out 2> err); then echo "FAIL mesh: MaxTriangles ignored"
 elif grep -q "max-triangles" "$tmp/err" && [ ! -e "$tmp/big.stl" ]; then echo "ok mesh: MaxTriangles refuses, no file"
 else echo "FAIL mesh: MaxTriangles: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
+
+# .ply and .3mf: read back by tests/mesh_read.py (struct, zipfile, xml):
+# closed by edge counting, and the two Colours of the parts kept
+cat > "$tmp/col.qcs" <<'Q'
+a = Colour (0.8, 0.1, 0.1) (Rounded 0.1 UnitCube);
+b = Colour (0.1, 0.2, 0.9) (Shift (0.5, 0.5, 0.5) (Scale (0.7, 0.7, 0.7) UnitCube));
+meshWith [Tolerance 0.02, Quiet] "col.ply" (Union a b)
+meshWith [Tolerance 0.02, Quiet] "col.3mf" (Union a b)
+Q
+if (cd "$tmp" && "$top/$QCS" col.qcs > out 2> err); then
+  for f in col.ply col.3mf; do
+    r=$(python3 tests/mesh_read.py "$tmp/$f" 2>&1)
+    case $r in
+      *"closed=1 colours=2") echo "ok mesh: $f read back: closed, 2 colours ($r)" ;;
+      *) echo "FAIL mesh: $f read back: $r" ;;
+    esac
+  done
+else echo "FAIL mesh: .ply/.3mf: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
+printf 'mesh "x.off" UnitCube\n' > "$tmp/ext.qcs"
+if (cd "$tmp" && "$top/$QCS" ext.qcs > out 2> err); then echo "FAIL mesh: .off accepted"
+elif grep -q "ext.qcs:1:1: .*\.stl, \.obj, \.ply or \.3mf" "$tmp/err" && [ ! -e "$tmp/x.off" ]; then
+  echo "ok mesh: an unknown mesh extension is refused with the formats named"
+else echo "FAIL mesh: .off: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
+
+# OpenSCAD read-back: import() of qcs's STL rendered by OpenSCAD (z up:
+# the model turned so that qcs's y is up) against qcs's own render of the
+# object from the same camera; the silhouettes must agree
+if command -v openscad > /dev/null 2>&1 && command -v xvfb-run > /dev/null 2>&1; then
+  cat > "$tmp/os.qcs" <<'Q'
+hole = Shift (0.25, 0.8, 0.25) (Scale (0.5, 0.5, 0.5) UnitCube);
+obj = SetDifference (Rounded 0.07 UnitCube) hole;
+meshWith [Tolerance 0.002, Quiet] "os.stl" obj
+renderWith [Size 300 200, Camera (3, 2.5, 4) (0.5, 0.5, 0.5) 22.5] "qcs.png" obj
+Q
+  printf 'rotate([90, 0, 0]) import("os.stl");\n' > "$tmp/os.scad"
+  if (cd "$tmp" && "$top/$QCS" os.qcs > out 2> err) &&
+     (cd "$tmp" && xvfb-run -a openscad -o openscad.png --imgsize=300,200 \
+        --camera=3,-4,2.5,0.5,-0.5,0.5 --projection=p os.scad > osout 2>&1) &&
+     [ -s "$tmp/openscad.png" ]; then
+    r=$(python3 tests/mesh_silhouette.py "$tmp/openscad.png" "$tmp/qcs.png" 0.99)
+    if [ $? = 0 ]; then echo "ok mesh: OpenSCAD imports the STL: $r against qcs's render"
+    else echo "FAIL mesh: OpenSCAD's picture of the STL: $r"; fi
+  else echo "FAIL mesh: OpenSCAD read-back: $(tail -c 300 "$tmp/osout" "$tmp/err" 2>/dev/null | tr '\n' ' ')"; fi
+else
+  echo "skip mesh: openscad or xvfb-run is not installed (apt-get install openscad xvfb)"
+fi
 
 if command -v admesh > /dev/null 2>&1; then
   for f in cli.stl soft.stl slab.stl; do

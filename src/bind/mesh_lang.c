@@ -20,8 +20,15 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
   fprintf(f, "qcs: mesh %s: %zu triangles, %zu vertices in %.2f s\n", path,
           r->triangles, r->vertices, r->seconds);
   fprintf(f, "  octree: %ld cells visited, %ld proven empty, %ld proven "
-          "full, %ld finest cells meshed (depth %d, cell %.4g)\n", r->cells,
-          r->empty, r->full, r->leaves, r->depth, r->h);
+          "full, %ld surface cells meshed: %ld proven one plane, %ld proven "
+          "smooth enough, %ld sharp (a CSG of planes, meshed exactly), %ld at "
+          "the finest level (depth %d, cell %.4g)\n",
+          r->cells, r->empty, r->full, r->leaves, r->planar, r->smooth,
+          r->sharp, r->leaves - r->planar - r->smooth - r->sharp, r->depth,
+          r->h);
+  if (r->sharp_off)
+    fprintf(f, "  sharp cells given up: two of them decided a degenerate "
+            "case apart; the mesh was made again without them\n");
   fprintf(f, "  distance to the surface: certified <= %.4g (requested %.4g; vertices within "
           "%.2g of the surface)\n", r->certified, e, r->vtol);
   fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",
@@ -48,6 +55,16 @@ static int do_mesh(const struct Scene *s, const MeshSettings *ms,
   }
   int rc = mesh_scene(s, s->root, &m2, &m, &rep, bad, err, errlen);
   if (rc) return rc;
+  size_t pl = strlen(path);
+  if (pl > 4 && (!strcmp(path + pl - 4, ".ply") || !strcmp(path + pl - 4, ".3mf"))) {
+    /* the renderer's default object colour where no Colour is given */
+    static const double grey[3] = {0.80, 0.78, 0.72};
+    if (mesh_colour(s, s->root, m, grey, 4 * rep.vtol) < 0) {
+      mesh_free(m);
+      snprintf(err, errlen, "out of memory while colouring the mesh");
+      return -1;
+    }
+  }
   rc = mesh_write(m, path, err, errlen);
   mesh_free(m);
   if (rc) return -1;
@@ -123,7 +140,8 @@ static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
     }
   }
   if (!mesh_is_mesh_path(path))
-    qcs_error(pos, "cannot write %s: a mesh is written as .stl or .obj", path);
+    qcs_error(pos, "cannot write %s: a mesh is written as .stl, .obj, .ply "
+              "or .3mf", path);
   char err[512];
   if (render_writable(path, err, sizeof err) < 0) qcs_error(pos, "%s", err);
   Scene *s = compile_scene(I, args[2], pos);
@@ -141,7 +159,8 @@ static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
 
 static const Builtin mesh_builtins[] = {
     {"meshWith", 3, bi_mesh_with,
-     "meshWith settings file object: a closed triangle mesh (.stl, .obj) "
+     "meshWith settings file object: a closed triangle mesh (.stl, .obj, "
+     ".ply, .3mf) "
      "within Tolerance e; e.g. meshWith [Tolerance 0.05, Quiet] "
      "\"cube.obj\" (Rounded 0.1 UnitCube)"},
 };

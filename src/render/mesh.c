@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <zip.h>
 
 #include "core/bounds.h"
 #include "core/interval.h"
@@ -75,9 +76,64 @@ static void hfree(hmap *h) {
   free(h->v);
 }
 
+/* ---- a hash map from 4 x 64-bit keys to ints ------------------------------ */
+
+typedef struct {
+  uint64_t *k;             /* 4 per slot */
+  int *v;                  /* -1: free */
+  size_t cap, n;
+} kmap;
+
+static size_t kslot(const kmap *h, const uint64_t *key) {
+  uint64_t x = 0;
+  for (int i = 0; i < 4; i++) {
+    x ^= key[i] + 0x9E3779B97F4A7C15ull + (x << 6) + (x >> 2);
+    x *= 0xBF58476D1CE4E5B9ull;
+  }
+  x ^= x >> 31;
+  size_t i = (size_t)x & (h->cap - 1);
+  while (h->v[i] >= 0 && memcmp(h->k + 4 * i, key, 4 * sizeof *key))
+    i = (i + 1) & (h->cap - 1);
+  return i;
+}
+
+static int kmap_get(const kmap *h, const uint64_t *key) {
+  return h->cap ? h->v[kslot(h, key)] : -1;
+}
+
+static int kmap_put(kmap *h, const uint64_t *key, int v) {
+  if (2 * (h->n + 1) > h->cap) {
+    size_t nc = h->cap ? 2 * h->cap : 1024;
+    kmap g = {malloc(4 * nc * sizeof *g.k), malloc(nc * sizeof *g.v), nc, h->n};
+    if (!g.k || !g.v) {
+      free(g.k);
+      free(g.v);
+      return -1;
+    }
+    for (size_t i = 0; i < nc; i++) g.v[i] = -1;
+    for (size_t i = 0; i < h->cap; i++)
+      if (h->v[i] >= 0) {
+        size_t j = kslot(&g, h->k + 4 * i);
+        memcpy(g.k + 4 * j, h->k + 4 * i, 4 * sizeof *g.k);
+        g.v[j] = h->v[i];
+      }
+    free(h->k);
+    free(h->v);
+    *h = g;
+  }
+  size_t i = kslot(h, key);
+  if (h->v[i] < 0) h->n++;
+  memcpy(h->k + 4 * i, key, 4 * sizeof *key);
+  h->v[i] = v;
+  return 0;
+}
+
 /* ---- proofs over a box -------------------------------------------------- */
 
-enum { T_OUT = 0, T_IN = 1, T_MIX = 2 };
+/* T_ONE: undecided, but the solid in the box is decided by one node's
+   inside test; T_PL: undecided, and every undecided leaf below is a sharp
+   halfspace. */
+enum { T_OUT = 0, T_IN = 1, T_MIX = 2, T_ONE = 3, T_PL = 4 };
 
 /* The range of n.x - d over the box. */
 static void plane_range(const double n[3], double d, const double lo[3],
@@ -176,19 +232,19 @@ static int leaf_box(const ScNode *nd, const double lo[3], const double hi[3]) {
   case SC_HALFSPACE: {
     double rl, rh;
     plane_range(nd->n, nd->d, lo, hi, &rl, &rh);
-    return rh < 0 ? T_IN : (rl > 0 ? T_OUT : T_MIX);
+    return rh < 0 ? T_IN : (rl > 0 ? T_OUT : T_ONE);
   }
   case SC_ROUNDED: {
     if (nd->outer && csg_box(nd->outer, lo, hi) == T_OUT) return T_OUT;
     if (nd->inner && csg_box(nd->inner, lo, hi) == T_IN) return T_IN;
     double dl, dh;
     dt_box(nd->tape, lo, hi, &dl, &dh);
-    return dh < 0.5 ? T_OUT : (dl > 0.5 ? T_IN : T_MIX);
+    return dh < 0.5 ? T_OUT : (dl > 0.5 ? T_IN : T_ONE);
   }
   case SC_SOFT: {
     double fl, fh, mg = soft_magic(nd->soft);
     soft_field_box(nd->soft, lo, hi, &fl, &fh);
-    return fh < mg ? T_OUT : (fl > mg ? T_IN : T_MIX);
+    return fh < mg ? T_OUT : (fl > mg ? T_IN : T_ONE);
   }
   case SC_EMPTY: return T_OUT;
   case SC_ALL: return T_IN;
@@ -196,57 +252,302 @@ static int leaf_box(const ScNode *nd, const double lo[3], const double hi[3]) {
   }
 }
 
-/* The node over the box, children first (st has room for the subtree). */
+/* Nodes a and b have the same surface: the same node, or two halfspaces
+   on one plane (either side). */
+static int same_surface(const Scene *s, int a, int b) {
+  if (a == b) return 1;
+  const ScNode *x = &s->nodes[a], *y = &s->nodes[b];
+  if (x->kind != SC_HALFSPACE || y->kind != SC_HALFSPACE) return 0;
+  int same = 1, opp = 1;
+  for (int i = 0; i < 3; i++) {
+    same &= x->n[i] == y->n[i];
+    opp &= x->n[i] == -y->n[i];
+  }
+  return (same && x->d == y->d) || (opp && x->d == -y->d);
+}
+
+/* A set operation on classes. T_ONE (undecided, but the solid in the box
+   is decided by one node's inside test, so the surface there is that
+   node's) carries its node in *o. */
+static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
+                  int *o) {
+  int ra, rb; /* the classes that decide alone */
+  switch (k) {
+  case SC_UNION:
+    if (a == T_IN || b == T_IN) return T_IN;
+    ra = b == T_OUT;
+    rb = a == T_OUT;
+    break;
+  case SC_INTER:
+    if (a == T_OUT || b == T_OUT) return T_OUT;
+    ra = b == T_IN;
+    rb = a == T_IN;
+    break;
+  default: /* a - b */
+    if (a == T_OUT || b == T_IN) return T_OUT;
+    if (a == T_IN && b == T_OUT) return T_IN;
+    ra = b == T_OUT;
+    rb = a == T_IN;
+    break;
+  }
+  if (ra) { /* the result is a */
+    *o = oa;
+    return a;
+  }
+  if (rb) { /* the result is b, or the complement of b */
+    *o = ob;
+    return b;
+  }
+  if (a == T_ONE && b == T_ONE && same_surface(s, oa, ob)) {
+    *o = oa;
+    return T_ONE;
+  }
+  if ((a == T_PL || (a == T_ONE && s->nodes[oa].kind == SC_HALFSPACE)) &&
+      (b == T_PL || (b == T_ONE && s->nodes[ob].kind == SC_HALFSPACE)))
+    return T_PL;
+  return T_MIX;
+}
+
+/* The node over the box, children first (st and one have room for the
+   subtree); *onep is the node deciding a T_ONE result. */
 static int scene_box(const Scene *s, int node, const double lo[3],
-                     const double hi[3], unsigned char *st) {
+                     const double hi[3], unsigned char *st, int *one,
+                     int *onep) {
   int f = s->nodes[node].first;
   for (int i = f; i <= node; i++) {
     const ScNode *nd = &s->nodes[i];
-    int r;
+    int r, o = i;
     switch (nd->kind) {
-    case SC_UNION: r = tri_op(0, st[nd->a - f], st[nd->b - f]); break;
-    case SC_INTER: r = tri_op(1, st[nd->a - f], st[nd->b - f]); break;
-    case SC_DIFF: r = tri_op(2, st[nd->a - f], st[nd->b - f]); break;
+    case SC_UNION:
+    case SC_INTER:
+    case SC_DIFF:
+      r = set_op(s, nd->kind, st[nd->a - f], one[nd->a - f], st[nd->b - f],
+                 one[nd->b - f], &o);
+      break;
     default: r = leaf_box(nd, lo, hi); break;
     }
     st[i - f] = (unsigned char)r;
+    one[i - f] = o;
   }
+  *onep = one[node - f];
   return st[node - f];
+}
+
+/* ---- the gradient of a density tape over a box -------------------------- */
+
+/* Over a box the gradient of a density tape is sum_k c_k n_k over its
+   leaves k whose filter meets the box (n_k the leaf's unit normal), with
+   c_k = d rho / d s_k bounded by forward-mode interval arithmetic: a leaf's
+   own derivative 3/4 (alpha^2 - 1) / r over its alpha range, the product
+   and union rules with the operands' value ranges. Keeping one interval
+   per leaf, not per axis, keeps a lone leaf's gradient exactly along its
+   normal, so a flat face of a rounded solid is seen to be flat. */
+#define GR_MAX 16
+
+typedef struct {
+  double l, h;             /* the value range */
+  int n;                   /* leaves whose filter meets the box */
+  int leaf[GR_MAX];
+  double cl[GR_MAX], ch[GR_MAX];
+} GrIv;
+
+/* r = sx x + sy y on the coefficients (sx, sy intervals); -1 when more
+   than GR_MAX leaves are live. */
+static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
+                  const GrIv *y, double syl, double syh) {
+  GrIv o;
+  o.n = 0;
+  for (int i = 0; i < x->n; i++) {
+    o.leaf[o.n] = x->leaf[i];
+    iv_mul(sxl, sxh, x->cl[i], x->ch[i], &o.cl[o.n], &o.ch[o.n]);
+    o.n++;
+  }
+  for (int i = 0; i < y->n; i++) {
+    double l, h;
+    iv_mul(syl, syh, y->cl[i], y->ch[i], &l, &h);
+    int j = 0;
+    while (j < o.n && o.leaf[j] != y->leaf[i]) j++;
+    if (j == o.n) {
+      if (o.n == GR_MAX) return -1;
+      o.leaf[o.n] = y->leaf[i];
+      o.cl[o.n] = l;
+      o.ch[o.n] = h;
+      o.n++;
+    } else {
+      iv_add(o.cl[j], o.ch[j], l, h, &o.cl[j], &o.ch[j]);
+    }
+  }
+  o.l = r->l;
+  o.h = r->h;
+  *r = o;
+  return 0;
+}
+
+typedef struct {
+  int planar;              /* one live leaf: the 0.5 level is a plane */
+  double w;                /* |grad - g0| <= w over the box */
+  double gmin;             /* grad . n0 >= gmin > 0 over the box */
+} GrBound;
+
+/* The gradient bound of t over [lo, hi]: 0 when found (*b), -1 when the
+   tape is not smooth there (a sharp leaf crosses it, too many live leaves,
+   or no direction n0 with a positive lower bound). */
+static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
+                    GrIv *st, GrBound *b) {
+  int sp = 0, step = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    GrIv *x = &st[sp];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double rl, rh;
+      plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
+      x->n = 0;
+      if (lf->r <= 0) {
+        x->l = rh < 0 ? 1 : 0;
+        x->h = rl > 0 ? 0 : 1;
+        if (rl <= 0 && rh >= 0) { /* a step crossing the box */
+          step = 1;
+          x->leaf[0] = in->arg;
+          x->cl[0] = x->ch[0] = 0;
+          x->n = 1;
+        }
+      } else {
+        double al = rl / lf->r, ah = rh / lf->r;
+        x->l = dt_halfspace_a(ah);
+        x->h = dt_halfspace_a(al);
+        if (al < 1 && ah > -1) {
+          double a0 = fmax(al, -1), a1 = fmin(ah, 1);
+          double m0 = a0 <= 0 && a1 >= 0 ? 0 : fmin(a0 * a0, a1 * a1);
+          double m1 = fmax(a0 * a0, a1 * a1);
+          x->leaf[0] = in->arg;
+          x->cl[0] = 0.75 * (m0 - 1) / lf->r;
+          x->ch[0] = 0.75 * (m1 - 1) / lf->r;
+          x->n = 1;
+        }
+      }
+      sp++;
+    } else if (in->op == DT_CONST) {
+      x->l = x->h = in->c;
+      x->n = 0;
+      sp++;
+    } else {
+      sp--;
+      GrIv *a = &st[sp - 1], *y = &st[sp];
+      double l, h;
+      dt_range_op(in->op, a->l, a->h, y->l, y->h, &l, &h);
+      int rc;
+      switch (in->op) {
+      case DT_SUM: rc = gr_lin(a, a, 1, 1, y, 1, 1); break;
+      case DT_DIFF: rc = gr_lin(a, a, 1, 1, y, -1, -1); break;
+      case DT_RDIFF: rc = gr_lin(a, a, -1, -1, y, 1, 1); break;
+      case DT_PRODUCT: rc = gr_lin(a, a, y->l, y->h, y, a->l, a->h); break;
+      default: /* x + y - x y */
+        rc = gr_lin(a, a, 1 - y->h, 1 - y->l, y, 1 - a->h, 1 - a->l);
+        break;
+      }
+      if (rc < 0) return -1;
+      a->l = l;
+      a->h = h;
+    }
+  }
+  const GrIv *r = &st[0];
+  memset(b, 0, sizeof *b);
+  if (r->n == 1) {
+    b->planar = 1;
+    return 0;
+  }
+  if (step || r->n == 0) return -1;
+  double g0[3] = {0, 0, 0}, w = 0;
+  for (int i = 0; i < r->n; i++) {
+    const double *n = t->leaves[r->leaf[i]].n;
+    double c = 0.5 * (r->cl[i] + r->ch[i]);
+    for (int q = 0; q < 3; q++) g0[q] += c * n[q];
+    w += 0.5 * (r->ch[i] - r->cl[i]);
+  }
+  double len = sqrt(vec3_dot(g0, g0));
+  if (!(len > 0) || !isfinite(len)) return -1;
+  double al = 0, ah = 0;
+  for (int i = 0; i < r->n; i++) {
+    double k = vec3_dot(t->leaves[r->leaf[i]].n, g0) / len, l, h;
+    iv_mul(k, k, r->cl[i], r->ch[i], &l, &h);
+    al += l;
+    ah += h;
+  }
+  double gmin = al > 0 ? al : (ah < 0 ? -ah : 0);
+  if (!(gmin > 0) || !isfinite(w)) return -1;
+  b->w = w * (1 + 1e-9) + 1e-300;
+  b->gmin = gmin * (1 - 1e-9);
+  return 0;
 }
 
 /* ---- the mesher's state --------------------------------------------------- */
 
+/* A surface leaf of the octree and how its triangles are certified. */
+enum { LEAF_PLANE, LEAF_SMOOTH, LEAF_FINE, LEAF_EXACT };
+
+/* The most planes a sharp cell (LEAF_EXACT) may hold. */
+#define PL_MAX 8
+
+typedef struct {
+  uint32_t q[3];           /* its lowest corner, in units of its side */
+  unsigned char level, kind;
+  int pl0, npl;            /* LEAF_EXACT: its planes, pls[pl0 .. + npl) */
+  double w, gmin;          /* LEAF_SMOOTH: the gradient bound */
+} Leaf;
+
+struct ExTet;
+
 typedef struct {
   const Scene *s;
   int node;
-  double org[3], h;        /* grid point (i, j, k) is org + h (i, j, k) */
+  double org[3], h;        /* finest grid point (i, j, k) is org + h (i, j, k) */
   double clo[3], chi[3];   /* the clip box: outside it is outside */
+  double tol, vtol;
   int depth;
-  unsigned char *st;       /* scene_box scratch */
-  uint32_t *leaves;        /* 3 per finest cell: its lowest grid point */
+  unsigned char *st;       /* scene_box scratch: classes */
+  int *one;                /* scene_box scratch: T_ONE's node */
+  GrIv *gst;               /* grad_box scratch */
+  Leaf *leaves;
   size_t nleaves, capleaves;
   size_t max_cells;
-  hmap sign;               /* grid point -> inside */
-  hmap vert;               /* grid edge -> mesh vertex */
+  hmap split;              /* (level, cell) -> 1 for every split cell */
+  hmap pt;                 /* point (doubled finest coordinates) -> index */
+  uint32_t *pc;            /* its coordinates */
+  unsigned char *ps;       /* its sign: 1 inside */
+  size_t np, capp, capps;
+  hmap vert;               /* point pair -> mesh vertex */
   double *v;
   size_t nv, capv;
   int *t;
   size_t nt, capt;
+  int *fl;                 /* scratch: a face's boundary loop */
+  size_t nfl, capfl;
+  int *ft;                 /* scratch: a cell's face triangles */
+  size_t nft, capft;
+  const Leaf *cur;         /* the leaf being meshed */
+  int sharp;               /* make LEAF_EXACT cells */
+  int *pls;                /* the planes of the sharp cells (node indices) */
+  size_t npls, cappls;
+  int *plmap;              /* per node of the subtree: 2 (plane) + flip */
+  unsigned char *pv;       /* pl_eval scratch */
+  struct ExTet *ex;        /* exact_tet scratch */
+  kmap vert2;              /* named corners of sharp cells -> mesh vertex */
+  hmap crease;             /* (u, v) -> the surface's path between the
+                              edge vertices u < v on a sharp cell's face,
+                              poly[off] points then the points in order */
+  int *poly;
+  size_t npoly, cappoly;
+  kmap fpath;              /* (vertex, axis, plane) -> the next vertex of
+                              a sharp cell's surface along a cell face */
+  uint64_t *fstart;        /* the keys of fpath, in order */
+  size_t nfs, capfs;
+  unsigned char *uni;      /* per mesh vertex: made by edge_vertex */
+  size_t capuni;
   RayCtx *ray;
   MeshReport *rep;
   int err;                 /* MESH_E* */
 } Mesher;
-
-static void grid_point(const Mesher *m, uint32_t i, uint32_t j, uint32_t k,
-                       double p[3]) {
-  p[0] = m->org[0] + m->h * i;
-  p[1] = m->org[1] + m->h * j;
-  p[2] = m->org[2] + m->h * k;
-}
-
-static uint64_t vkey(uint32_t i, uint32_t j, uint32_t k) {
-  return (uint64_t)i | (uint64_t)j << 20 | (uint64_t)k << 40;
-}
 
 static int in_clip(const Mesher *m, const double p[3]) {
   for (int i = 0; i < 3; i++)
@@ -254,19 +555,75 @@ static int in_clip(const Mesher *m, const double p[3]) {
   return 1;
 }
 
-/* Classify the cell of side 2^(depth - level) finest cells at (i, j, k). */
+static int grow(void **p, size_t *cap, size_t need, size_t size) {
+  if (need <= *cap) return 0;
+  size_t nc = *cap ? *cap : 1024;
+  while (nc < need) nc *= 2;
+  void *g = realloc(*p, nc * size);
+  if (!g) return -1;
+  *p = g;
+  *cap = nc;
+  return 0;
+}
+
+static uint64_t ckey(int level, uint64_t i, uint64_t j, uint64_t k) {
+  return (uint64_t)level << 57 | i << 38 | j << 19 | k;
+}
+
+/* Cell (i, j, k) of the level exists in the tree and is split. */
+static int is_split(const Mesher *m, int level, int64_t i, int64_t j,
+                    int64_t k) {
+  int64_t n = (int64_t)1 << level;
+  if (i < 0 || j < 0 || k < 0 || i >= n || j >= n || k >= n) return 0;
+  return hget(&m->split, ckey(level, (uint64_t)i, (uint64_t)j, (uint64_t)k)) >= 0;
+}
+
+/* The point at doubled finest coordinates c, with its sign: its index, or
+   -1 when memory runs out. */
+static int point(Mesher *m, const uint32_t c[3]) {
+  uint64_t key = (uint64_t)c[0] | (uint64_t)c[1] << 21 | (uint64_t)c[2] << 42;
+  int v = hget(&m->pt, key);
+  if (v >= 0) return v;
+  if (grow((void **)&m->pc, &m->capp, 3 * (m->np + 1), sizeof *m->pc) < 0 ||
+      grow((void **)&m->ps, &m->capps, m->np + 1, 1) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  double p[3];
+  for (int i = 0; i < 3; i++) p[i] = m->org[i] + 0.5 * m->h * c[i];
+  int s = in_clip(m, p) ? scene_inside(m->s, m->node, p) : 0;
+  v = (int)m->np;
+  if (s < 0 || hput(&m->pt, key, v) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  memcpy(m->pc + 3 * m->np, c, 3 * sizeof *c);
+  m->ps[m->np++] = (unsigned char)s;
+  return v;
+}
+
+/* Classify the cell (i, j, k) of the level (in units of its side) and
+   either drop it (proven empty or full), keep it as a surface leaf, or
+   split it. A leaf is kept above the finest level when its error is
+   proven within the tolerance: the surface in the box is one plane
+   (LEAF_PLANE), or one rounded node whose gradient bound over the box
+   grown by the tolerance makes the triangles close enough (LEAF_SMOOTH,
+   see mesh.h). */
 static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
-  uint32_t n = 1u << (m->depth - level);
-  double lo[3], hi[3];
-  grid_point(m, i, j, k, lo);
-  grid_point(m, i + n, j + n, k + n, hi);
+  double side = ldexp(m->h, m->depth - level), lo[3], hi[3];
+  uint32_t q[3] = {i, j, k};
+  for (int a = 0; a < 3; a++) {
+    lo[a] = m->org[a] + side * q[a];
+    hi[a] = m->org[a] + side * (q[a] + 1);
+  }
   m->rep->cells++;
   int clip_out = 0, clip_in = 1;
   for (int a = 0; a < 3; a++) {
     if (hi[a] <= m->clo[a] || lo[a] >= m->chi[a]) clip_out = 1;
     if (lo[a] <= m->clo[a] || hi[a] >= m->chi[a]) clip_in = 0;
   }
-  int c = clip_out ? T_OUT : scene_box(m->s, m->node, lo, hi, m->st);
+  int one = -1;
+  int c = clip_out ? T_OUT : scene_box(m->s, m->node, lo, hi, m->st, m->one, &one);
   if (c == T_IN && !clip_in) c = T_MIX;
   if (c == T_OUT) {
     m->rep->empty++;
@@ -276,49 +633,83 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     m->rep->full++;
     return 0;
   }
-  if (level == m->depth) {
+  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0};
+  int leaf = level == m->depth;
+  if (c == T_ONE && clip_in) {
+    const ScNode *nd = &m->s->nodes[one];
+    if (nd->kind == SC_HALFSPACE) {
+      lf.kind = LEAF_PLANE;
+      leaf = 1;
+    } else if (nd->kind == SC_ROUNDED) {
+      double gl[3], gh[3];
+      GrBound b;
+      for (int a = 0; a < 3; a++) {
+        gl[a] = lo[a] - m->tol;
+        gh[a] = hi[a] + m->tol;
+      }
+      if (grad_box(nd->tape, gl, gh, m->gst, &b) == 0) {
+        double d = sqrt(3.0) * side;
+        if (b.planar) {
+          lf.kind = LEAF_PLANE;
+          leaf = 1;
+        } else if (m->vtol + b.w * (d + 2 * m->vtol) / b.gmin <= m->tol) {
+          lf.kind = LEAF_SMOOTH;
+          lf.w = b.w;
+          lf.gmin = b.gmin;
+          leaf = 1;
+        }
+      }
+    }
+  }
+  if (c == T_PL && clip_in && m->sharp) {
+    /* the distinct planes of the undecided halfspaces */
+    int f = m->s->nodes[m->node].first, n0 = (int)m->npls, n = 0;
+    for (int x = f; x <= m->node && n <= PL_MAX; x++) {
+      if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+      int dup = 0;
+      for (int y = 0; y < n && !dup; y++) dup = same_surface(m->s, m->pls[n0 + y], x);
+      if (dup) continue;
+      if (grow((void **)&m->pls, &m->cappls, m->npls + 1, sizeof *m->pls) < 0) {
+        m->err = MESH_ENOMEM;
+        return -1;
+      }
+      m->pls[m->npls++] = x;
+      n++;
+    }
+    if (n <= PL_MAX) {
+      lf.kind = LEAF_EXACT;
+      lf.pl0 = n0;
+      lf.npl = n;
+      leaf = 1;
+    } else {
+      m->npls = (size_t)n0;
+    }
+  }
+  if (leaf) {
     if (m->nleaves >= m->max_cells) {
       m->err = MESH_ELIMIT;
       return -1;
     }
-    if (m->nleaves == m->capleaves) {
-      size_t nc = m->capleaves ? 2 * m->capleaves : 4096;
-      uint32_t *g = realloc(m->leaves, 3 * nc * sizeof *g);
-      if (!g) {
-        m->err = MESH_ENOMEM;
-        return -1;
-      }
-      m->leaves = g;
-      m->capleaves = nc;
+    if (grow((void **)&m->leaves, &m->capleaves, m->nleaves + 1,
+             sizeof *m->leaves) < 0) {
+      m->err = MESH_ENOMEM;
+      return -1;
     }
-    m->leaves[3 * m->nleaves] = i;
-    m->leaves[3 * m->nleaves + 1] = j;
-    m->leaves[3 * m->nleaves + 2] = k;
-    m->nleaves++;
+    m->leaves[m->nleaves++] = lf;
+    if (lf.kind == LEAF_PLANE) m->rep->planar++;
+    else if (lf.kind == LEAF_EXACT) m->rep->sharp++;
+    else if (lf.kind == LEAF_SMOOTH) m->rep->smooth++;
     return 0;
   }
-  uint32_t hn = n / 2;
-  for (int q = 0; q < 8; q++)
-    if (walk(m, i + (q & 1 ? hn : 0), j + (q & 2 ? hn : 0),
-             k + (q & 4 ? hn : 0), level + 1) < 0)
-      return -1;
-  return 0;
-}
-
-/* The sign of grid point (i, j, k), cached: 1 inside, 0 outside, -1 on
-   failure. */
-static int corner(Mesher *m, uint32_t i, uint32_t j, uint32_t k) {
-  uint64_t key = vkey(i, j, k);
-  int v = hget(&m->sign, key);
-  if (v >= 0) return v;
-  double p[3];
-  grid_point(m, i, j, k, p);
-  v = in_clip(m, p) ? scene_inside(m->s, m->node, p) : 0;
-  if (v < 0 || hput(&m->sign, key, v) < 0) {
+  if (hput(&m->split, ckey(level, i, j, k), 1) < 0) {
     m->err = MESH_ENOMEM;
     return -1;
   }
-  return v;
+  for (int c8 = 0; c8 < 8; c8++)
+    if (walk(m, 2 * i + (uint32_t)(c8 & 1), 2 * j + (uint32_t)(c8 >> 1 & 1),
+             2 * k + (uint32_t)(c8 >> 2 & 1), level + 1) < 0)
+      return -1;
+  return 0;
 }
 
 /* Inside at o + t d (the clipped solid). */
@@ -332,6 +723,7 @@ static int inside_at(Mesher *m, const double o[3], const double d[3],
 static double crossing(Mesher *m, const double a[3], const double b[3],
                        int sa) {
   double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  double len = sqrt(vec3_dot(d, d));
   /* the clip box's slab along the edge */
   double t0 = 0, t1 = 1;
   for (int i = 0; i < 3; i++) {
@@ -356,7 +748,7 @@ static double crossing(Mesher *m, const double a[3], const double b[3],
   }
   if (isnan(best)) { /* bisection on the point classification */
     double lo = 0, hi = 1;
-    for (int it = 0; it < 60 && (hi - lo) * m->h > m->rep->vtol * 0.5; it++) {
+    for (int it = 0; it < 80 && (hi - lo) * len > m->vtol * 0.5; it++) {
       double mid = 0.5 * (lo + hi);
       int s = inside_at(m, a, d, mid);
       if (s < 0) break;
@@ -366,37 +758,39 @@ static double crossing(Mesher *m, const double a[3], const double b[3],
     best = 0.5 * (lo + hi);
     m->rep->bisected++;
   }
-  const double edge = 1.0 / 1048576; /* keep off the grid points */
+  /* keep off the corners (no repeated vertex position), by far less than
+     the vertices' tolerance */
+  double edge = fmin(1.0 / 1048576, 0.01 * m->vtol / len);
   if (best < edge) best = edge;
   if (best > 1 - edge) best = 1 - edge;
   return best;
 }
 
-/* The mesh vertex on the grid edge from corner ca to cb of the cell at
-   base (masks: bit 0 x, 1 y, 2 z; one mask holds the other). */
-static int edge_vertex(Mesher *m, const uint32_t base[3], int ca, int cb,
-                       const int sg[8]) {
-  int lo = ca & cb, dir = ca ^ cb, hi = lo | dir;
-  uint32_t i = base[0] + (uint32_t)(lo & 1), j = base[1] + (uint32_t)(lo >> 1 & 1),
-           k = base[2] + (uint32_t)(lo >> 2 & 1);
-  uint64_t key = vkey(i, j, k) << 3 | (uint64_t)dir;
+/* The mesh vertex on the segment between points pa and pb (signs differ). */
+static int edge_vertex(Mesher *m, int pa, int pb) {
+  if (pa > pb) {
+    int x = pa;
+    pa = pb;
+    pb = x;
+  }
+  uint64_t key = (uint64_t)pa << 32 | (uint64_t)pb;
   int v = hget(&m->vert, key);
   if (v >= 0) return v;
   double a[3], b[3];
-  grid_point(m, i, j, k, a);
-  grid_point(m, base[0] + (uint32_t)(hi & 1), base[1] + (uint32_t)(hi >> 1 & 1),
-             base[2] + (uint32_t)(hi >> 2 & 1), b);
-  double t = crossing(m, a, b, sg[lo]);
-  if (m->nv == m->capv) {
-    size_t nc = m->capv ? 2 * m->capv : 4096;
-    double *g = realloc(m->v, 3 * nc * sizeof *g);
-    if (!g) {
-      m->err = MESH_ENOMEM;
-      return -1;
-    }
-    m->v = g;
-    m->capv = nc;
+  for (int q = 0; q < 3; q++) {
+    a[q] = m->org[q] + 0.5 * m->h * m->pc[3 * pa + q];
+    b[q] = m->org[q] + 0.5 * m->h * m->pc[3 * pb + q];
   }
+  double t = crossing(m, a, b, m->ps[pa]);
+  if (grow((void **)&m->v, &m->capv, 3 * (m->nv + 1), sizeof *m->v) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  if (grow((void **)&m->uni, &m->capuni, m->nv + 1, 1) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->uni[m->nv] = 1;
   double *p = m->v + 3 * m->nv;
   for (int q = 0; q < 3; q++) p[q] = a[q] + t * (b[q] - a[q]);
   v = (int)m->nv++;
@@ -408,95 +802,9 @@ static int edge_vertex(Mesher *m, const uint32_t base[3], int ca, int cb,
   return v;
 }
 
-static int emit(Mesher *m, int a, int b, int c) {
-  if (a < 0 || b < 0 || c < 0) return -1;
-  if (m->nt == m->capt) {
-    size_t nc = m->capt ? 2 * m->capt : 4096;
-    int *g = realloc(m->t, 3 * nc * sizeof *g);
-    if (!g) {
-      m->err = MESH_ENOMEM;
-      return -1;
-    }
-    m->t = g;
-    m->capt = nc;
-  }
-  m->t[3 * m->nt] = a;
-  m->t[3 * m->nt + 1] = b;
-  m->t[3 * m->nt + 2] = c;
-  m->nt++;
-  return 0;
-}
-
-/* The Kuhn split: 6 tetrahedra around the diagonal 0 - 7, each ordered to
-   positive orientation. */
-static const int kuhn[6][4] = {
-    {0, 1, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, /* even permutations */
-    {0, 1, 7, 5}, {0, 4, 7, 6}, {0, 2, 7, 3}, /* odd, last two swapped */
-};
-
 static double dist3(const double *a, const double *b) {
   double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
   return sqrt(x * x + y * y + z * z);
-}
-
-static int parity4(const int p[4]) {
-  int inv = 0;
-  for (int i = 0; i < 4; i++)
-    for (int j = i + 1; j < 4; j++) inv += p[i] > p[j];
-  return inv & 1;
-}
-
-/* Triangles of one positively oriented tetrahedron (corner masks c). When
-   count is set, only count them. */
-static int tet(Mesher *m, const uint32_t base[3], const int c[4],
-               const int sg[8], size_t *count) {
-  static const int lone[4][4] = {
-      {0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
-  int in[4], n = 0;
-  for (int i = 0; i < 4; i++) n += in[i] = sg[c[i]];
-  if (n == 0 || n == 4) return 0;
-  if (n == 1 || n == 3) {
-    if (count) return (void)(*count += 1), 0;
-    int i = 0;
-    while (in[i] != (n == 1)) i++;
-    const int *p = lone[i];
-    int e1 = edge_vertex(m, base, c[p[0]], c[p[1]], sg);
-    int e2 = edge_vertex(m, base, c[p[0]], c[p[2]], sg);
-    int e3 = edge_vertex(m, base, c[p[0]], c[p[3]], sg);
-    return n == 1 ? emit(m, e1, e2, e3) : emit(m, e1, e3, e2);
-  }
-  if (count) return (void)(*count += 2), 0;
-  int p[4], a = 0, b = 2;
-  for (int i = 0; i < 4; i++) {
-    if (in[i]) p[a++] = i;
-    else p[b++] = i;
-  }
-  if (parity4(p)) {
-    int x = p[2];
-    p[2] = p[3];
-    p[3] = x;
-  }
-  int q0 = edge_vertex(m, base, c[p[0]], c[p[2]], sg);
-  int q1 = edge_vertex(m, base, c[p[0]], c[p[3]], sg);
-  int q2 = edge_vertex(m, base, c[p[1]], c[p[3]], sg);
-  int q3 = edge_vertex(m, base, c[p[1]], c[p[2]], sg);
-  if (q0 < 0 || q1 < 0 || q2 < 0 || q3 < 0) return -1;
-  if (dist3(m->v + 3 * q0, m->v + 3 * q2) <= dist3(m->v + 3 * q1, m->v + 3 * q3))
-    return emit(m, q0, q1, q2) < 0 ? -1 : emit(m, q0, q2, q3);
-  return emit(m, q1, q2, q3) < 0 ? -1 : emit(m, q1, q3, q0);
-}
-
-static int cell(Mesher *m, size_t leaf, size_t *count) {
-  const uint32_t *b = m->leaves + 3 * leaf;
-  int sg[8];
-  for (int q = 0; q < 8; q++) {
-    sg[q] = corner(m, b[0] + (uint32_t)(q & 1), b[1] + (uint32_t)(q >> 1 & 1),
-                   b[2] + (uint32_t)(q >> 2 & 1));
-    if (sg[q] < 0) return -1;
-  }
-  for (int t = 0; t < 6; t++)
-    if (tet(m, b, kuhn[t], sg, count) < 0) return -1;
-  return 0;
 }
 
 /* The covering radius of a triangle by its vertices: the circumradius if
@@ -515,6 +823,731 @@ static double cover_radius(const double *a, const double *b, const double *c) {
   return r < l ? r : l;
 }
 
+/* The proven distance bound of a triangle of the current leaf (mesh.h). */
+static double tri_bound(const Mesher *m, int a, int b, int c) {
+  const double *pa = m->v + 3 * a, *pb = m->v + 3 * b, *pc = m->v + 3 * c;
+  switch (m->cur->kind) {
+  case LEAF_PLANE:
+  case LEAF_EXACT: return m->vtol;
+  case LEAF_SMOOTH: {
+    double d = fmax(dist3(pa, pb), fmax(dist3(pb, pc), dist3(pa, pc)));
+    return m->vtol + m->cur->w * (d + 2 * m->vtol) / m->cur->gmin;
+  }
+  default: return m->vtol + cover_radius(pa, pb, pc);
+  }
+}
+
+static int emit(Mesher *m, int a, int b, int c) {
+  if (a < 0 || b < 0 || c < 0) return -1;
+  if (grow((void **)&m->t, &m->capt, 3 * (m->nt + 1), sizeof *m->t) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->t[3 * m->nt] = a;
+  m->t[3 * m->nt + 1] = b;
+  m->t[3 * m->nt + 2] = c;
+  m->nt++;
+  double e = tri_bound(m, a, b, c);
+  if (e > m->rep->certified) m->rep->certified = e;
+  return 0;
+}
+
+static int parity4(const int p[4]) {
+  int inv = 0;
+  for (int i = 0; i < 4; i++)
+    for (int j = i + 1; j < 4; j++) inv += p[i] > p[j];
+  return inv & 1;
+}
+
+/* A marching triangle whose edge (u, v) lies on a face where a sharp
+   neighbour put the crease point c between u and v is split there, so
+   the two sides meet edge to edge (c is on the surface and in the cell,
+   so the cell's proof still covers the pieces). */
+static int emit_split(Mesher *m, int a, int b, int c, int depth) {
+  if (a < 0 || b < 0 || c < 0) return -1;
+  if (m->crease.n && depth < 4) {
+    int t[3] = {a, b, c};
+    for (int e = 0; e < 3; e++) {
+      int u = t[e], v = t[(e + 1) % 3], w = t[(e + 2) % 3];
+      uint64_t key = u < v ? (uint64_t)u << 32 | (uint64_t)v
+                           : (uint64_t)v << 32 | (uint64_t)u;
+      int off = hget(&m->crease, key);
+      if (off < 0) continue;
+      int n = m->poly[off], prev = u;
+      for (int q = 0; q <= n; q++) {
+        int x = q == n ? v : m->poly[off + 1 + (u < v ? q : n - 1 - q)];
+        if (emit_split(m, prev, x, w, depth + 1) < 0) return -1;
+        prev = x;
+      }
+      return 0;
+    }
+  }
+  return emit(m, a, b, c);
+}
+
+/* Marching tetrahedra: the triangles of the positively oriented
+   tetrahedron on points c. When count is set, only count them. */
+static int tet(Mesher *m, const int c[4], size_t *count) {
+  static const int lone[4][4] = {
+      {0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+  int in[4], n = 0;
+  for (int i = 0; i < 4; i++) n += in[i] = m->ps[c[i]];
+  if (n == 0 || n == 4) return 0;
+  if (n == 1 || n == 3) {
+    if (count) return (void)(*count += 1), 0;
+    int i = 0;
+    while (in[i] != (n == 1)) i++;
+    const int *p = lone[i];
+    int e1 = edge_vertex(m, c[p[0]], c[p[1]]);
+    int e2 = edge_vertex(m, c[p[0]], c[p[2]]);
+    int e3 = edge_vertex(m, c[p[0]], c[p[3]]);
+    return n == 1 ? emit_split(m, e1, e2, e3, 0) : emit_split(m, e1, e3, e2, 0);
+  }
+  if (count) return (void)(*count += 2), 0;
+  int p[4], a = 0, b = 2;
+  for (int i = 0; i < 4; i++) {
+    if (in[i]) p[a++] = i;
+    else p[b++] = i;
+  }
+  if (parity4(p)) {
+    int x = p[2];
+    p[2] = p[3];
+    p[3] = x;
+  }
+  int q0 = edge_vertex(m, c[p[0]], c[p[2]]);
+  int q1 = edge_vertex(m, c[p[0]], c[p[3]]);
+  int q2 = edge_vertex(m, c[p[1]], c[p[3]]);
+  int q3 = edge_vertex(m, c[p[1]], c[p[2]]);
+  if (q0 < 0 || q1 < 0 || q2 < 0 || q3 < 0) return -1;
+  if (dist3(m->v + 3 * q0, m->v + 3 * q2) <= dist3(m->v + 3 * q1, m->v + 3 * q3))
+    return emit_split(m, q0, q1, q2, 0) < 0 ? -1 : emit_split(m, q0, q2, q3, 0);
+  return emit_split(m, q1, q2, q3, 0) < 0 ? -1 : emit_split(m, q1, q3, q0, 0);
+}
+
+/* ---- a conforming tetrahedral mesh of the octree's surface leaves ----------
+
+   A leaf whose six faces are plain (the cell across a face is not split
+   and no edge carries a corner of a smaller cell) is cut into the 6 Kuhn
+   tetrahedra around its main diagonal, as a uniform grid would be. Any
+   other leaf gets a point at its centre and one tetrahedron from it to
+   each triangle of its faces: a face whose neighbour is split is cut into
+   its four quarters (recursively); a leaf face is cut along its diagonal
+   from its lowest to its highest corner if it has only its 4 corners (the
+   diagonal the Kuhn split of both cells uses), else fanned from its
+   centre to its corners and to every corner of a smaller cell on its
+   edges. Both cells sharing a face compute the same cut from the same
+   global facts (which cells are split), so the tetrahedra meet face to
+   face and the level set of the signs is closed across cells of any
+   sizes. A corner of a smaller cell lies on an edge of a cell of level l
+   exactly when one of the 4 cells of level l around that edge is split. */
+
+static int fl_push(Mesher *m, int p) {
+  if (p < 0) return -1;
+  if (grow((void **)&m->fl, &m->capfl, m->nfl + 1, sizeof *m->fl) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->fl[m->nfl++] = p;
+  return 0;
+}
+
+/* The corners of smaller cells strictly inside the edge of level l from
+   corner c (level-l units) along axis a, pushed in order from c, or from
+   the far end when rev. */
+static int edge_points(Mesher *m, int l, const int64_t c[3], int a, int rev) {
+  int b = (a + 1) % 3, e = (a + 2) % 3, split = 0;
+  for (int u = 0; u < 2 && !split; u++)
+    for (int w = 0; w < 2 && !split; w++) {
+      int64_t q[3] = {c[0], c[1], c[2]};
+      q[b] -= u;
+      q[e] -= w;
+      split = is_split(m, l, q[0], q[1], q[2]);
+    }
+  if (!split) return 0;
+  int64_t h0[3] = {2 * c[0], 2 * c[1], 2 * c[2]}, h1[3];
+  memcpy(h1, h0, sizeof h1);
+  h1[a] += 1;
+  uint32_t mid[3];
+  for (int i = 0; i < 3; i++)
+    mid[i] = (uint32_t)(h1[i] << (m->depth - l));
+  const int64_t *first = rev ? h1 : h0, *second = rev ? h0 : h1;
+  if (edge_points(m, l + 1, first, a, rev) < 0) return -1;
+  if (fl_push(m, point(m, mid)) < 0) return -1;
+  return edge_points(m, l + 1, second, a, rev);
+}
+
+static int ft_push(Mesher *m, int a, int b, int c) {
+  if (grow((void **)&m->ft, &m->capft, m->nft + 3, sizeof *m->ft) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->ft[m->nft++] = a;
+  m->ft[m->nft++] = b;
+  m->ft[m->nft++] = c;
+  return 0;
+}
+
+/* The triangles of the face of cell q (level l) on axis a, side s (0 low,
+   1 high), counter-clockwise seen from outside the cell; *plain is cleared
+   unless the face is one leaf face with its 4 corners only. */
+static int face(Mesher *m, int l, const int64_t q[3], int a, int s,
+                int *plain) {
+  int64_t nb[3] = {q[0], q[1], q[2]};
+  nb[a] += s ? 1 : -1;
+  int b = (a + 1) % 3, e = (a + 2) % 3;
+  if (is_split(m, l, nb[0], nb[1], nb[2])) {
+    *plain = 0;
+    for (int u = 0; u < 2; u++)
+      for (int w = 0; w < 2; w++) {
+        int64_t ch[3];
+        ch[a] = 2 * q[a] + s;
+        ch[b] = 2 * q[b] + u;
+        ch[e] = 2 * q[e] + w;
+        int dummy = 1;
+        if (face(m, l + 1, ch, a, s, &dummy) < 0) return -1;
+      }
+    return 0;
+  }
+  /* the loop (0,0) (1,0) (1,1) (0,1) in (b, e) is counter-clockwise seen
+     from +a; from -a it runs the other way */
+  static const int cu[4] = {0, 1, 1, 0}, cw[4] = {0, 0, 1, 1};
+  m->nfl = 0;
+  for (int r = 0; r < 4; r++) {
+    int k0 = s ? r : (4 - r) % 4, k1 = s ? (r + 1) % 4 : (3 - r) % 4;
+    int64_t p0[3], p1[3];
+    p0[a] = p1[a] = q[a] + s;
+    p0[b] = q[b] + cu[k0];
+    p0[e] = q[e] + cw[k0];
+    p1[b] = q[b] + cu[k1];
+    p1[e] = q[e] + cw[k1];
+    uint32_t dc[3];
+    for (int i = 0; i < 3; i++) dc[i] = (uint32_t)(p0[i] << (m->depth - l + 1));
+    if (fl_push(m, point(m, dc)) < 0) return -1;
+    int ax = p0[b] != p1[b] ? b : e, rev = p1[ax] < p0[ax];
+    const int64_t *lowc = rev ? p1 : p0;
+    if (edge_points(m, l, lowc, ax, rev) < 0) return -1;
+  }
+  size_t n = m->nfl;
+  if (n == 4) {
+    /* loop[0] is corner (0,0) and loop[2] is (1,1) either way round */
+    if (ft_push(m, m->fl[0], m->fl[1], m->fl[2]) < 0) return -1;
+    return ft_push(m, m->fl[0], m->fl[2], m->fl[3]);
+  }
+  *plain = 0;
+  uint32_t fc[3];
+  fc[a] = (uint32_t)((q[a] + s) << (m->depth - l + 1));
+  fc[b] = (uint32_t)((2 * q[b] + 1) << (m->depth - l));
+  fc[e] = (uint32_t)((2 * q[e] + 1) << (m->depth - l));
+  int cp = point(m, fc);
+  if (cp < 0) return -1;
+  for (size_t i = 0; i < n; i++)
+    if (ft_push(m, cp, m->fl[i], m->fl[(i + 1) % n]) < 0) return -1;
+  return 0;
+}
+
+/* ---- sharp cells: the exact surface of a CSG of planes in a tetrahedron ----
+
+   In a LEAF_EXACT cell the solid is decided by a Boolean combination of at
+   most PL_MAX halfspaces (all other nodes are proven in or out over the
+   box). In each tetrahedron the polygon of every plane i (plane i cut by
+   the tetrahedron) is split by every other plane into convex pieces; a
+   piece is surface exactly when the solid's value on it changes with the
+   side of plane i (the value is computed from the sides, combinatorially,
+   not from a sample), and it is oriented by which side is inside. The
+   pieces' corners are named by what defines them: a plane on a
+   tetrahedron edge, two planes on a tetrahedron face, three planes; the
+   neighbours that share an edge or a face compute the same names and the
+   same positions (from the sorted points and planes), so pieces meet edge
+   to edge across tetrahedra and across the crease between two planes, and
+   edges and corners of the solid are vertices and edges of the mesh. A
+   plane's single crossing on an edge whose ends differ is the same vertex
+   the marching cells make there (edge_vertex). The whole mesh is checked
+   for closure at the end; if rounding ever made two neighbours decide a
+   degenerate case differently, the mesh is made again without sharp cells
+   (mesh_scene). */
+#define PV_MAX 32
+#define PC_MAX 64
+#define LV_MAX 256
+
+typedef struct {
+  int n;
+  unsigned bits;           /* side of each plane: 1 inside */
+  int v[PV_MAX];           /* local vertices, counter-clockwise about +n_i */
+  int sup[PV_MAX];         /* support of edge v[q] -> v[q+1]: a plane
+                              (list index) or -1 - (tetrahedron face) */
+} Piece;
+
+typedef struct {
+  uint64_t key[4];
+  double x[3];
+  int kind, la, lb, plane; /* kind 0: plane on a tetrahedron edge */
+  int global;              /* mesh vertex, -1 until needed */
+  int unified;             /* global is the marching cells' edge vertex */
+} LVert;
+
+typedef struct ExTet {
+  Mesher *m;
+  const int *p;            /* the tetrahedron's 4 points */
+  double x[4][3];
+  double s[PL_MAX][4];     /* each plane's signed distance at the corners */
+  LVert lv[LV_MAX];
+  int nlv;
+  Piece pc[2][PC_MAX];
+  int fe[LV_MAX][3];       /* surface edges on the faces: face, from, to */
+  int nfe;
+  int bad;
+} ExTet;
+
+static void pl_plane(const Mesher *m, int j, double n[3], double *d) {
+  const ScNode *nd = &m->s->nodes[m->pls[m->cur->pl0 + j]];
+  memcpy(n, nd->n, 3 * sizeof *n);
+  *d = nd->d;
+}
+
+/* Solve rows a x = b (3 x 3) by Cramer's rule: 0, or -1 if near singular. */
+static int solve3(const double a[3][3], const double b[3], double x[3]) {
+  double c0[3], det;
+  double r1[3] = {a[1][0], a[1][1], a[1][2]}, r2[3] = {a[2][0], a[2][1], a[2][2]};
+  vec3_cross(r1, r2, c0);
+  det = vec3_dot(a[0], c0);
+  double sc = sqrt(vec3_dot(a[0], a[0]) * vec3_dot(r1, r1) * vec3_dot(r2, r2));
+  if (!(fabs(det) > 1e-9 * sc)) return -1;
+  for (int i = 0; i < 3; i++) {
+    double m[3][3];
+    memcpy(m, a, sizeof m);
+    for (int r = 0; r < 3; r++) m[r][i] = b[r];
+    double q1[3] = {m[1][0], m[1][1], m[1][2]}, q2[3] = {m[2][0], m[2][1], m[2][2]}, c[3];
+    vec3_cross(q1, q2, c);
+    x[i] = vec3_dot(m[0], c) / det;
+  }
+  return 0;
+}
+
+static int lv_find(ExTet *e, const uint64_t k[4]) {
+  for (int i = 0; i < e->nlv; i++)
+    if (!memcmp(e->lv[i].key, k, sizeof e->lv[i].key)) return i;
+  return -1;
+}
+
+static int lv_add(ExTet *e, const uint64_t k[4], const double x[3], int kind,
+                  int la, int lb, int plane) {
+  int i = lv_find(e, k);
+  if (i >= 0) return i;
+  if (e->nlv == LV_MAX) {
+    e->bad = 1;
+    return -1;
+  }
+  LVert *v = &e->lv[e->nlv];
+  memcpy(v->key, k, sizeof v->key);
+  memcpy(v->x, x, sizeof v->x);
+  v->kind = kind;
+  v->la = la;
+  v->lb = lb;
+  v->plane = plane;
+  v->global = -1;
+  v->unified = 0;
+  return e->nlv++;
+}
+
+/* Plane i on the tetrahedron edge la - lb (its sides differ there). */
+static int ex_edge(ExTet *e, int i, int la, int lb) {
+  int pa = e->p[la], pb = e->p[lb];
+  if (pa > pb) {
+    int t = la;
+    la = lb;
+    lb = t;
+    pa = e->p[la];
+    pb = e->p[lb];
+  }
+  double sa = e->s[i][la], sb = e->s[i][lb], t = sa / (sa - sb), x[3];
+  for (int q = 0; q < 3; q++) x[q] = e->x[la][q] + t * (e->x[lb][q] - e->x[la][q]);
+  uint64_t k[4] = {5, (uint64_t)pa << 32 | (uint64_t)pb,
+                   (uint64_t)e->m->pls[e->m->cur->pl0 + i], 0};
+  return lv_add(e, k, x, 0, la, lb, i);
+}
+
+/* The vertex where piece edge (a, b) with support sup meets plane j. */
+static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
+  const Mesher *m = e->m;
+  uint64_t k[4];
+  double A[3][3], B[3], x[3];
+  pl_plane(m, i, A[0], &B[0]);
+  pl_plane(m, j, A[1], &B[1]);
+  uint64_t ni = (uint64_t)m->pls[m->cur->pl0 + i], nj = (uint64_t)m->pls[m->cur->pl0 + j];
+  if (ni > nj) {
+    uint64_t t = ni;
+    ni = nj;
+    nj = t;
+  }
+  if (sup >= 0) { /* three planes */
+    pl_plane(m, sup, A[2], &B[2]);
+    uint64_t n3[3] = {ni, nj, (uint64_t)m->pls[m->cur->pl0 + sup]};
+    for (int r = 0; r < 2; r++)
+      for (int c = 0; c < 2 - r; c++)
+        if (n3[c] > n3[c + 1]) {
+          uint64_t t = n3[c];
+          n3[c] = n3[c + 1];
+          n3[c + 1] = t;
+        }
+    k[0] = 3;
+    k[1] = n3[0];
+    k[2] = n3[1];
+    k[3] = n3[2];
+    /* the rows in node order, so that every tetrahedron solves alike */
+    double R[3][3], Rb[3];
+    for (int r = 0; r < 3; r++) {
+      int li = n3[r] == (uint64_t)m->pls[m->cur->pl0 + i] ? i
+               : n3[r] == (uint64_t)m->pls[m->cur->pl0 + j] ? j : sup;
+      pl_plane(m, li, R[r], &Rb[r]);
+    }
+    memcpy(A, R, sizeof A);
+    memcpy(B, Rb, sizeof B);
+  } else { /* two planes on a tetrahedron face */
+    int ex = -1 - sup, f[3], nf = 0;
+    for (int q = 0; q < 4; q++)
+      if (q != ex) f[nf++] = q;
+    for (int r = 0; r < 2; r++)
+      for (int c = 0; c < 2 - r; c++)
+        if (e->p[f[c]] > e->p[f[c + 1]]) {
+          int t = f[c];
+          f[c] = f[c + 1];
+          f[c + 1] = t;
+        }
+    double u[3], w[3];
+    for (int q = 0; q < 3; q++) {
+      u[q] = e->x[f[1]][q] - e->x[f[0]][q];
+      w[q] = e->x[f[2]][q] - e->x[f[0]][q];
+    }
+    double fi[3], fj[3], bi, bj;
+    pl_plane(m, ni == (uint64_t)m->pls[m->cur->pl0 + i] ? i : j, fi, &bi);
+    pl_plane(m, ni == (uint64_t)m->pls[m->cur->pl0 + i] ? j : i, fj, &bj);
+    memcpy(A[0], fi, sizeof fi);
+    memcpy(A[1], fj, sizeof fj);
+    B[0] = bi;
+    B[1] = bj;
+    vec3_cross(u, w, A[2]);
+    B[2] = vec3_dot(A[2], e->x[f[0]]);
+    k[0] = 4;
+    k[1] = (uint64_t)e->p[f[0]] << 32 | (uint64_t)e->p[f[1]];
+    k[2] = (uint64_t)e->p[f[2]];
+    k[3] = ni << 32 | nj;
+  }
+  if (solve3(A, B, x) < 0) { /* near parallel: between the two ends */
+    double n[3], d;
+    pl_plane(m, j, n, &d);
+    double sa = vec3_dot(n, e->lv[a].x) - d, sb = vec3_dot(n, e->lv[b].x) - d;
+    double t = sa / (sa - sb);
+    for (int q = 0; q < 3; q++) x[q] = e->lv[a].x[q] + t * (e->lv[b].x[q] - e->lv[a].x[q]);
+  }
+  return lv_add(e, k, x, 1, -1, -1, -1);
+}
+
+/* The solid's value with each plane on the side its bit says (scene_box's
+   classes in m->st decide every other node). */
+static int pl_eval(const Mesher *m, unsigned bits) {
+  const Scene *s = m->s;
+  int f = s->nodes[m->node].first;
+  for (int i = f; i <= m->node; i++) {
+    const ScNode *nd = &s->nodes[i];
+    int c = m->st[i - f], v;
+    if (c == T_IN || c == T_OUT) v = c == T_IN;
+    else if (nd->kind == SC_HALFSPACE) {
+      int q = m->plmap[i - f];
+      v = (int)(bits >> (q >> 1) & 1) ^ (q & 1);
+    } else {
+      int a = m->pv[nd->a - f], b = m->pv[nd->b - f];
+      v = nd->kind == SC_UNION ? a | b : nd->kind == SC_INTER ? a & b : a & !b;
+    }
+    m->pv[i - f] = (unsigned char)v;
+  }
+  return m->pv[m->node - f];
+}
+
+static int lv_global(ExTet *e, int i) {
+  LVert *v = &e->lv[i];
+  if (v->global >= 0) return v->global;
+  Mesher *m = e->m;
+  if (v->kind == 0) {
+    /* the solid's value along the edge, between the planes' crossings:
+       one change, with the ends' signs differing, is the one crossing a
+       marching neighbour finds there too */
+    int pa = e->p[v->la], pb = e->p[v->lb], k = m->cur->npl, nt = 0;
+    double t[PL_MAX + 1];
+    for (int j = 0; j < k; j++) {
+      double sa = e->s[j][v->la], sb = e->s[j][v->lb];
+      if ((sa < 0) != (sb < 0)) t[nt++] = sa / (sa - sb);
+    }
+    for (int r = 0; r < nt; r++)
+      for (int q = 0; q + 1 < nt - r; q++)
+        if (t[q] > t[q + 1]) {
+          double x = t[q];
+          t[q] = t[q + 1];
+          t[q + 1] = x;
+        }
+    int changes = 0, prev = -1;
+    for (int r = 0; r <= nt; r++) {
+      double u = 0.5 * ((r ? t[r - 1] : 0) + (r < nt ? t[r] : 1));
+      unsigned bits = 0;
+      for (int j = 0; j < k; j++) {
+        double sa = e->s[j][v->la], sb = e->s[j][v->lb];
+        if (sa + u * (sb - sa) < 0) bits |= 1u << j;
+      }
+      int val = pl_eval(m, bits);
+      changes += prev >= 0 && val != prev;
+      prev = val;
+    }
+    if (m->ps[pa] != m->ps[pb] && changes == 1) {
+      v->unified = 1;
+      return v->global = edge_vertex(m, pa, pb);
+    }
+  }
+  int g = kmap_get(&m->vert2, v->key);
+  if (g >= 0) return v->global = g;
+  if (grow((void **)&m->v, &m->capv, 3 * (m->nv + 1), sizeof *m->v) < 0 ||
+      kmap_put(&m->vert2, v->key, (int)m->nv) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  if (grow((void **)&m->uni, &m->capuni, m->nv + 1, 1) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->uni[m->nv] = 0;
+  memcpy(m->v + 3 * m->nv, v->x, sizeof v->x);
+  return v->global = (int)m->nv++;
+}
+
+static void pc_push(Piece *p, int v, int sup, int *bad) {
+  if (p->n == PV_MAX) {
+    *bad = 1;
+    return;
+  }
+  p->v[p->n] = v;
+  p->sup[p->n++] = sup;
+}
+
+/* The exact surface in the positively oriented tetrahedron on points p. */
+static int exact_tet(Mesher *m, const int p[4], size_t *count) {
+  ExTet *e = m->ex;
+  e->m = m;
+  e->p = p;
+  e->nlv = 0;
+  e->nfe = 0;
+  e->bad = 0;
+  int k = m->cur->npl;
+  for (int q = 0; q < 4; q++)
+    for (int a = 0; a < 3; a++) e->x[q][a] = m->org[a] + 0.5 * m->h * m->pc[3 * p[q] + a];
+  for (int j = 0; j < k; j++) {
+    double n[3], d;
+    pl_plane(m, j, n, &d);
+    for (int q = 0; q < 4; q++) e->s[j][q] = vec3_dot(n, e->x[q]) - d;
+  }
+  static const int tedge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  for (int i = 0; i < k; i++) {
+    /* plane i's polygon: its crossings of the tetrahedron's edges */
+    int cv[4], ce[4][2], nc = 0;
+    for (int q = 0; q < 6; q++) {
+      int a = tedge[q][0], b = tedge[q][1];
+      if ((e->s[i][a] < 0) == (e->s[i][b] < 0)) continue;
+      if (nc == 4) return (void)(m->err = MESH_EINTERNAL), -1;
+      cv[nc] = ex_edge(e, i, a, b);
+      ce[nc][0] = a;
+      ce[nc][1] = b;
+      nc++;
+    }
+    if (nc < 3) continue;
+    if (e->bad) return (void)(m->err = MESH_EINTERNAL), -1;
+    /* order them counter-clockwise about +n_i */
+    double n[3], d, c[3] = {0, 0, 0}, u[3], w[3], ang[4];
+    pl_plane(m, i, n, &d);
+    for (int q = 0; q < nc; q++)
+      for (int a = 0; a < 3; a++) c[a] += e->lv[cv[q]].x[a] / nc;
+    for (int a = 0; a < 3; a++) u[a] = e->lv[cv[0]].x[a] - c[a];
+    vec3_cross(n, u, w);
+    for (int q = 0; q < nc; q++) {
+      double r[3];
+      for (int a = 0; a < 3; a++) r[a] = e->lv[cv[q]].x[a] - c[a];
+      ang[q] = atan2(vec3_dot(r, w), vec3_dot(r, u));
+    }
+    int ord[4] = {0, 1, 2, 3};
+    for (int r = 0; r < nc; r++)
+      for (int q = 0; q + 1 < nc - r; q++)
+        if (ang[ord[q]] > ang[ord[q + 1]]) {
+          int t = ord[q];
+          ord[q] = ord[q + 1];
+          ord[q + 1] = t;
+        }
+    Piece *cur = e->pc[0], *nxt = e->pc[1];
+    int np = 1;
+    cur[0].n = 0;
+    cur[0].bits = 0;
+    for (int q = 0; q < nc; q++) {
+      int a = ord[q], b = ord[(q + 1) % nc], ex = 0;
+      /* the face holding both edges misses one corner */
+      int seen[4] = {0, 0, 0, 0};
+      seen[ce[a][0]] = seen[ce[a][1]] = seen[ce[b][0]] = seen[ce[b][1]] = 1;
+      while (seen[ex]) ex++;
+      pc_push(&cur[0], cv[a], -1 - ex, &e->bad);
+    }
+    for (int j = 0; j < k; j++) {
+      if (j == i) continue;
+      double nj[3], dj;
+      pl_plane(m, j, nj, &dj);
+      int nn = 0;
+      for (int r = 0; r < np; r++) {
+        Piece *P = &cur[r];
+        int in[PV_MAX], nin = 0;
+        for (int q = 0; q < P->n; q++) nin += in[q] = vec3_dot(nj, e->lv[P->v[q]].x) - dj < 0;
+        if (nin == 0 || nin == P->n) {
+          if (nn == PC_MAX) return (void)(m->err = MESH_EINTERNAL), -1;
+          nxt[nn] = *P;
+          if (nin) nxt[nn].bits |= 1u << j;
+          nn++;
+          continue;
+        }
+        if (nn + 2 > PC_MAX) return (void)(m->err = MESH_EINTERNAL), -1;
+        Piece *I = &nxt[nn], *O = &nxt[nn + 1];
+        I->n = O->n = 0;
+        I->bits = P->bits | 1u << j;
+        O->bits = P->bits;
+        for (int q = 0; q < P->n; q++) {
+          int r2 = (q + 1) % P->n;
+          pc_push(in[q] ? I : O, P->v[q], P->sup[q], &e->bad);
+          if (in[q] != in[r2]) {
+            int x = ex_split(e, i, P->sup[q], j, P->v[q], P->v[r2]);
+            if (x < 0) return (void)(m->err = MESH_EINTERNAL), -1;
+            if (in[q]) {
+              pc_push(I, x, j, &e->bad);
+              pc_push(O, x, P->sup[q], &e->bad);
+            } else {
+              pc_push(O, x, j, &e->bad);
+              pc_push(I, x, P->sup[q], &e->bad);
+            }
+          }
+        }
+        nn += 2;
+      }
+      Piece *t = cur;
+      cur = nxt;
+      nxt = t;
+      np = nn;
+    }
+    if (e->bad) return (void)(m->err = MESH_EINTERNAL), -1;
+    for (int r = 0; r < np; r++) {
+      const Piece *P = &cur[r];
+      int vin = pl_eval(m, P->bits | 1u << i), vout = pl_eval(m, P->bits & ~(1u << i));
+      if (vin == vout || P->n < 3) continue;
+      if (count) {
+        *count += (size_t)(P->n - 2);
+        continue;
+      }
+      int g[PV_MAX];
+      for (int q = 0; q < P->n; q++)
+        if ((g[q] = lv_global(e, P->v[q])) < 0) return -1;
+      /* its edges on the cell's faces, as the surface runs (paths) */
+      for (int q = 0; q < P->n; q++) {
+        if (P->sup[q] >= 0) continue;
+        int ex = -1 - P->sup[q], ax = -1;
+        for (int a = 0; a < 3 && ax < 0; a++) {
+          uint32_t c0 = UINT32_MAX;
+          int same = 1;
+          for (int r2 = 0; r2 < 4; r2++)
+            if (r2 != ex) {
+              uint32_t cc = m->pc[3 * p[r2] + a];
+              if (c0 == UINT32_MAX) c0 = cc;
+              else same &= cc == c0;
+            }
+          if (same) ax = a;
+        }
+        if (ax < 0) continue; /* inside the cell */
+        int ga = g[q], gb = g[(q + 1) % P->n];
+        if (!vin) {
+          int t = ga;
+          ga = gb;
+          gb = t;
+        }
+        uint64_t key[4] = {(uint64_t)ga, (uint64_t)ax,
+                           m->pc[3 * p[ex == 0 ? 1 : 0] + ax], 0};
+        if (kmap_get(&m->fpath, key) >= 0) continue;
+        if (kmap_put(&m->fpath, key, gb) < 0 ||
+            grow((void **)&m->fstart, &m->capfs, 4 * (m->nfs + 1), sizeof *m->fstart) < 0)
+          return (void)(m->err = MESH_ENOMEM), -1;
+        memcpy(m->fstart + 4 * m->nfs++, key, sizeof key);
+      }
+      for (int q = 1; q + 1 < P->n; q++) {
+        int rc = vin ? emit(m, g[0], g[q], g[q + 1]) : emit(m, g[0], g[q + 1], g[q]);
+        if (rc < 0) return -1;
+      }
+    }
+  }
+  return 0;
+}
+
+/* The Kuhn split: 6 tetrahedra around the diagonal 0 - 7, each ordered to
+   positive orientation (corner masks: bit 0 x, 1 y, 2 z). */
+static const int kuhn[6][4] = {
+    {0, 1, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, /* even permutations */
+    {0, 1, 7, 5}, {0, 4, 7, 6}, {0, 2, 7, 3}, /* odd, last two swapped */
+};
+
+static int cell(Mesher *m, size_t leaf, size_t *count) {
+  const Leaf *lf = &m->leaves[leaf];
+  m->cur = lf;
+  int l = lf->level, plain = 1;
+  int64_t q[3] = {lf->q[0], lf->q[1], lf->q[2]};
+  int (*mk)(Mesher *, const int *, size_t *) = tet;
+  if (lf->kind == LEAF_EXACT) {
+    /* the classes over this box again, for pl_eval, and each undecided
+       halfspace's plane in the cell's list */
+    double side = ldexp(m->h, m->depth - l), lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+      lo[a] = m->org[a] + side * (double)q[a];
+      hi[a] = lo[a] + side;
+    }
+    int one, f = m->s->nodes[m->node].first;
+    scene_box(m->s, m->node, lo, hi, m->st, m->one, &one);
+    for (int x = f; x <= m->node; x++) {
+      if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+      int y = 0;
+      while (y < lf->npl && !same_surface(m->s, m->pls[lf->pl0 + y], x)) y++;
+      if (y == lf->npl) return (void)(m->err = MESH_EINTERNAL), -1;
+      const ScNode *a = &m->s->nodes[x], *b = &m->s->nodes[m->pls[lf->pl0 + y]];
+      m->plmap[x - f] = 2 * y + (vec3_dot(a->n, b->n) < 0);
+    }
+    mk = exact_tet;
+  }
+  m->nft = 0;
+  if (l < m->depth)
+    for (int a = 0; a < 3; a++)
+      for (int s = 0; s < 2; s++)
+        if (face(m, l, q, a, s, &plain) < 0) return -1;
+  if (plain) {
+    int c[8];
+    for (int k = 0; k < 8; k++) {
+      uint32_t dc[3];
+      for (int i = 0; i < 3; i++)
+        dc[i] = (uint32_t)((q[i] + (k >> i & 1)) << (m->depth - l + 1));
+      if ((c[k] = point(m, dc)) < 0) return -1;
+    }
+    for (int t = 0; t < 6; t++) {
+      int p[4] = {c[kuhn[t][0]], c[kuhn[t][1]], c[kuhn[t][2]], c[kuhn[t][3]]};
+      if (mk(m, p, count) < 0) return -1;
+    }
+    return 0;
+  }
+  uint32_t cc[3];
+  for (int i = 0; i < 3; i++) cc[i] = (uint32_t)((2 * q[i] + 1) << (m->depth - l));
+  int cp = point(m, cc);
+  if (cp < 0) return -1;
+  for (size_t i = 0; i < m->nft; i += 3) {
+    /* (a, b, c) counter-clockwise from outside, the centre inside:
+       (a, c, b, centre) is positive */
+    int p[4] = {m->ft[i], m->ft[i + 2], m->ft[i + 1], cp};
+    if (mk(m, p, count) < 0) return -1;
+  }
+  return 0;
+}
+
 /* The node of node's subtree that makes it unbounded. */
 static int unbounded_leaf(const Scene *s, int node) {
   double lo[3], hi[3];
@@ -529,8 +1562,57 @@ static int unbounded_leaf(const Scene *s, int node) {
   }
 }
 
-int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
-               MeshReport *rep, int *bad_node, char *err, size_t errlen) {
+/* The sharp cells' surface along each cell face, from one vertex that a
+   marching neighbour also makes (edge_vertex) to the next, through crease
+   points and double crossings: a marching triangle edge (u, v) on that
+   face is split into the same path (emit_split: a fan from the
+   triangle's third vertex over a simple path in the face's plane). */
+static int face_paths(Mesher *m) {
+  for (size_t f = 0; f < m->nfs; f++) {
+    uint64_t key[4];
+    memcpy(key, m->fstart + 4 * f, sizeof key);
+    int a = (int)key[0];
+    if (!m->uni[a]) continue;
+    size_t mark = m->npoly;
+    if (grow((void **)&m->poly, &m->cappoly, m->npoly + 1, sizeof *m->poly) < 0)
+      return (void)(m->err = MESH_ENOMEM), -1;
+    m->npoly++;
+    int cur = a, n = 0, ok = 1;
+    for (;;) {
+      key[0] = (uint64_t)cur;
+      int nx = kmap_get(&m->fpath, key);
+      if (nx < 0 || n > 1000) {
+        ok = 0;
+        break;
+      }
+      cur = nx;
+      if (m->uni[cur]) break;
+      if (grow((void **)&m->poly, &m->cappoly, m->npoly + 1, sizeof *m->poly) < 0)
+        return (void)(m->err = MESH_ENOMEM), -1;
+      m->poly[m->npoly++] = cur;
+      n++;
+    }
+    uint64_t pk = a < cur ? (uint64_t)a << 32 | (uint64_t)cur
+                          : (uint64_t)cur << 32 | (uint64_t)a;
+    if (!ok || n == 0 || hget(&m->crease, pk) >= 0) {
+      m->npoly = mark;
+      continue;
+    }
+    m->poly[mark] = n;
+    if (cur < a) /* stored from the lower index to the higher */
+      for (int q = 0; q < n / 2; q++) {
+        int t = m->poly[mark + 1 + (size_t)q];
+        m->poly[mark + 1 + (size_t)q] = m->poly[mark + (size_t)n - (size_t)q];
+        m->poly[mark + (size_t)n - (size_t)q] = t;
+      }
+    if (hput(&m->crease, pk, (int)mark) < 0) return (void)(m->err = MESH_ENOMEM), -1;
+  }
+  return 0;
+}
+
+static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
+                    Mesh **out, MeshReport *rep, int *bad_node, char *err,
+                    size_t errlen, int sharp) {
   struct timespec t0, t1;
   clock_gettime(CLOCK_MONOTONIC, &t0);
   memset(rep, 0, sizeof *rep);
@@ -578,7 +1660,7 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
     return MESH_ETOL;
   }
   double vtol = fmax(0.01 * e, 64 * RAY_TOL_FLOOR * scale);
-  double ht = e - vtol, L = size + 2 * ht;
+  double ht = e - vtol, L = size + 3 * ht;
   int depth = 0;
   while (L / ldexp(1, depth) > ht) depth++;
   if (depth > MAX_DEPTH) {
@@ -593,31 +1675,45 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
   m.node = node;
   m.depth = depth;
   m.h = L / ldexp(1, depth);
+  m.tol = e;
+  m.vtol = vtol;
+  m.sharp = sharp;
   m.rep = rep;
   m.max_cells = ms->max_cells ? ms->max_cells : (size_t)1 << 24;
   for (int i = 0; i < 3; i++) {
     double c = 0.5 * (lo[i] + hi[i]);
-    m.org[i] = c - 0.5 * L;
-    /* the clip box: the object's box, a little enlarged (never cutting
-       a bounded object), or the user's box */
-    m.clo[i] = ms->has_bounds && ms->lo[i] >= lo[i] ? lo[i] : lo[i] - 0.5 * ht;
-    m.chi[i] = ms->has_bounds && ms->hi[i] <= hi[i] ? hi[i] : hi[i] + 0.5 * ht;
+    /* off centre by a fraction of a cell unlike on each axis, so that a
+       centred object's diagonals and faces miss the grid's (a plane
+       through a grid point or along a tetrahedron's face is a degenerate
+       case for the sharp cells) */
+    static const double shift[3] = {0.1713, 0.2389, 0.3167};
+    m.org[i] = c - 0.5 * L + shift[i] * ht;
+    /* the clip box: the user's box where it cuts the object, else no
+       clip (the object's box is conservative; a clip there would keep
+       the cells at its faces from being proven plane) */
+    m.clo[i] = ms->has_bounds && ms->lo[i] >= lo[i] ? lo[i] : -HUGE_VAL;
+    m.chi[i] = ms->has_bounds && ms->hi[i] <= hi[i] ? hi[i] : HUGE_VAL;
   }
   rep->depth = depth;
   rep->h = m.h;
   rep->vtol = vtol;
   int nsub = node - s->nodes[node].first + 1;
   m.st = malloc((size_t)nsub);
+  m.one = malloc((size_t)nsub * sizeof *m.one);
+  m.gst = malloc(DT_STACK_MAX * sizeof *m.gst);
+  m.plmap = malloc((size_t)nsub * sizeof *m.plmap);
+  m.pv = malloc((size_t)nsub);
+  m.ex = malloc(sizeof *m.ex);
   m.ray = ray_ctx_new(s, vtol);
   int rc = MESH_OK;
-  if (!m.st || !m.ray) {
+  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.ex || !m.ray) {
     rc = MESH_ENOMEM;
     goto done;
   }
   if (walk(&m, 0, 0, 0, 0) < 0) {
     rc = m.err;
     if (rc == MESH_ELIMIT)
-      snprintf(err, errlen, "the mesh needs more than %zu finest octree "
+      snprintf(err, errlen, "the mesh needs more than %zu surface octree "
                "cells (limit max-cells): give a larger tolerance than %g",
                m.max_cells, e);
     goto done;
@@ -648,22 +1744,23 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
     rc = MESH_ELIMIT;
     goto done;
   }
-  for (size_t l = 0; l < m.nleaves; l++)
-    if (cell(&m, l, NULL) < 0) {
+  /* the sharp cells first: their crease points split the marching
+     triangles next to them */
+  for (int pass = 0; pass < 2; pass++) {
+    for (size_t l = 0; l < m.nleaves; l++)
+      if ((m.leaves[l].kind == LEAF_EXACT) == !pass && cell(&m, l, NULL) < 0) {
+        rc = m.err;
+        goto done;
+      }
+    if (!pass && face_paths(&m) < 0) {
       rc = m.err;
       goto done;
     }
+  }
   if (m.ray->failed) {
     rc = MESH_ENOMEM;
     goto done;
   }
-  double cert = 0;
-  for (size_t i = 0; i < m.nt; i++) {
-    const int *t = m.t + 3 * i;
-    double r = cover_radius(m.v + 3 * t[0], m.v + 3 * t[1], m.v + 3 * t[2]);
-    if (r > cert) cert = r;
-  }
-  rep->certified = cert + vtol;
   Mesh *me = malloc(sizeof *me);
   if (!me) {
     rc = MESH_ENOMEM;
@@ -671,6 +1768,7 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
   }
   me->nv = m.nv;
   me->nt = m.nt;
+  me->rgb = NULL;
   me->v = m.v;
   me->t = m.t;
   m.v = NULL;
@@ -696,10 +1794,29 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
 done:
   if (rc == MESH_ENOMEM) snprintf(err, errlen, "out of memory while meshing");
   free(m.st);
+  free(m.one);
+  free(m.gst);
+  free(m.plmap);
+  free(m.pv);
+  free(m.ex);
+  free(m.pls);
+  free(m.vert2.k);
+  free(m.vert2.v);
   free(m.leaves);
   free(m.v);
   free(m.t);
-  hfree(&m.sign);
+  free(m.pc);
+  free(m.ps);
+  free(m.fl);
+  free(m.ft);
+  hfree(&m.split);
+  hfree(&m.crease);
+  free(m.poly);
+  free(m.fpath.k);
+  free(m.fpath.v);
+  free(m.fstart);
+  free(m.uni);
+  hfree(&m.pt);
   hfree(&m.vert);
   if (m.ray) ray_ctx_free(m.ray);
   clock_gettime(CLOCK_MONOTONIC, &t1);
@@ -710,6 +1827,7 @@ done:
 
 void mesh_free(Mesh *m) {
   if (!m) return;
+  free(m->rgb);
   free(m->v);
   free(m->t);
   free(m);
@@ -849,7 +1967,112 @@ static const char *ext_of(const char *path) {
 
 int mesh_is_mesh_path(const char *path) {
   const char *e = ext_of(path);
-  return !strcmp(e, "stl") || !strcmp(e, "obj");
+  return !strcmp(e, "stl") || !strcmp(e, "obj") || !strcmp(e, "ply") ||
+         !strcmp(e, "3mf");
+}
+
+/* ---- colours ------------------------------------------------------------ */
+
+/* The top-level union's parts with their inherited Colour (as the tracer
+   collects them). */
+static int collect_parts(const Scene *s, int root, int **parts,
+                         const double ***cols, int *n) {
+  int cap = 16, sp = 0, capst = 16;
+  int *st = malloc((size_t)capst * sizeof *st);
+  const double **stc = malloc((size_t)capst * sizeof *stc);
+  *parts = malloc((size_t)cap * sizeof **parts);
+  *cols = malloc((size_t)cap * sizeof **cols);
+  *n = 0;
+  if (!st || !stc || !*parts || !*cols) goto nomem;
+  st[sp] = root;
+  stc[sp++] = NULL;
+  while (sp) {
+    sp--;
+    int nd = st[sp];
+    const ScNode *x = &s->nodes[nd];
+    const double *c = x->has_colour ? x->colour : stc[sp];
+    if (x->kind == SC_UNION) {
+      if (sp + 2 > capst) {
+        capst *= 2;
+        int *g = realloc(st, (size_t)capst * sizeof *st);
+        if (g) st = g;
+        const double **gc = realloc(stc, (size_t)capst * sizeof *stc);
+        if (gc) stc = gc;
+        if (!g || !gc) goto nomem;
+      }
+      st[sp] = x->b;
+      stc[sp++] = c;
+      st[sp] = x->a;
+      stc[sp++] = c;
+      continue;
+    }
+    if (*n == cap) {
+      cap *= 2;
+      int *g = realloc(*parts, (size_t)cap * sizeof **parts);
+      if (g) *parts = g;
+      const double **gc = realloc(*cols, (size_t)cap * sizeof **cols);
+      if (gc) *cols = gc;
+      if (!g || !gc) goto nomem;
+    }
+    (*parts)[*n] = nd;
+    (*cols)[(*n)++] = c;
+  }
+  free(st);
+  free(stc);
+  return 0;
+nomem:
+  free(st);
+  free(stc);
+  free(*parts);
+  free(*cols);
+  *parts = NULL;
+  *cols = NULL;
+  return -1;
+}
+
+int mesh_colour(const Scene *s, int node, Mesh *m, const double def[3],
+                double inset) {
+  int *parts, np;
+  const double **cols;
+  if (collect_parts(s, node, &parts, &cols, &np) < 0) return -1;
+  double *vn = calloc(3 * (m->nv ? m->nv : 1), sizeof *vn);
+  float *rgb = malloc(3 * (m->nv ? m->nv : 1) * sizeof *rgb);
+  if (!vn || !rgb) {
+    free(vn);
+    free(rgb);
+    free(parts);
+    free(cols);
+    return -1;
+  }
+  for (size_t i = 0; i < m->nt; i++) {
+    const int *t = m->t + 3 * i;
+    const double *a = m->v + 3 * t[0], *b = m->v + 3 * t[1], *c = m->v + 3 * t[2];
+    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]}, n[3];
+    vec3_cross(u, w, n);
+    for (int k = 0; k < 3; k++)
+      for (int j = 0; j < 3; j++) vn[3 * (size_t)t[k] + (size_t)j] += n[j];
+  }
+  /* a vertex takes the colour of the first part holding a point just
+     inside the surface below it */
+  for (size_t i = 0; i < m->nv; i++) {
+    double *n = vn + 3 * i, l = sqrt(vec3_dot(n, n)), q[3];
+    for (int j = 0; j < 3; j++)
+      q[j] = m->v[3 * i + (size_t)j] - (l > 0 ? inset * n[j] / l : 0);
+    const double *c = def;
+    for (int k = 0; k < np; k++)
+      if (scene_inside(s, parts[k], q) == 1) {
+        if (cols[k]) c = cols[k];
+        break;
+      }
+    for (int j = 0; j < 3; j++) rgb[3 * i + (size_t)j] = (float)c[j];
+  }
+  free(vn);
+  free(parts);
+  free(cols);
+  free(m->rgb);
+  m->rgb = rgb;
+  return 0;
 }
 
 typedef struct {
@@ -890,6 +2113,166 @@ static void tri_normal(const Mesh *m, size_t i, double n[3]) {
   double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
   double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
   vec3_cross(u, w, n);
+}
+
+static void put_le(buf *b, uint32_t u, int n) {
+  unsigned char q[4];
+  for (int i = 0; i < n; i++) q[i] = (unsigned char)(u >> (8 * i));
+  put(b, q, (size_t)n);
+}
+
+static unsigned char vcolour(const Mesh *m, size_t v, int k) {
+  static const float grey[3] = {0.80f, 0.78f, 0.72f};
+  return img_srgb8(m->rgb ? m->rgb[3 * v + (size_t)k] : grey[k]);
+}
+
+/* Binary little-endian PLY: float x y z, uchar red green blue (sRGB) per
+   vertex, a uchar-counted int list per face. */
+static void write_ply(const Mesh *m, buf *b) {
+  char head[400];
+  int len = snprintf(head, sizeof head,
+                     "ply\nformat binary_little_endian 1.0\ncomment written "
+                     "by qcs\nelement vertex %zu\nproperty float x\nproperty "
+                     "float y\nproperty float z\nproperty uchar red\nproperty "
+                     "uchar green\nproperty uchar blue\nelement face %zu\n"
+                     "property list uchar int vertex_indices\nend_header\n",
+                     m->nv, m->nt);
+  put(b, head, (size_t)len);
+  for (size_t i = 0; i < m->nv; i++) {
+    for (int k = 0; k < 3; k++) put_f32(b, m->v[3 * i + (size_t)k]);
+    unsigned char c[3];
+    for (int k = 0; k < 3; k++) c[k] = vcolour(m, i, k);
+    put(b, c, 3);
+  }
+  for (size_t i = 0; i < m->nt; i++) {
+    put(b, "\3", 1);
+    for (int k = 0; k < 3; k++) put_le(b, (uint32_t)m->t[3 * i + (size_t)k], 4);
+  }
+}
+
+static void put_str(buf *b, const char *s) { put(b, s, strlen(s)); }
+
+/* 3MF (core specification): the model XML with one base material per
+   distinct colour, each triangle taking its first vertex's; zipped in
+   memory by libzip and written whole by img_write_bytes. */
+static int write_3mf(const Mesh *m, const char *path, char *err,
+                     size_t errlen) {
+  buf x = {0};
+  char line[200];
+  /* the distinct colours */
+  uint32_t *pal = NULL;
+  int *tc = malloc((m->nt ? m->nt : 1) * sizeof *tc);
+  size_t npal = 0, cappal = 0;
+  hmap idx = {0};
+  int rc = -1;
+  if (!tc) goto nomem;
+  for (size_t i = 0; i < m->nt; i++) {
+    size_t v = (size_t)m->t[3 * i];
+    uint32_t c = (uint32_t)vcolour(m, v, 0) << 16 | (uint32_t)vcolour(m, v, 1) << 8 |
+                 vcolour(m, v, 2);
+    int k = hget(&idx, c);
+    if (k < 0) {
+      if (grow((void **)&pal, &cappal, npal + 1, sizeof *pal) < 0 ||
+          hput(&idx, c, (int)npal) < 0)
+        goto nomem;
+      pal[npal] = c;
+      k = (int)npal++;
+    }
+    tc[i] = k;
+  }
+  put_str(&x, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\""
+              "millimeter\" xml:lang=\"en-US\" xmlns=\"http://schemas."
+              "microsoft.com/3dmanufacturing/core/2015/02\">\n <metadata "
+              "name=\"Application\">qcs</metadata>\n <resources>\n  "
+              "<basematerials id=\"1\">\n");
+  for (size_t i = 0; i < npal; i++) {
+    snprintf(line, sizeof line, "   <base name=\"colour %zu\" displaycolor="
+             "\"#%06X\" />\n", i, (unsigned)pal[i]);
+    put_str(&x, line);
+  }
+  put_str(&x, "  </basematerials>\n  <object id=\"2\" type=\"model\" "
+              "pid=\"1\" pindex=\"0\">\n   <mesh>\n    <vertices>\n");
+  for (size_t i = 0; i < m->nv; i++) {
+    snprintf(line, sizeof line, "     <vertex x=\"%.9g\" y=\"%.9g\" z=\"%.9g\" />\n",
+             m->v[3 * i], m->v[3 * i + 1], m->v[3 * i + 2]);
+    put_str(&x, line);
+  }
+  put_str(&x, "    </vertices>\n    <triangles>\n");
+  for (size_t i = 0; i < m->nt; i++) {
+    const int *t = m->t + 3 * i;
+    snprintf(line, sizeof line, "     <triangle v1=\"%d\" v2=\"%d\" v3=\"%d\" "
+             "pid=\"1\" p1=\"%d\" />\n", t[0], t[1], t[2], tc[i]);
+    put_str(&x, line);
+  }
+  put_str(&x, "    </triangles>\n   </mesh>\n  </object>\n </resources>\n "
+              "<build>\n  <item objectid=\"2\" />\n </build>\n</model>\n");
+  if (x.bad) goto nomem;
+  static const char types[] =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Types xmlns=\"http://"
+      "schemas.openxmlformats.org/package/2006/content-types\">\n <Default "
+      "Extension=\"rels\" ContentType=\"application/vnd.openxmlformats-"
+      "package.relationships+xml\" />\n <Default Extension=\"model\" "
+      "ContentType=\"application/vnd.ms-package.3dmanufacturing-3dmodel+xml\""
+      " />\n</Types>\n";
+  static const char rels[] =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Relationships xmlns=\""
+      "http://schemas.openxmlformats.org/package/2006/relationships\">\n "
+      "<Relationship Target=\"/3D/3dmodel.model\" Id=\"rel0\" Type=\"http://"
+      "schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel\" />\n"
+      "</Relationships>\n";
+  zip_error_t ze;
+  zip_error_init(&ze);
+  zip_source_t *src = zip_source_buffer_create(NULL, 0, 0, &ze);
+  zip_t *za = src ? zip_open_from_source(src, ZIP_TRUNCATE, &ze) : NULL;
+  if (!za) {
+    if (src) zip_source_free(src);
+    zip_error_fini(&ze);
+    goto nomem;
+  }
+  zip_source_keep(src);
+  const char *names[3] = {"[Content_Types].xml", "_rels/.rels", "3D/3dmodel.model"};
+  const void *data[3] = {types, rels, x.p};
+  size_t lens[3] = {sizeof types - 1, sizeof rels - 1, x.n};
+  int zok = 1;
+  for (int i = 0; i < 3 && zok; i++) {
+    zip_source_t *fs = zip_source_buffer(za, data[i], lens[i], 0);
+    if (!fs || zip_file_add(za, names[i], fs, ZIP_FL_OVERWRITE) < 0) {
+      if (fs) zip_source_free(fs);
+      zok = 0;
+    }
+  }
+  if (!zok || zip_close(za) < 0) {
+    if (zok) zip_discard(za);
+    else zip_discard(za);
+    zip_source_free(src);
+    zip_error_fini(&ze);
+    goto nomem;
+  }
+  zip_stat_t st;
+  char *bytes = NULL;
+  if (zip_source_open(src) == 0) {
+    if (zip_source_stat(src, &st) == 0 && (st.valid & ZIP_STAT_SIZE) &&
+        (bytes = malloc(st.size ? (size_t)st.size : 1)) != NULL &&
+        zip_source_read(src, bytes, st.size) == (zip_int64_t)st.size)
+      rc = img_write_bytes(path, bytes, (size_t)st.size, err, errlen);
+    else rc = -2;
+    zip_source_close(src);
+  } else rc = -2;
+  free(bytes);
+  zip_source_free(src);
+  zip_error_fini(&ze);
+  if (rc == -2) goto nomem;
+  goto out;
+nomem:
+  snprintf(err, errlen, "cannot write %s: out of memory (or the zip "
+           "library failed)", path);
+  rc = -1;
+out:
+  free(x.p);
+  free(pal);
+  free(tc);
+  hfree(&idx);
+  return rc;
 }
 
 int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
@@ -941,9 +2324,13 @@ int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
       put(&b, line, (size_t)len);
     }
     free(vn);
+  } else if (!strcmp(ext_of(path), "ply")) {
+    write_ply(m, &b);
+  } else if (!strcmp(ext_of(path), "3mf")) {
+    return write_3mf(m, path, err, errlen);
   } else {
-    snprintf(err, errlen, "cannot write %s: a mesh is written as .stl or "
-             ".obj", path);
+    snprintf(err, errlen, "cannot write %s: a mesh is written as .stl, "
+             ".obj, .ply or .3mf", path);
     return -1;
   }
   if (b.bad) {
@@ -953,5 +2340,19 @@ int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
   }
   int rc = img_write_bytes(path, b.p, b.n, err, errlen);
   free(b.p);
+  return rc;
+}
+
+int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
+               MeshReport *rep, int *bad_node, char *err, size_t errlen) {
+  int rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, 1);
+  if (rc == MESH_EINTERNAL) {
+    /* a degenerate case decided differently by two sharp cells: the
+       marching cells alone are closed by construction */
+    double t = rep->seconds;
+    rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, 0);
+    rep->seconds += t;
+    rep->sharp_off = 1;
+  }
   return rc;
 }

@@ -51,7 +51,7 @@ typedef struct MeshSettings {
                               object needs it) */
   double lo[3], hi[3];
   size_t max_triangles;    /* refuse a mesh with more (0: no limit) */
-  size_t max_cells;        /* refuse an octree with more finest cells */
+  size_t max_cells;        /* refuse an octree with more surface cells */
 } MeshSettings;
 
 typedef struct Mesh {
@@ -59,12 +59,20 @@ typedef struct Mesh {
   double *v;               /* 3 nv coordinates */
   int *t;                  /* 3 nt vertex indices, counter-clockwise seen
                               from outside */
+  float *rgb;              /* 3 nv linear colours (mesh_colour), or NULL */
 } Mesh;
 
 typedef struct MeshReport {
   long cells;              /* octree cells visited */
   long empty, full;        /* of them proven outside / inside */
-  long leaves;             /* finest cells meshed */
+  long leaves;             /* surface cells meshed (at any level) */
+  long planar, smooth;     /* of them kept above the finest level: the
+                              surface proven one plane, or proven close
+                              enough by the gradient bound */
+  long sharp;              /* of them meshed exactly: the solid there is a
+                              CSG of at most 8 planes (edges and corners
+                              kept) */
+  int sharp_off;           /* sharp cells were given up (see mesh.c) */
   int depth;               /* finest level */
   double h;                /* finest cell side */
   double vtol;             /* the vertices' distance bound */
@@ -104,9 +112,17 @@ typedef struct MeshCheck {
    else -1 (details in *c); -2 when memory runs out. */
 int mesh_check(const Mesh *m, MeshCheck *c);
 
-/* 1 if the file name asks for a mesh (.stl, .obj), else 0. */
+/* Colours m's vertices: each takes the Colour of the first part of the
+   scene's top-level union that holds the point inset below it along the
+   vertex normal (def where no part has a Colour). 0, or -1 out of memory. */
+int mesh_colour(const Scene *s, int node, Mesh *m, const double def[3],
+                double inset);
+
+/* 1 if the file name asks for a mesh (.stl, .obj, .ply, .3mf), else 0. */
 int mesh_is_mesh_path(const char *path);
-/* Writes m to path, binary STL or OBJ with vertex normals by extension,
-   whole or not at all (a temporary file renamed into place). */
+/* Writes m to path by extension: binary STL, OBJ with vertex normals,
+   binary PLY with per-vertex sRGB colour, or 3MF (a zip made in memory by
+   libzip, one base material per colour); whole or not at all (a
+   temporary file renamed into place). */
 int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen);
 #endif

@@ -235,6 +235,8 @@ static void one(const char *name, const char *src, double tol, long euler,
   snprintf(buf, sizeof buf, "%s: certified error %.4g <= tolerance %.4g", name,
            rep.certified, tol);
   CHECK(buf, rep.certified <= tol);
+  snprintf(buf, sizeof buf, "%s: the sharp cells were kept", name);
+  CHECK(buf, !rep.sharp_off);
   double v = volume(m);
   snprintf(buf, sizeof buf, "%s: outward (signed volume %.4f > 0)", name, v);
   CHECK(buf, v > 0);
@@ -250,11 +252,315 @@ static void one(const char *name, const char *src, double tol, long euler,
     snprintf(buf, sizeof buf, "%s: ray crossings within tol of the mesh (worst %.3g)", name, w);
     CHECK(buf, w <= tol);
   }
-  printf("# %s: %zu triangles, %ld cells (%ld empty, %ld full, %ld meshed), "
-         "certified %.4g, %.3f s\n", name, rep.triangles, rep.cells, rep.empty,
-         rep.full, rep.leaves, rep.certified, rep.seconds);
+  printf("# %s: %zu triangles, %ld cells (%ld empty, %ld full, %ld meshed: "
+         "%ld plane, %ld smooth, %ld sharp), certified %.4g, %.3f s\n", name,
+         rep.triangles, rep.cells, rep.empty, rep.full, rep.leaves, rep.planar,
+         rep.smooth, rep.sharp, rep.certified, rep.seconds);
   mesh_free(m);
   scene_free(s);
+}
+
+
+/* ---- the property test: random scenes, fixed seed ------------------------ */
+
+/* orient3d, plain doubles: the sign of det(b - a, c - a, d - a). */
+static double orient(const double *a, const double *b, const double *c,
+                     const double *d) {
+  double u[3], v[3], w[3], x[3];
+  for (int i = 0; i < 3; i++) u[i] = b[i] - a[i], v[i] = c[i] - a[i], w[i] = d[i] - a[i];
+  vec3_cross(u, v, x);
+  return vec3_dot(x, w);
+}
+
+/* Segment pq crosses the inside of triangle abc strictly (eps: volumes
+   this small count as touching, which is not a crossing). */
+static int seg_tri(const double *p, const double *q, const double *a,
+                   const double *b, const double *c, double eps) {
+  double s1 = orient(a, b, c, p), s2 = orient(a, b, c, q);
+  if (!((s1 > eps && s2 < -eps) || (s1 < -eps && s2 > eps))) return 0;
+  double e1 = orient(p, q, a, b), e2 = orient(p, q, b, c), e3 = orient(p, q, c, a);
+  return (e1 > eps && e2 > eps && e3 > eps) || (e1 < -eps && e2 < -eps && e3 < -eps);
+}
+
+/* Two triangles intersect (other than along what they share): an edge of
+   one not through a shared vertex crosses the other. Coplanar overlaps
+   are not seen by this test. */
+static int tri_tri(const Mesh *m, size_t i, size_t j, double eps) {
+  const int *s = m->t + 3 * i, *t = m->t + 3 * j;
+  int shared = 0;
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) shared += s[a] == t[b];
+  if (shared >= 2) return 0;
+  for (int pass = 0; pass < 2; pass++) {
+    const int *x = pass ? t : s, *y = pass ? s : t;
+    for (int e = 0; e < 3; e++) {
+      int u = x[e], v = x[(e + 1) % 3];
+      if (u == y[0] || u == y[1] || u == y[2] || v == y[0] || v == y[1] || v == y[2])
+        continue;
+      if (seg_tri(m->v + 3 * u, m->v + 3 * v, m->v + 3 * y[0], m->v + 3 * y[1],
+                  m->v + 3 * y[2], eps))
+        return 1;
+    }
+  }
+  return 0;
+}
+
+/* Pairs of intersecting triangles, by a uniform grid over the mesh's box
+   (a pair is tested in the first grid cell both boxes share). */
+static long self_intersections(const Mesh *m) {
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (size_t i = 0; i < 3 * m->nv; i++) {
+    if (m->v[i] < lo[i % 3]) lo[i % 3] = m->v[i];
+    if (m->v[i] > hi[i % 3]) hi[i % 3] = m->v[i];
+  }
+  int g = 1;
+  while ((size_t)g * (size_t)g * (size_t)g < m->nt / 2 && g < 128) g++;
+  double size = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+  double cs = size / g * 1.0001, eps = 1e-13 * size * size * size;
+  size_t ncell = (size_t)g * (size_t)g * (size_t)g;
+  size_t *cnt = calloc(ncell + 1, sizeof *cnt);
+  int (*box)[6] = malloc(m->nt * sizeof *box);
+  for (size_t i = 0; i < m->nt; i++)
+    for (int a = 0; a < 3; a++) {
+      double l = 1e300, h = -1e300;
+      for (int k = 0; k < 3; k++) {
+        double x = m->v[3 * m->t[3 * i + k] + a];
+        l = fmin(l, x);
+        h = fmax(h, x);
+      }
+      box[i][a] = (int)((l - lo[a]) / cs);
+      box[i][3 + a] = (int)((h - lo[a]) / cs);
+      if (box[i][3 + a] >= g) box[i][3 + a] = g - 1;
+    }
+  for (int pass = 0; pass < 2; pass++) {
+    if (pass) {
+      for (size_t c = 0, sum = 0; c <= ncell; c++) {
+        size_t n = cnt[c];
+        cnt[c] = sum;
+        sum += n;
+      }
+    }
+    static size_t *items;
+    static size_t *fill;
+    if (pass == 1) {
+      items = malloc((cnt[ncell] + 1) * sizeof *items);
+      fill = malloc((ncell + 1) * sizeof *fill);
+      memcpy(fill, cnt, (ncell + 1) * sizeof *fill);
+    }
+    for (size_t i = 0; i < m->nt; i++)
+      for (int x = box[i][0]; x <= box[i][3]; x++)
+        for (int y = box[i][1]; y <= box[i][4]; y++)
+          for (int z = box[i][2]; z <= box[i][5]; z++) {
+            size_t c = ((size_t)x * (size_t)g + (size_t)y) * (size_t)g + (size_t)z;
+            if (pass) items[fill[c]++] = i;
+            else cnt[c]++;
+          }
+    if (pass == 1) {
+      long bad = 0;
+      for (size_t c = 0; c < ncell; c++) {
+        int cx = (int)(c / ((size_t)g * (size_t)g)), cy = (int)(c / (size_t)g % (size_t)g),
+            cz = (int)(c % (size_t)g);
+        for (size_t a = cnt[c]; a < fill[c]; a++)
+          for (size_t b = a + 1; b < fill[c]; b++) {
+            size_t i = items[a], j = items[b];
+            int fx = box[i][0] > box[j][0] ? box[i][0] : box[j][0];
+            int fy = box[i][1] > box[j][1] ? box[i][1] : box[j][1];
+            int fz = box[i][2] > box[j][2] ? box[i][2] : box[j][2];
+            if (fx != cx || fy != cy || fz != cz) continue;
+            bad += tri_tri(m, i, j, eps);
+          }
+      }
+      free(items);
+      free(fill);
+      free(cnt);
+      free(box);
+      return bad;
+    }
+  }
+  return -1;
+}
+
+/* The value of a qcs expression (the language's own probes). */
+static Value *eval_text(const char *text) {
+  Src *src = malloc(sizeof *src);
+  size_t n = strlen(text) + 1;
+  char *copy = malloc(n);
+  memcpy(copy, text, n);
+  src->name = "<probe>";
+  src->text = copy;
+  ErrFrame f;
+  Value *volatile v = NULL;
+  if (ERR_TRY(f)) {
+    v = force(I, eval(I, parse_expression(I, src), NULL));
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    printf("# probe error: %s\n", err_info()->msg);
+  }
+  return v;
+}
+
+/* Triangle points within tol of the surface, by the Roots probe: a root
+   of the object on the segment p -+ tol along the triangle's normal or an
+   axis (a root at distance <= tol along any direction proves the
+   distance). With rounded (a density tree and its radius), also by the
+   Density probe: the density crosses 0.5 on one of those segments. The
+   number of points failing both (or either, for rounded). */
+static long probe_points(const char *obj, const char *tree, double radius,
+                         const Mesh *m, double tol, int n) {
+  long bad = 0;
+  char buf[4096];
+  for (int k = 0; k < n; k++) {
+    size_t i = (size_t)(urand() * (double)m->nt);
+    const double *a = m->v + 3 * m->t[3 * i], *b = m->v + 3 * m->t[3 * i + 1],
+                 *c = m->v + 3 * m->t[3 * i + 2];
+    double u = urand(), v = urand(), p[3], ab[3], ac[3], nn[3];
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    for (int j = 0; j < 3; j++) {
+      p[j] = a[j] + u * (b[j] - a[j]) + v * (c[j] - a[j]);
+      ab[j] = b[j] - a[j];
+      ac[j] = c[j] - a[j];
+    }
+    vec3_cross(ab, ac, nn);
+    double l = sqrt(vec3_dot(nn, nn));
+    if (!(l > 0)) continue; /* a sliver: its points are its edges' */
+    double dirs[4][3] = {{nn[0] / l, nn[1] / l, nn[2] / l}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    int found = 0, dens = tree == NULL;
+    for (int d = 0; d < 4 && !(found && dens); d++) {
+      double o[3], e[3];
+      for (int j = 0; j < 3; j++) o[j] = p[j] - tol * dirs[d][j], e[j] = 2 * tol * dirs[d][j];
+      if (!found) {
+        snprintf(buf, sizeof buf, "Roots (%s) (%.17g, %.17g, %.17g) (%.17g, %.17g, %.17g)",
+                 obj, o[0], o[1], o[2], e[0], e[1], e[2]);
+        for (Value *r = eval_text(buf); r && r->kind == V_CONS; r = force(I, r->u.cons.tail)) {
+          Value *t = force(I, r->u.cons.head);
+          if (t->kind == V_NUM && t->u.num <= 1) found = 1;
+        }
+      }
+      if (!dens) {
+        double q[2];
+        for (int sgn = 0; sgn < 2; sgn++) {
+          snprintf(buf, sizeof buf, "Density %.17g (%.17g, %.17g, %.17g) (%s)", radius,
+                   o[0] + sgn * e[0], o[1] + sgn * e[1], o[2] + sgn * e[2], tree);
+          Value *r = eval_text(buf);
+          q[sgn] = r && r->kind == V_NUM ? r->u.num : NAN;
+        }
+        if ((q[0] - 0.5) * (q[1] - 0.5) <= 0) dens = 1;
+      }
+    }
+    if (!found || !dens) bad++;
+  }
+  return bad;
+}
+
+static void box_text(char *out, size_t n) {
+  double s[3], c[3];
+  for (int i = 0; i < 3; i++) s[i] = 0.25 + 0.6 * urand(), c[i] = 0.9 * urand() - 0.45;
+  const char *ax[3] = {"x", "y", "z"};
+  snprintf(out, n, "Rotate \"%s\" %.3f (Shift (%.3f, %.3f, %.3f) (Scale (%.3f, %.3f, %.3f) UnitCube))",
+           ax[(int)(urand() * 3)], 90 * urand(), c[0], c[1], c[2], s[0], s[1], s[2]);
+}
+
+static void soft_text(char *out, size_t n) {
+  char keys[600] = "";
+  int nk = 2 + (int)(urand() * 3);
+  for (int k = 0; k < nk; k++) {
+    char key[120];
+    snprintf(key, sizeof key, "%sKey (%.3f, %.3f, %.3f) %.3f %s", k ? ", " : "",
+             urand() - 0.5, urand() - 0.5, urand() - 0.5, 0.5 + 0.4 * urand(),
+             k == nk - 1 && nk > 2 ? "(-1)" : "1");
+    strcat(keys, key);
+  }
+  snprintf(out, n, "SoftObject 0.5 [%s]", keys);
+}
+
+/* Random rounded, sharp, soft and mixed scenes: every mesh closed,
+   oriented, free of self-intersections and within the tolerance (Roots
+   and Density probes), the certified bound within it too. */
+static void property(void) {
+  static const char *ops[3] = {"Union", "Intersection", "SetDifference"};
+  static const char *dops[3] = {"Sum", "Product", "Difference"};
+  int total = 0, good = 0;
+  for (int k = 0; k < 24; k++) {
+    char a[400], b[400], obj[2400], tree[1000] = "", name[80];
+    double radius = 0.05 + 0.1 * urand(), tol = 0.03;
+    int kind = k % 4, op = (int)(urand() * 3);
+    box_text(a, sizeof a);
+    box_text(b, sizeof b);
+    if (op == 1) snprintf(b, sizeof b, "Scale (1.6, 1.6, 1.6) UnitCube"); /* overlap */
+    switch (kind) {
+    case 0: /* rounded */
+      snprintf(tree, sizeof tree, "%s (%s) (%s)", dops[op], a, b);
+      snprintf(obj, sizeof obj, "Rounded %.17g (%s)", radius, tree);
+      break;
+    case 1: /* sharp */
+      snprintf(obj, sizeof obj, "%s (%s) (%s)", ops[op], a, b);
+      break;
+    case 2: /* soft */
+      soft_text(obj, sizeof obj);
+      break;
+    default: { /* mixed: rounded, sharp and soft together */
+      char so[700];
+      soft_text(so, sizeof so);
+      snprintf(obj, sizeof obj, "%s (Union (Rounded %.17g (%s)) (%s)) (%s)",
+               ops[op == 1 ? 0 : op], radius, a, b, so);
+      break;
+    }
+    }
+    snprintf(name, sizeof name, "random scene %d (%s)", k,
+             kind == 0 ? "rounded" : kind == 1 ? "sharp" : kind == 2 ? "soft" : "mixed");
+    Scene *s = compile(obj);
+    if (!s) {
+      printf("# %s: %s\n", name, obj);
+      CHECK(name, 0);
+      continue;
+    }
+    MeshSettings ms = {0};
+    ms.tol = tol;
+    Mesh *m;
+    MeshReport rep;
+    char err[300], buf[700];
+    int bad;
+    int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+    if (rc == MESH_EEMPTY) { /* an intersection of boxes may be empty */
+      scene_free(s);
+      continue;
+    }
+    total++;
+    snprintf(buf, sizeof buf, "%s: meshed (%s)", name, rc ? err : "ok");
+    CHECK(buf, rc == 0);
+    if (rc) {
+      printf("# %s\n", obj);
+      scene_free(s);
+      continue;
+    }
+    long eu;
+    int closed = closed_oriented(m, &eu);
+    long si = self_intersections(m);
+    long far = probe_points(obj, kind == 0 ? tree : NULL, radius, m, tol, 60);
+    snprintf(buf, sizeof buf, "%s: closed and oriented", name);
+    CHECK(buf, closed);
+    snprintf(buf, sizeof buf, "%s: no self-intersections (%ld pairs)", name, si);
+    CHECK(buf, si == 0);
+    snprintf(buf, sizeof buf, "%s: 60 triangle points within tol by Roots%s (%ld far)",
+             name, kind == 0 ? " and Density" : "", far);
+    CHECK(buf, far == 0);
+    snprintf(buf, sizeof buf, "%s: certified %.4g <= tol", name, rep.certified);
+    CHECK(buf, rep.certified <= tol);
+    double w = surface_to_mesh(s, m, 10);
+    snprintf(buf, sizeof buf, "%s: surface points from random rays within tol of the mesh (worst %.3g)", name, w);
+    CHECK(buf, w <= tol);
+    good += closed && si == 0 && far == 0 && w <= tol;
+    if (!(closed && si == 0 && far == 0 && w <= tol)) printf("# %s\n", obj);
+    printf("# %s: %zu triangles (%ld plane, %ld smooth, %ld sharp cells%s)\n", name,
+           rep.triangles, rep.planar, rep.smooth, rep.sharp,
+           rep.sharp_off ? ", sharp given up" : "");
+    mesh_free(m);
+    scene_free(s);
+  }
+  printf("# property test: %d of %d random scenes closed, oriented, "
+         "self-intersection-free, within tolerance\n", good, total);
+  CHECK("property test: most random scenes were not empty", total >= 18);
 }
 
 static void bad_input(void) {
@@ -270,6 +576,8 @@ static void bad_input(void) {
     CHECK("bad tolerance refused", mesh_scene(s, s->root, &ms, &m, &rep, &bad, err,
                                               sizeof err) == MESH_ETOL && !m);
   }
+  scene_free(s);
+  s = compile("Rounded 0.2 UnitCube"); /* a sharp cube is 40 triangles */
   ms.tol = 0.05;
   ms.max_triangles = 100;
   CHECK("max-triangles refused before the crossings",
@@ -345,5 +653,6 @@ int main(void) {
            "(SoftObject 0.5 [Key (1, 1, 1) 0.8 1])");
   one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
   bad_input();
+  property();
   CHECK_DONE();
 }
