@@ -23,14 +23,14 @@
 
 (defconst qcs-builtins
   '("Density" "Displacement" "Field" "Gradient" "InnerBounds" "LG"
-      "OuterBounds" "PointInObject" "Roots" "Trace" "abs" "acos"
-      "asin" "atan" "atan2" "ceiling" "clock" "concatMap"
-      "cos" "cross" "dot" "error" "exp" "floor"
-      "foldl" "frame" "isInfinite" "isNaN" "length" "log"
-      "max" "meshWith" "min" "mod" "norm" "not"
-      "pi" "plotDisplacement" "plotField" "plotRay" "plotSlice" "product"
-      "renderWith" "round" "seq" "show" "showReal" "sin"
-      "sqrt" "sum" "tan" "truncate")
+      "OuterBounds" "PointInObject" "Roots" "Trace" "TrueDensity" "abs"
+      "acos" "asin" "atan" "atan2" "ceiling" "clock"
+      "concatMap" "cos" "cross" "dot" "error" "exp"
+      "floor" "foldl" "frame" "isInfinite" "isNaN" "length"
+      "log" "max" "meshWith" "min" "mod" "norm"
+      "not" "pi" "plotConvolution" "plotDisplacement" "plotField" "plotRay"
+      "plotSlice" "product" "renderWith" "round" "seq" "show"
+      "showReal" "sin" "sqrt" "sum" "tan" "truncate")
   "The functions built into qcs.")
 
 (defconst qcs-prelude-functions

@@ -549,7 +549,7 @@ static inline void stab_init(const char *prefix, char *base) {
 /* Compile qcs text into a scene; NULL and stab_error on an error. The
  * text must outlive the scene (it is copied and never freed). */
 static inline Scene *stab_compile(const char *text) {
-  Src *src = malloc(sizeof *src);
+  Src *src = calloc(1, sizeof *src);
   size_t n = strlen(text) + 1;
   char *copy = malloc(n);
   memcpy(copy, text, n);

@@ -22,7 +22,7 @@
 static Interp *I;
 
 static Scene *compile(const char *text) {
-  Src *src = malloc(sizeof *src);
+  Src *src = calloc(1, sizeof *src);
   size_t n = strlen(text) + 1;
   char *copy = malloc(n);
   memcpy(copy, text, n);
@@ -382,7 +382,7 @@ static long self_intersections(const Mesh *m) {
 
 /* The value of a qcs expression (the language's own probes). */
 static Value *eval_text(const char *text) {
-  Src *src = malloc(sizeof *src);
+  Src *src = calloc(1, sizeof *src);
   size_t n = strlen(text) + 1;
   char *copy = malloc(n);
   memcpy(copy, text, n);

@@ -30,7 +30,7 @@ static char last_error[1100];
 /* Evaluates text and compiles it into a scene; NULL (and last_error) on
    an error. The source must outlive the values: it is never freed. */
 static Scene *compile(const char *text) {
-  Src *src = malloc(sizeof *src);
+  Src *src = calloc(1, sizeof *src);
   size_t n = strlen(text) + 1;
   char *copy = malloc(n);
   memcpy(copy, text, n);

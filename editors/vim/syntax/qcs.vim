@@ -18,12 +18,13 @@ syn keyword qcsConstructor Rounded RoundedHalfspace Samples SetDifference
 syn keyword qcsConstructor Shadows Sides Size SoftObject Sum Threads Tolerance
 syn keyword qcsConstructor Union Up
 syn keyword qcsBuiltin Density Displacement Field Gradient InnerBounds LG
-syn keyword qcsBuiltin OuterBounds PointInObject Roots Trace abs acos asin
-syn keyword qcsBuiltin atan atan2 ceiling clock concatMap cos cross dot error
-syn keyword qcsBuiltin exp floor foldl frame isInfinite isNaN length log max
-syn keyword qcsBuiltin meshWith min mod norm not pi plotDisplacement plotField
-syn keyword qcsBuiltin plotRay plotSlice product renderWith round seq show
-syn keyword qcsBuiltin showReal sin sqrt sum tan truncate
+syn keyword qcsBuiltin OuterBounds PointInObject Roots Trace TrueDensity abs
+syn keyword qcsBuiltin acos asin atan atan2 ceiling clock concatMap cos cross
+syn keyword qcsBuiltin dot error exp floor foldl frame isInfinite isNaN length
+syn keyword qcsBuiltin log max meshWith min mod norm not pi plotConvolution
+syn keyword qcsBuiltin plotDisplacement plotField plotRay plotSlice product
+syn keyword qcsBuiltin renderWith round seq show showReal sin sqrt sum tan
+syn keyword qcsBuiltin truncate
 syn keyword qcsPrelude AffineMap AffinePlane AffinePoint Ball BallWith Box
 syn keyword qcsPrelude ChordSides Cone ConeWith Cylinder CylinderWith
 syn keyword qcsPrelude DefaultChord DistanceOfPointFromPlane Dodecahedron
