@@ -331,3 +331,6 @@ clean:
 	rm -rf $(BUILD) build-san build-tsan build-fuzz qcs
 
 -include $(OBJS:.o=.d)
+# The test binaries and fuzz replays are built straight from their .c with
+# -MMD: their .d files make a change to a header they include rebuild them.
+-include $(UNIT_BINS:=.d) $(REPLAY_BINS:=.d)
