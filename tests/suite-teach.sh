@@ -67,6 +67,19 @@ if [ "$out" = "0.3333 0.6667 0.1429 " ] &&
    [ "$out0" = "0.3333333333333333 0.6666666666666666 " ]
 then echo "ok teach: --digits N, over a script's :set digits"
 else echo "FAIL teach: --digits: got '$out' and '$out0'"; fi
+# an animation's later frames print as the first did, setting by setting
+printf ':set digits 3\nframe / 3\n:set digits 0\nframe / 3\n' > "$tmp/an.qcs"
+out=$("$QCS" --frames 1-2 "$tmp/an.qcs" 2>&1 | tr '\n' ' ')
+if [ "$out" = "0.333 0.3333333333333333 0.667 0.6666666666666666 " ]; then
+  echo "ok teach: :set digits replayed in order for every frame"
+else echo "FAIL teach: :set digits over frames: got '$out'"; fi
+# a file :load-ed at the prompt sets the prompt's digits, unless --digits
+printf ':set digits 3\nx = 1\n' > "$tmp/ld.qcs"
+a=$(printf ':load %s\n1/3\n' "$tmp/ld.qcs" | "$QCS" 2>&1)
+b=$(printf ':load %s\n1/3\n' "$tmp/ld.qcs" | "$QCS" --digits 5 2>&1)
+if [ "$a" = "0.333" ] && [ "$b" = "0.33333" ]; then
+  echo "ok teach: :load of a file with :set digits, and --digits over it"
+else echo "FAIL teach: :load and digits: got '$a' and '$b'"; fi
 if "$QCS" --digits 18 -e 1 > /dev/null 2> "$tmp/err"; then
   echo "FAIL teach: --digits 18 accepted"
 elif grep -q "qcs: error: --digits needs 0 (shortest that reads back) to 17, not '18'" "$tmp/err"

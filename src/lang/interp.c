@@ -696,9 +696,15 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
     check_sets(I, runname);
   if (imported || I->declare_only) return RUN_OK;
   for (int i = 0; i < n; i++) {
-    /* :set digits N applies from its line on; --digits N overrides it */
-    if (items[i]->kind == ITEM_SET && !I->digits_fixed)
-      I->digits = items[i]->digits;
+    /* :set digits N applies from its line on; --digits N overrides it.
+       An animation's later frames replay it in order too. */
+    if (items[i]->kind == ITEM_SET) {
+      if (!I->digits_fixed) I->digits = items[i]->digits;
+      if (mode == MODE_SCRIPT) {
+        I->anim = grow(I->anim, I->nanim, &I->capanim, sizeof(Item *));
+        I->anim[I->nanim++] = items[i];
+      }
+    }
     if (items[i]->kind != ITEM_EXPR) continue;
     if (mode == MODE_SCRIPT) {
       I->anim = grow(I->anim, I->nanim, &I->capanim, sizeof(Item *));
@@ -1089,6 +1095,10 @@ RunStatus interp_rerun(Interp *I) {
   ErrFrame f;
   if (ERR_TRY(f)) {
     for (int i = 0; i < I->nanim; i++) {
+      if (I->anim[i]->kind == ITEM_SET) {
+        if (!I->digits_fixed) I->digits = I->anim[i]->digits;
+        continue;
+      }
       I->steps = 0;
       I->item_pos = I->anim[i]->expr->pos;
       Value *v = eval(I, I->anim[i]->expr, NULL);
