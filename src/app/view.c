@@ -1354,10 +1354,13 @@ int view_parse_listen(const char *s, char *err, size_t errlen) {
   return 0;
 }
 
-static volatile sig_atomic_t stop_flag;
+/* Set by SIGINT or SIGTERM, which may be delivered to any thread (a
+   server or render thread too): an atomic, lock-free and so safe in a
+   handler, not a plain sig_atomic_t (a data race between threads). */
+static atomic_int stop_flag;
 static void on_signal(int sig) {
   (void)sig;
-  stop_flag = 1;
+  atomic_store(&stop_flag, 1);
 }
 
 static struct MHD_Daemon *start(View *v, const ViewOptions *o) {
@@ -1540,7 +1543,7 @@ int view_file(const char *file, const ViewOptions *o) {
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
   signal(SIGPIPE, SIG_IGN);
-  stop_flag = 0;
+  atomic_store(&stop_flag, 0);
   pthread_t rt;
   if (pthread_create(&rt, NULL, render_main, &v)) {
     fprintf(stderr, "qcs: error: view: cannot start a thread\n");
@@ -1558,7 +1561,7 @@ int view_file(const char *file, const ViewOptions *o) {
   int nwatched = watch_deps(&v, ino, watched);
   double pending = 0; /* when a change was seen, 0: none */
   int gone = 0;
-  while (!stop_flag) {
+  while (!atomic_load(&stop_flag)) {
     struct pollfd pfd[2] = {{ino, POLLIN, 0}, {v.wake[0], POLLIN, 0}};
     poll(pfd, 2, pending > 0 ? 10 : 200);
     char drain[64];
@@ -1639,8 +1642,8 @@ int view_scene(Interp *src_I, Scene *s, const RenderSettings *rs,
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = on_signal;
   sigaction(SIGINT, &sa, &old_int);
-  stop_flag = 0;
-  while (!stop_flag) {
+  atomic_store(&stop_flag, 0);
+  while (!atomic_load(&stop_flag)) {
     struct pollfd pfd = {0, POLLIN, 0};
     if (poll(&pfd, 1, 200) > 0) {
       char line[256];
