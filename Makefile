@@ -177,7 +177,16 @@ test-deps-mesh:
 	  echo "note: $$p is not installed: its mesh read-back tests are skipped"; \
 	done
 
-test: deps test-deps test-deps-mesh
+# suite-editors.sh loads the highlighting in Vim and Emacs (skipped without them).
+.PHONY: test-deps-editors
+test-deps-editors:
+	@for p in vim emacs-nox; do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || \
+	  { [ "$$(id -u)" = 0 ] && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$p >/dev/null 2>&1; } || \
+	  echo "note: $$p is not installed: its editor test is skipped"; \
+	done
+
+test: deps test-deps test-deps-mesh test-deps-editors
 	@$(MAKE) -s $(BIN) units
 	@sh tests/run-all.sh
 

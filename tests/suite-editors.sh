@@ -137,8 +137,13 @@ sys.exit(0 if depth == 0 else "%d ( left open" % depth)
 PY
 if [ $? -eq 0 ]; then ok editors-emacs-balanced; else fail editors-emacs-balanced "$(cat "$tmp/el")"; fi
 if command -v emacs >/dev/null 2>&1; then
-  if out=$(emacs --batch -L editors/emacs --eval "(progn (require 'qcs-mode) (find-file \"examples/gear.qcs\") (font-lock-ensure) (unless (eq major-mode 'qcs-mode) (error \"not qcs-mode\")))" 2>&1)
-  then ok editors-emacs-loads; else fail editors-emacs-loads "$out"; fi
+  printf '%s\n' '// doc: a sample' 'x = Rounded 0.1 (Cylinder 1 2) where y = sqrt 2' \
+    '/* outer /* nested */ still */ t = "str"' >"$tmp/e.qcs"
+  # the face at (line, column) of the sample, as the Vim check reads it
+  out=$(emacs --batch -Q -L editors/emacs --eval "(progn (require 'qcs-mode) (find-file \"$tmp/e.qcs\") (font-lock-ensure) (princ major-mode) (dolist (lc '((1 1) (2 5) (2 18) (2 32) (2 42) (3 23) (3 37))) (goto-char (point-min)) (forward-line (1- (car lc))) (forward-char (1- (cadr lc))) (princ (format \" %s\" (get-text-property (point) 'face)))))" 2>&1 | tail -1)
+  want="qcs-mode font-lock-comment-delimiter-face font-lock-constant-face font-lock-function-name-face font-lock-keyword-face font-lock-builtin-face font-lock-comment-face font-lock-string-face"
+  if [ "$out" = "$want" ]; then ok editors-emacs-highlights
+  else fail editors-emacs-highlights "got '$out', want '$want'"; fi
 else
-  echo "skip editors-emacs-loads: emacs is not installed"
+  echo "skip editors-emacs-highlights: emacs is not installed"
 fi

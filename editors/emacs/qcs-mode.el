@@ -45,15 +45,15 @@
       "SumAll" "Tetrahedron" "Transform" "Translate" "Tube" "TubeWith"
       "UnionAll" "UnitCube" "Wedge" "all" "any" "ballFaces"
       "concat" "const" "cosd" "cycle" "cyclic3" "drop"
-      "dropWhile" "elem" "facetSides" "fibonacciSphere" "filter" "flip"
-      "foldTree" "foldl1" "foldr" "foldr1" "fract" "fst"
-      "head" "id" "init" "iterate" "kitCount" "kitSides"
-      "kitSize" "last" "lookup" "map" "maximum" "mesh"
-      "minimum" "mmul" "noNegZero" "normalize" "null" "otherwise"
-      "phi" "polygonPlanes" "polyhedronOf" "positiveReal" "productOf" "render"
-      "repeat" "replicate" "reverse" "row4" "signs3" "sind"
-      "snd" "tail" "take" "takeWhile" "transpose" "transposeRows"
-      "unzip" "wholeNumber" "zip" "zip3" "zipWith")
+      "dropWhile" "elem" "facetSides" "fibonacciSphere" "filter" "finiteReal"
+      "flip" "foldTree" "foldl1" "foldr" "foldr1" "fract"
+      "fst" "head" "id" "init" "iterate" "kitCount"
+      "kitSides" "kitSize" "last" "lookup" "map" "maximum"
+      "mesh" "minimum" "mmul" "noNegZero" "normalize" "null"
+      "otherwise" "phi" "polygonPlanes" "polyhedronOf" "positiveReal" "productOf"
+      "render" "repeat" "replicate" "reverse" "row4" "signs3"
+      "sind" "snd" "tail" "take" "takeWhile" "transpose"
+      "transposeRows" "unzip" "wholeNumber" "zip" "zip3" "zipWith")
   "The functions of the prelude (stdlib/prelude.qcs) and the kit (stdlib/kit.qcs).")
 
 (defconst qcs-font-lock-keywords

@@ -560,6 +560,23 @@ Pos eval_user_pos(Interp *I, Pos pos) {
   return pos;
 }
 
+/* Is the source at pos right after a '-' (spaces between)? Then
+   `Cylinder -1 1` was read as Cylinder - (1 1), as in Haskell. */
+static int after_minus(Pos pos) {
+  if (!pos.src || !pos.src->text || pos.line < 1 || pos.col < 2) return 0;
+  const char *t = pos.src->text;
+  for (int line = 1; line < pos.line; line++) {
+    t = strchr(t, '\n');
+    if (!t) return 0;
+    t++;
+  }
+  for (int c = pos.col - 2; c >= 0; c--) {
+    if (t[c] == '-') return 1;
+    if (t[c] != ' ' && t[c] != '\t') return 0;
+  }
+  return 0;
+}
+
 /* Apply f to n arguments. Returns 1 with (*body, *benv) set when the result
    is a function body to evaluate in tail position, or 0 with *result. */
 static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
@@ -588,7 +605,11 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
                   over_arity == 1 ? "" : "s", over_arity + n, val_describe(f),
                   buf);
       qcs_error(pos, "%s is not a function, but it is applied to %d "
-                "argument%s: %s", val_describe(f), n, n == 1 ? "" : "s", buf);
+                "argument%s: %s%s", val_describe(f), n, n == 1 ? "" : "s", buf,
+                f->kind == V_NUM && after_minus(pos)
+                    ? " (a negative argument goes in parentheses: "
+                      "f (-1), not f -1)"
+                    : "");
     }
     int a = f->u.fn.arity;
     if (n < a) {

@@ -255,8 +255,11 @@ Token *lex_all(const Src *src, int *ntokens) {
       int len = (int)(L.p - start);
       TokKind k = (c >= 'A' && c <= 'Z') ? T_CNAME : T_NAME;
       if (len == 1 && c == '_') k = T_WILD;
+      /* (the first character first: the prelude and the kit are lexed
+         at every start) */
       for (size_t i = 0; i < sizeof keywords / sizeof *keywords; i++)
-        if ((int)strlen(keywords[i].text) == len &&
+        if (keywords[i].text[0] == (char)c &&
+            (int)strlen(keywords[i].text) == len &&
             !memcmp(keywords[i].text, start, (size_t)len))
           k = keywords[i].kind;
       /* A qualified name, Parts.bolt (no spaces): a definition of the
@@ -272,6 +275,7 @@ Token *lex_all(const Src *src, int *ntokens) {
     }
     int matched = 0;
     for (size_t i = 0; i < sizeof puncts / sizeof *puncts; i++) {
+      if (puncts[i].text[0] != (char)c) continue;
       size_t n = strlen(puncts[i].text);
       if (!strncmp(L.p, puncts[i].text, n)) {
         for (size_t j = 0; j < n; j++) advance(&L);

@@ -38,14 +38,14 @@ syn keyword qcsPrelude ShiftPlane ShiftQuadric Slab Sphere SphereKey SumAll
 syn keyword qcsPrelude Tetrahedron Transform Translate Tube TubeWith UnionAll
 syn keyword qcsPrelude UnitCube Wedge all any ballFaces concat const cosd
 syn keyword qcsPrelude cycle cyclic3 drop dropWhile elem facetSides
-syn keyword qcsPrelude fibonacciSphere filter flip foldTree foldl1 foldr
-syn keyword qcsPrelude foldr1 fract fst head id init iterate kitCount kitSides
-syn keyword qcsPrelude kitSize last lookup map maximum mesh minimum mmul
-syn keyword qcsPrelude noNegZero normalize null otherwise phi polygonPlanes
-syn keyword qcsPrelude polyhedronOf positiveReal productOf render repeat
-syn keyword qcsPrelude replicate reverse row4 signs3 sind snd tail take
-syn keyword qcsPrelude takeWhile transpose transposeRows unzip wholeNumber zip
-syn keyword qcsPrelude zip3 zipWith
+syn keyword qcsPrelude fibonacciSphere filter finiteReal flip foldTree foldl1
+syn keyword qcsPrelude foldr foldr1 fract fst head id init iterate kitCount
+syn keyword qcsPrelude kitSides kitSize last lookup map maximum mesh minimum
+syn keyword qcsPrelude mmul noNegZero normalize null otherwise phi
+syn keyword qcsPrelude polygonPlanes polyhedronOf positiveReal productOf
+syn keyword qcsPrelude render repeat replicate reverse row4 signs3 sind snd
+syn keyword qcsPrelude tail take takeWhile transpose transposeRows unzip
+syn keyword qcsPrelude wholeNumber zip zip3 zipWith
 
 " a capitalised name that is none of the above: a type or a user's constructor
 syn match qcsType "\<\u[A-Za-z0-9_']*\>"
