@@ -6,8 +6,11 @@
 #   SCENE     figure12 figure12-sharp figure13 figure15a figure15a-sharp
 #             figure15b soft-cloud-N (any N); default: all of them, with
 #             N = 10 100 1000 10000 100000 (figure15b is an extra)
-#   -n REPS   qcs renders per scene (default 5; median of whole-process wall)
-#   -p REPS   POV-Ray renders per scene (default 3; 0 = skip POV-Ray)
+#   -n REPS   renders per scene (default 7), each qcs run paired with a
+#             POV-Ray run right after it (A B A B ...), so both see the
+#             same load; min and median of whole-process wall for both
+#   -p REPS   POV-Ray renders per scene (default: as many as qcs's; 0 =
+#             skip POV-Ray)
 #   -c        also run the callgrind counts (bench/callgrind.sh)
 # Environment: QCS (default ./qcs), THREADS (2), SIZE (600x380),
 #   OUT (/tmp/qcs-bench), POVDIR (bench/povray),
@@ -17,16 +20,21 @@
 #   against 100 processes; 0 to skip),
 #   TILES_BENCH (1: bench/tiles.sh, 16 tiles of a 1920x1080 figure12 as
 #   processes of their own against the whole; 0 to skip),
-#   KIT_BENCH (1: bench/kit.sh, a 10x10x10 grid of rounded cubes; 0 to skip).
+#   KIT_BENCH (1: bench/kit.sh, a 10x10x10 grid of rounded cubes; 0 to skip),
+#   INTERP_BENCH (1: bench/interp.sh, the interpreter against Hugs on
+#   bench/hugs/; 0 to skip), SOFT_1M (1: soft-cloud with 10^6 keys, once).
 # Writes bench/results.csv and bench/README.md (the summary of this run).
 #
 # Each repetition renders the scene with qcs, then at once with POV-Ray, so
-# both see the same machine load: the ratios are the figures to report.
+# both see the same machine load: the ratios are the figures to report,
+# as the ratio of the medians and the ratio of the minimums (the minimum is
+# the run least disturbed by other load; the two agreeing says the ratio
+# is sound).
 set -u
 cd "$(dirname "$0")/.." || exit 1
 ROOT=$(pwd)
 
-REPS=5; POV_REPS=3; CALLGRIND=0
+REPS=7; POV_REPS=""; CALLGRIND=0
 while getopts "n:p:c" opt; do
   case $opt in
     n) REPS=$OPTARG ;;
@@ -36,6 +44,7 @@ while getopts "n:p:c" opt; do
   esac
 done
 shift $((OPTIND - 1))
+[ -n "$POV_REPS" ] || POV_REPS=$REPS
 
 QCS=${QCS:-./qcs}
 THREADS=${THREADS:-2}
@@ -151,15 +160,15 @@ else
 fi
 echo
 
-echo "scene,qcs_runs,qcs_wall_median_s,qcs_wall_min_s,qcs_render_median_s,rays,rays_per_s_wall,density_evals,evals_per_ray,root_steps_per_ray,rounded_hits,evals_per_rounded_hit,pov_runs,pov_wall_median_s,pov_trace_median_s,pov_over_qcs" > "$CSV.tmp"
+echo "scene,qcs_runs,qcs_wall_median_s,qcs_wall_min_s,qcs_render_median_s,rays,rays_per_s_wall,density_evals,evals_per_ray,root_steps_per_ray,rounded_hits,evals_per_rounded_hit,pov_runs,pov_wall_median_s,pov_trace_median_s,pov_over_qcs,pov_wall_min_s,pov_over_qcs_min" > "$CSV.tmp"
 
-declare -A QW PW PT EPH MISSING
+declare -A QW PW PT EPH MISSING PWMIN RMIN
 ROWS=()
 for s in "$@"; do
   if ! qcs_args "$s" > /dev/null; then
     echo "missing: $s -- $(qcs_file "$s") does not exist yet; not timed"
     MISSING[$s]=1
-    echo "$s,0,,,,,,,,,,,,,," >> "$CSV.tmp"
+    echo "$s,0,,,,,,,,,,,,,,,," >> "$CSV.tmp"
     continue
   fi
   walls=(); renders=(); povw=(); povt=(); failed=""
@@ -182,7 +191,7 @@ for s in "$@"; do
   done
   if [ ${#walls[@]} -eq 0 ]; then
     echo "FAILED: $s ($failed)"; sed 's/^/    /' "$OUT/qcs/$s.1.log" | head -5
-    echo "$s,0,,,,,,,,,,,,,," >> "$CSV.tmp"; MISSING[$s]=1; continue
+    echo "$s,0,,,,,,,,,,,,,,,," >> "$CSV.tmp"; MISSING[$s]=1; continue
   fi
   [ -n "$failed" ] && echo "  $s: $failed"
   wmed=$(printf '%s\n' "${walls[@]}" | median)
@@ -193,17 +202,22 @@ for s in "$@"; do
   rps=$(div "$rays" "$wmed" "%.0f")
   epr=$(div "$ev" "$rays" "%.2f")
   spr=$(div "$((sg + po))" "$rays" "%.2f")
-  pwmed=""; ptmed=""; ratio="-"
+  pwmed=""; ptmed=""; pwmin=""; ratio="-"; ratio_min="-"
   if [ ${#povw[@]} -gt 0 ]; then
     pwmed=$(printf '%s\n' "${povw[@]}" | median)
+    pwmin=$(printf '%s\n' "${povw[@]}" | minimum)
     ptmed=$(printf '%s\n' "${povt[@]}" | median)
     ratio=$(div "$pwmed" "$wmed" "%.2f")
+    # the minimums over the same paired runs (qcs's first n, where n POV-Ray runs)
+    qmin_paired=$(printf '%s\n' "${walls[@]:0:${#povw[@]}}" | minimum)
+    ratio_min=$(div "$pwmin" "$qmin_paired" "%.2f")
   fi
+  PWMIN[$s]=$pwmin; RMIN[$s]=$ratio_min
   QW[$s]=$wmed; PW[$s]=$pwmed; PT[$s]=$ptmed; EPH[$s]=$eph
-  echo "$s,${#walls[@]},$wmed,$wmin,$rmed,$rays,$rps,$ev,$epr,$spr,$hits,$eph,${#povw[@]},$pwmed,$ptmed,$ratio" >> "$CSV.tmp"
-  ROWS+=("$(printf '%-18s %9.3f %9.3f %8.2f %10s %10s %11s %10s %10s %10s' "$s" "$wmed" "$rmed" \
+  echo "$s,${#walls[@]},$wmed,$wmin,$rmed,$rays,$rps,$ev,$epr,$spr,$hits,$eph,${#povw[@]},$pwmed,$ptmed,$ratio,$pwmin,$ratio_min" >> "$CSV.tmp"
+  ROWS+=("$(printf '%-18s %9.3f %9.3f %8.2f %10s %10s %11s %10s %10s %10s %10s' "$s" "$wmed" "$rmed" \
     "$(awk -v r="$rps" 'BEGIN { printf "%.2f", r / 1e6 }')" "$epr" "$spr" "$eph" \
-    "${pwmed:--}" "${ptmed:--}" "$ratio")")
+    "${pwmed:--}" "${ptmed:--}" "$ratio" "$ratio_min")")
   echo "  done: $s (${#walls[@]} qcs runs, ${#povw[@]} POV-Ray runs)"
 done
 
@@ -215,8 +229,8 @@ fi
 mv "$CSV.tmp" "$CSV"
 
 TABLE=$(
-  printf '%-18s %9s %9s %8s %10s %10s %11s %10s %10s %10s\n' scene "qcs wall" "render" "Mray/s" \
-    "evals/ray" "steps/ray" "evals/rhit" "pov wall" "pov trace" "pov/qcs"
+  printf '%-18s %9s %9s %8s %10s %10s %11s %10s %10s %10s %10s\n' scene "qcs wall" "render" "Mray/s" \
+    "evals/ray" "steps/ray" "evals/rhit" "pov wall" "pov trace" "pov/qcs" "(of mins)"
   printf '%s\n' "${ROWS[@]}"
 )
 echo
@@ -224,7 +238,7 @@ echo "$TABLE"
 echo "(seconds; qcs wall = median whole-process wall time, render = qcs's own render time;"
 echo " Mray/s = primary + shadow rays / qcs wall; evals/ray and steps/ray = density evaluations and"
 echo " root-search steps (segments + polishing steps, or soft-object polynomial solves) per ray; evals/rhit = per ray hitting a rounded"
-echo " surface; pov wall / trace = POV-Ray medians, pov/qcs = POV-Ray wall / qcs wall)"
+echo " surface; pov wall / trace = POV-Ray medians, pov/qcs = POV-Ray wall / qcs wall, medians and mins)"
 
 q() { echo "${QW[$1]:-}"; }
 R12=$(div "$(q figure12)" "$(q figure12-sharp)")
@@ -317,6 +331,15 @@ if [ "${KIT_BENCH:-1}" = 1 ]; then
   echo "$KIT_SUMMARY"
 fi
 
+# The interpreter against Hugs (issue 18): bench/interp.sh.
+INTERP_SUMMARY=""
+if [ "${INTERP_BENCH:-1}" = 1 ]; then
+  INTERP_SUMMARY=$(QCS="$QCS" bash bench/interp.sh -n "$REPS" 2>&1)
+  echo
+  echo "the interpreter against Hugs (bench/interp.sh):"
+  echo "$INTERP_SUMMARY"
+fi
+
 # Issue 7's targets.
 verdict() { if [ "$1" = "-" ] || [ -z "$1" ]; then echo "not measured"; elif awk "BEGIN { exit !($2) }"; then echo "met"; else echo "NOT met"; fi; }
 ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "-" && a != "" && a + 0 >= b) }'; }
@@ -351,6 +374,28 @@ TARGETS=$(
     echo "| figure12's full picture at the prompt ($m) within 0.3 s | ${PV_FULL[$m]:--} s | $(verdict "${PV_FULL[$m]:-}" "${PV_FULL[$m]:-0} <= 0.3") |"
   done
 )
+# Issue 18's targets (the interpreter's are in bench/interp.sh's table).
+R_F12_MIN=${RMIN[figure12]:-}
+S1M=""
+if [ "${SOFT_1M:-1}" = 1 ] && [ -f examples/soft-cloud.qcs ]; then
+  t0=$(now); "$QCS" --threads "$THREADS" --size "$SIZE" -o "$OUT/qcs/soft-cloud-1000000.png" \
+    --set n=1000000 examples/soft-cloud.qcs > /dev/null 2>&1 && S1M=$(awk -v a="$t0" -v b="$(now)" 'BEGIN { printf "%.3f", b - a }')
+fi
+R10k18=$(div "${PW[soft-cloud-10000]:-}" "$(q soft-cloud-10000)"); R100k18=$(div "${PW[soft-cloud-100000]:-}" "$(q soft-cloud-100000)")
+TARGETS18=$(
+  echo "| target | measured | verdict |"
+  echo "|---|---|---|"
+  echo "| figure12 at least 40x POV-Ray, whole process, paired (ratio of medians; of mins) | $R_F12; ${R_F12_MIN:--} | $(verdict "$R_F12" "${R_F12:-0} >= 40") |"
+  echo "| rounded / sharp on figure12 at most 1.2 | $R12 | $(verdict "$R12" "$R12 <= 1.2") |"
+  echo "| soft-cloud T(100000) / T(100) at most 4 | $GROWTH | $T4d |"
+  echo "| soft-cloud 10^6 keys under 3 s whole process (one run) | ${S1M:--} s | $(verdict "$S1M" "${S1M:-0} < 3") |"
+  echo "| soft-cloud at least 10x POV-Ray's blob at 10^4 | $R10k18 | $(verdict "$R10k18" "$R10k18 >= 10") |"
+  echo "| soft-cloud at least 10x POV-Ray's blob at 10^5 | $R100k18 | $(verdict "$R100k18" "$R100k18 >= 10") |"
+)
+echo
+echo "issue 18 targets:"
+echo "$TARGETS18" | tail -n +3 | sed 's/^| //; s/ |$//; s/ | /: /; s/ | / -> /'
+
 echo
 echo "issue 7 targets:"
 echo "$TARGETS" | tail -n +3 | sed 's/^| //; s/ |$//; s/ | /: /; s/ | / -> /'
@@ -384,6 +429,10 @@ of whole-process wall time. The machines are shared and noisy: the
 - \`make bench-callgrind\` (\`bench/callgrind.sh\`): instruction counts per scene
   at 150x95, one thread, under \`valgrind --tool=callgrind\`, into
   \`bench/callgrind.csv\`; these are repeatable, so regressions show.
+- \`bash bench/interp.sh [-n REPS]\` (run by \`make bench\`; \`INTERP_BENCH=0\` skips it):
+  the interpreter against Hugs 98 on the programs of \`bench/hugs/\` (each
+  written in qcs and in Haskell), paired runs, medians of wall time and of
+  peak RSS, into \`bench/interp.csv\`.
 - figure15a's sharp baseline is \`examples/figure15a.qcs\` with
   \`--set side=0 --set flat=0\` (every plane's radius 0: the sharp cuboid).
 - The exact-Wyvill-field target compares qcs's soft-cloud N = 100 with one
@@ -412,6 +461,25 @@ EOF
   echo '```'
   echo "$RATIOS"
   echo '```'
+  echo
+  echo "## Targets (issue 18)"
+  echo
+  echo "$TARGETS18"
+  echo
+  echo "PNG writing's share of figure12 (target at most 10%) and the interpreter's"
+  echo "targets: see the interpreter section below and bench/NOTES.md."
+  if [ -n "$INTERP_SUMMARY" ]; then
+    echo
+    echo "## The interpreter against Hugs (issue 18)"
+    echo
+    echo "\`bash bench/interp.sh -n $REPS\`: the programs of \`bench/hugs/\` (NAME.qcs and"
+    echo "NAME.hs), each run by qcs and then by \`runhugs\`, $REPS pairs; medians of"
+    echo "whole-process wall time and of peak resident memory (max RSS)."
+    echo
+    echo '```'
+    echo "$INTERP_SUMMARY"
+    echo '```'
+  fi
   echo
   echo "## Targets (issues 7 and 13)"
   echo

@@ -132,9 +132,20 @@ static Value *list_next(Interp *I, Value *v, Pos pos, const char *what) {
   return v;
 }
 
+/* The list argument args[i], taken out of the array: a loop that walks a
+   list must not leave its head reachable from there, or the whole list,
+   produced lazily as the loop goes, stays alive until the loop ends
+   (`length [1 .. 10000000]` would hold 10^7 cells). The array is this
+   call's own (see builtins.h), the caller does not read it again. */
+static Value *take_arg(Value **args, int i) {
+  Value *v = args[i];
+  args[i] = NULL;
+  return v;
+}
+
 static Value *bi_length(Interp *I, Value **args, Pos pos) {
   unsigned long long n = 0;
-  for (Value *v = list_next(I, args[0], pos, "the argument of length");
+  for (Value *v = list_next(I, take_arg(args, 0), pos, "the argument of length");
        v->kind == V_CONS; v = list_next(I, v->u.cons.tail, pos, "a list tail")) {
     eval_check(I, pos);
     eval_list_count(I, pos, ++n);
@@ -144,7 +155,7 @@ static Value *bi_length(Interp *I, Value **args, Pos pos) {
 static Value *bi_sum(Interp *I, Value **args, Pos pos) {
   Value *acc = NULL;
   unsigned long long n = 0;
-  for (Value *v = list_next(I, args[0], pos, "the argument of sum");
+  for (Value *v = list_next(I, take_arg(args, 0), pos, "the argument of sum");
        v->kind == V_CONS; v = list_next(I, v->u.cons.tail, pos, "a list tail")) {
     eval_check(I, pos);
     eval_list_count(I, pos, ++n);
@@ -170,7 +181,7 @@ static Value *bi_sum(Interp *I, Value **args, Pos pos) {
 static Value *bi_product(Interp *I, Value **args, Pos pos) {
   double p = 1;
   unsigned long long n = 0;
-  for (Value *v = list_next(I, args[0], pos, "the argument of product");
+  for (Value *v = list_next(I, take_arg(args, 0), pos, "the argument of product");
        v->kind == V_CONS; v = list_next(I, v->u.cons.tail, pos, "a list tail")) {
     eval_check(I, pos);
     eval_list_count(I, pos, ++n);
@@ -182,7 +193,7 @@ static Value *bi_product(Interp *I, Value **args, Pos pos) {
 static Value *bi_foldl(Interp *I, Value **args, Pos pos) {
   Value *acc = args[1];
   unsigned long long n = 0;
-  for (Value *v = list_next(I, args[2], pos, "the list of foldl");
+  for (Value *v = list_next(I, take_arg(args, 2), pos, "the list of foldl");
        v->kind == V_CONS; v = list_next(I, v->u.cons.tail, pos, "a list tail")) {
     eval_list_count(I, pos, ++n);
     Value **a = val_array(2);
@@ -205,8 +216,9 @@ static Value *bi_append(Interp *I, Value **args, Pos pos) {
   Value **next = val_array(2);
   next[0] = a->u.cons.tail;
   next[1] = args[1];
-  return val_cons(a->u.cons.head,
-                  delay_apply(val_builtin(&append_builtin), 2, next));
+  static Value *append_fn;
+  if (!append_fn) append_fn = eval_builtin_value(&append_builtin);
+  return val_cons(a->u.cons.head, delay_apply(append_fn, 2, next));
 }
 
 /* concatMap f xs, lazily: list comprehensions are built on it. */
@@ -229,7 +241,9 @@ static Value *bi_concatMap(Interp *I, Value **args, Pos pos) {
     rest[1] = v->u.cons.tail;
     Value **app = val_array(2);
     app[0] = ys;
-    app[1] = delay_apply(val_builtin(&concatmap_builtin), 2, rest);
+    static Value *concatmap_fn;
+    if (!concatmap_fn) concatmap_fn = eval_builtin_value(&concatmap_builtin);
+    app[1] = delay_apply(concatmap_fn, 2, rest);
     return bi_append(I, app, pos);
   }
 }

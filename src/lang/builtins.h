@@ -8,7 +8,16 @@
  * errors; it raises errors with qcs_error and returns a Value in weak-head
  * normal form or a delayed application. Built-ins that loop over a list
  * call eval_check and eval_list_count per element, so the interrupt and
- * the limits reach them. Same thread rules as the evaluator. */
+ * the limits reach them. Same thread rules as the evaluator.
+ *
+ * The args array belongs to the call: the evaluator makes a fresh one per
+ * application (eval.c's E_APP, a partial application's, apply()'s callers
+ * here) and does not read it after the call, so a built-in that consumes a
+ * long list takes it out of the array (builtins.c's take_arg) and the
+ * consumed prefix can be collected. The exception is a delayed
+ * application (delay_apply), whose array is the thunk's and is kept to
+ * restore it after an error: the built-ins delayed that way (ranges, ++,
+ * concatMap) leave their arrays alone. */
 #ifndef QCS_BUILTINS_H
 #define QCS_BUILTINS_H
 

@@ -39,6 +39,9 @@ Value *force(Interp *I, Value *v);
 Value *delay(Interp *I, Expr *e, Env *env);
 /* f applied to n arguments, reduced to weak-head normal form. */
 Value *apply(Interp *I, Value *f, int n, Value **args, Pos pos);
+/* The built-in b as a function value made once, for C code that delays
+   calls to it per element (an uncollectable cell: keep it in a static). */
+Value *eval_builtin_value(const Builtin *b);
 /* A lazy application: a thunk that computes f args when forced. */
 Value *delay_apply(Value *f, int n, Value **args);
 

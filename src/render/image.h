@@ -132,6 +132,8 @@ int img_compare(const Image *a, const Image *b, double *rms,
  * to an 8-bit code, clamped to [0, 1] (NaN to 0) and rounded to nearest;
  * and a code value in [0, 1] back to linear. */
 unsigned char img_srgb8(float v);
+/* The same by its formula (a pow per call), for the test of img_srgb8. */
+unsigned char img_srgb8_exact(float v);
 double img_srgb_decode(double s);
 
 /* The parts of one picture (crops or farm tiles, .exr or .png, each

@@ -84,6 +84,12 @@ int img_write_png(const Image *im, FILE *f, const ImgWriteOptions *opt,
     return -1;
   }
   png_set_write_fn(png, &io, png_write_data, png_flush_data);
+  /* zlib level 3 and the Sub filter on every row, instead of libpng's
+     level 6 trying all five filters per row: on figure12 at 600x380 the
+     encoder runs 4.4 times fewer instructions (117M -> 27M, callgrind)
+     for a file a third larger (37 KB -> 50 KB). The pixels are the same. */
+  png_set_compression_level(png, 3);
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
   png_set_IHDR(png, info, (png_uint_32)im->width, (png_uint_32)im->height, 8,
                alpha ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
