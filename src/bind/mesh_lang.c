@@ -132,11 +132,13 @@ static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
       ms.max_triangles = (size_t)n;
     } else if (con_is(s, "Quiet")) {
       quiet = 1;
+    } else if (con_is(s, "Uniform")) {
+      ms.uniform = 1;
     } else {
       char buf[160];
       val_brief(s, buf, sizeof buf);
       qcs_error(sp, "not a mesh setting: %s (meshWith takes Tolerance, "
-                "Bounds, MaxTriangles, Quiet)", buf);
+                "Bounds, MaxTriangles, Quiet, Uniform)", buf);
     }
   }
   if (!mesh_is_mesh_path(path))

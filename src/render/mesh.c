@@ -348,21 +348,25 @@ typedef struct {
   double l, h;             /* the value range */
   int n;                   /* leaves whose filter meets the box */
   int leaf[GR_MAX];
+  unsigned char step[GR_MAX]; /* a sharp leaf: no derivative, a jump */
   double cl[GR_MAX], ch[GR_MAX];
 } GrIv;
 
 /* r = sx x + sy y on the coefficients (sx, sy intervals); -1 when more
-   than GR_MAX leaves are live. */
+   than GR_MAX leaves are live. An operand multiplied by exactly 0 (a
+   product with a factor that is 0 over the whole box) drops out: the
+   result does not depend on its leaves there. */
 static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
                   const GrIv *y, double syl, double syh) {
   GrIv o;
   o.n = 0;
-  for (int i = 0; i < x->n; i++) {
+  for (int i = 0; i < x->n && !(sxl == 0 && sxh == 0); i++) {
     o.leaf[o.n] = x->leaf[i];
+    o.step[o.n] = x->step[i];
     iv_mul(sxl, sxh, x->cl[i], x->ch[i], &o.cl[o.n], &o.ch[o.n]);
     o.n++;
   }
-  for (int i = 0; i < y->n; i++) {
+  for (int i = 0; i < y->n && !(syl == 0 && syh == 0); i++) {
     double l, h;
     iv_mul(syl, syh, y->cl[i], y->ch[i], &l, &h);
     int j = 0;
@@ -370,11 +374,13 @@ static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
     if (j == o.n) {
       if (o.n == GR_MAX) return -1;
       o.leaf[o.n] = y->leaf[i];
+      o.step[o.n] = y->step[i];
       o.cl[o.n] = l;
       o.ch[o.n] = h;
       o.n++;
     } else {
       iv_add(o.cl[j], o.ch[j], l, h, &o.cl[j], &o.ch[j]);
+      o.step[j] |= y->step[i];
     }
   }
   o.l = r->l;
@@ -407,7 +413,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
         x->l = rh < 0 ? 1 : 0;
         x->h = rl > 0 ? 0 : 1;
         if (rl <= 0 && rh >= 0) { /* a step crossing the box */
-          step = 1;
+          x->step[0] = 1;
           x->leaf[0] = in->arg;
           x->cl[0] = x->ch[0] = 0;
           x->n = 1;
@@ -421,6 +427,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
           double m0 = a0 <= 0 && a1 >= 0 ? 0 : fmin(a0 * a0, a1 * a1);
           double m1 = fmax(a0 * a0, a1 * a1);
           x->leaf[0] = in->arg;
+          x->step[0] = 0;
           x->cl[0] = 0.75 * (m0 - 1) / lf->r;
           x->ch[0] = 0.75 * (m1 - 1) / lf->r;
           x->n = 1;
@@ -453,6 +460,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   }
   const GrIv *r = &st[0];
   memset(b, 0, sizeof *b);
+  for (int i = 0; i < r->n; i++) step |= r->step[i];
   if (r->n == 1) {
     b->planar = 1;
     return 0;
@@ -527,6 +535,7 @@ typedef struct {
   size_t nft, capft;
   const Leaf *cur;         /* the leaf being meshed */
   int sharp;               /* make LEAF_EXACT cells */
+  int uniform;             /* no leaf above the finest level */
   int *pls;                /* the planes of the sharp cells (node indices) */
   size_t npls, cappls;
   int *plmap;              /* per node of the subtree: 2 (plane) + flip */
@@ -635,7 +644,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   }
   Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0};
   int leaf = level == m->depth;
-  if (c == T_ONE && clip_in) {
+  if (c == T_ONE && clip_in && !m->uniform) {
     const ScNode *nd = &m->s->nodes[one];
     if (nd->kind == SC_HALFSPACE) {
       lf.kind = LEAF_PLANE;
@@ -1677,7 +1686,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.h = L / ldexp(1, depth);
   m.tol = e;
   m.vtol = vtol;
-  m.sharp = sharp;
+  m.sharp = sharp && !ms->uniform;
+  m.uniform = ms->uniform;
   m.rep = rep;
   m.max_cells = ms->max_cells ? ms->max_cells : (size_t)1 << 24;
   for (int i = 0; i < 3; i++) {

@@ -52,6 +52,8 @@ typedef struct MeshSettings {
   double lo[3], hi[3];
   size_t max_triangles;    /* refuse a mesh with more (0: no limit) */
   size_t max_cells;        /* refuse an octree with more surface cells */
+  int uniform;             /* every surface cell at the finest level, no
+                              sharp cells: the uniform grid, to compare */
 } MeshSettings;
 
 typedef struct Mesh {
