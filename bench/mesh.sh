@@ -66,6 +66,6 @@ if command -v openscad > /dev/null 2>&1 && command -v xvfb-run > /dev/null 2>&1;
     ot=$(grep -c 'facet normal' "$tmp/o.stl" 2>/dev/null)
     size=1; [ $i -ge 5 ] && size=1.5
     set -- $(run "figure12-sharp obj$i" "obj$i" "$(echo "$size * 0.001" | bc -l | sed 's/^\./0./')" figure12-sharp "")
-    echo "| obj$i | $ot | $(echo "$t1 - $t0" | bc | sed 's/^\./0./') | $1 | $2 |"
+    echo "| obj$i | $ot | $(printf '%.2f' "$(echo "$t1 - $t0" | bc)") | $1 | $2 |"
   done
 fi

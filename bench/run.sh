@@ -13,6 +13,7 @@
 #   OUT (/tmp/qcs-bench), POVDIR (bench/povray),
 #   POV_ISO (1: render POV-Ray's exact Wyvill isosurface soft-cloud-iso-100
 #   once, for the "exact field at N = 100" target; 0 to skip),
+#   MESH_BENCH (1: bench/mesh.sh, meshing; 0 to skip),
 #   FRAMES_BENCH (1: bench/frames.sh, a 100-frame animation in one process
 #   against 100 processes; 0 to skip).
 # Writes bench/results.csv and bench/README.md (the summary of this run).
@@ -296,6 +297,16 @@ if [ "${FRAMES_BENCH:-1}" = 1 ]; then
   echo "$FRAMES_SUMMARY"
 fi
 
+# Meshing (issue 16): bench/mesh.sh, the figure12 objects at 1e-3 of their
+# size against a uniform grid, the unit cube at 1e-4, OpenSCAD's export.
+MESH_SUMMARY=""
+if [ "${MESH_BENCH:-1}" = 1 ]; then
+  MESH_SUMMARY=$(QCS="$QCS" sh bench/mesh.sh 2>&1)
+  echo
+  echo "meshing (bench/mesh.sh):"
+  echo "$MESH_SUMMARY"
+fi
+
 # Issue 7's targets.
 verdict() { if [ "$1" = "-" ] || [ -z "$1" ]; then echo "not measured"; elif awk "BEGIN { exit !($2) }"; then echo "met"; else echo "NOT met"; fi; }
 ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "-" && a != "" && a + 0 >= b) }'; }
@@ -413,6 +424,14 @@ EOF
     echo '```'
     echo "$FRAMES_SUMMARY"
     echo '```'
+  fi
+  if [ -n "$MESH_SUMMARY" ]; then
+    echo
+    echo "## Meshing (issue 16)"
+    echo
+    echo "\`sh bench/mesh.sh\`: peak MB is the process's maximum resident set."
+    echo
+    echo "$MESH_SUMMARY"
   fi
   if [ -f bench/callgrind.csv ]; then
     echo

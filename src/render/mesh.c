@@ -1771,6 +1771,15 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_ENOMEM;
     goto done;
   }
+  /* the count above is a lower bound: crease paths split a few marching
+     triangles more */
+  if (ms->max_triangles && m.nt > ms->max_triangles) {
+    snprintf(err, errlen, "the mesh would have %zu triangles, over the "
+             "limit of %zu (max-triangles): give a larger tolerance than %g",
+             m.nt, ms->max_triangles, e);
+    rc = MESH_ELIMIT;
+    goto done;
+  }
   Mesh *me = malloc(sizeof *me);
   if (!me) {
     rc = MESH_ENOMEM;
