@@ -79,6 +79,10 @@ typedef struct MeshReport {
   double h;                /* finest cell side */
   double vtol;             /* the vertices' distance bound */
   double certified;        /* the proven bound, see above */
+  double measured;         /* the largest distance along the normal from
+                              sample points of the triangles to the
+                              surface (INFINITY: none within reach) */
+  int samples;             /* the sample points used */
   long crossings, bisected;/* edge vertices; of them found by bisection */
   size_t vertices, triangles;
   double seconds;
