@@ -1,4 +1,5 @@
-/* mesh.c: octree classification and marching tetrahedra (see mesh.h). */
+/* mesh.c: the adaptive octree, its conforming tetrahedra, marching and
+   exact (sharp) tetrahedra, the checks and the writers (see mesh.h). */
 #include "render/mesh.h"
 
 #include <math.h>
