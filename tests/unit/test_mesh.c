@@ -21,13 +21,19 @@
 
 static Interp *I;
 
-static Scene *compile(const char *text) {
+/* A source holding a copy of text (kept: values point into it). */
+static Src *src_of(const char *name, const char *text) {
   Src *src = malloc(sizeof *src);
   size_t n = strlen(text) + 1;
   char *copy = malloc(n);
   memcpy(copy, text, n);
-  src->name = "<test>";
+  src->name = name;
   src->text = copy;
+  return src;
+}
+
+static Scene *compile(const char *text) {
+  Src *src = src_of("<test>", text);
   ErrFrame f;
   Scene *volatile s = NULL;
   if (ERR_TRY(f)) {
@@ -382,12 +388,7 @@ static long self_intersections(const Mesh *m) {
 
 /* The value of a qcs expression (the language's own probes). */
 static Value *eval_text(const char *text) {
-  Src *src = malloc(sizeof *src);
-  size_t n = strlen(text) + 1;
-  char *copy = malloc(n);
-  memcpy(copy, text, n);
-  src->name = "<probe>";
-  src->text = copy;
+  Src *src = src_of("<probe>", text);
   ErrFrame f;
   Value *volatile v = NULL;
   if (ERR_TRY(f)) {
