@@ -662,7 +662,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
         if (b.planar) {
           lf.kind = LEAF_PLANE;
           leaf = 1;
-        } else if (m->vtol + b.w * (d + 2 * m->vtol) / b.gmin <= m->tol) {
+        } else if (m->vtol + b.w * (2.0 / 3) * (d + 2 * m->vtol) / b.gmin <= m->tol) {
           lf.kind = LEAF_SMOOTH;
           lf.w = b.w;
           lf.gmin = b.gmin;
@@ -841,7 +841,9 @@ static double tri_bound(const Mesher *m, int a, int b, int c) {
   case LEAF_EXACT: return m->vtol;
   case LEAF_SMOOTH: {
     double d = fmax(dist3(pa, pb), fmax(dist3(pb, pc), dist3(pa, pc)));
-    return m->vtol + m->cur->w * (d + 2 * m->vtol) / m->cur->gmin;
+    /* sum_i l_i |p - x_i| <= sum_i l_i (1 - l_i) D'' <= 2/3 D'', with
+       D'' <= d + 2 vtol the crossings' diameter (sum l_i^2 >= 1/3) */
+    return m->vtol + m->cur->w * (2.0 / 3) * (d + 2 * m->vtol) / m->cur->gmin;
   }
   default: return m->vtol + cover_radius(pa, pb, pc);
   }
