@@ -16,6 +16,7 @@
 #   OUT (/tmp/qcs-bench), POVDIR (bench/povray),
 #   POV_ISO (1: render POV-Ray's exact Wyvill isosurface soft-cloud-iso-100
 #   once, for the "exact field at N = 100" target; 0 to skip),
+#   MESH_BENCH (1: bench/mesh.sh, meshing; 0 to skip),
 #   FRAMES_BENCH (1: bench/frames.sh, a 100-frame animation in one process
 #   against 100 processes; 0 to skip),
 #   TILES_BENCH (1: bench/tiles.sh, 16 tiles of a 1920x1080 figure12 as
@@ -340,6 +341,16 @@ if [ "${INTERP_BENCH:-1}" = 1 ]; then
   echo "$INTERP_SUMMARY"
 fi
 
+# Meshing (issue 16): bench/mesh.sh, the figure12 objects at 1e-3 of their
+# size against a uniform grid, the unit cube at 1e-4, OpenSCAD's export.
+MESH_SUMMARY=""
+if [ "${MESH_BENCH:-1}" = 1 ]; then
+  MESH_SUMMARY=$(QCS="$QCS" sh bench/mesh.sh 2>&1)
+  echo
+  echo "meshing (bench/mesh.sh):"
+  echo "$MESH_SUMMARY"
+fi
+
 # Issue 7's targets.
 verdict() { if [ "$1" = "-" ] || [ -z "$1" ]; then echo "not measured"; elif awk "BEGIN { exit !($2) }"; then echo "met"; else echo "NOT met"; fi; }
 ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "-" && a != "" && a + 0 >= b) }'; }
@@ -524,6 +535,15 @@ EOF
     echo '```'
     echo "$KIT_SUMMARY"
     echo '```'
+fi
+
+  if [ -n "$MESH_SUMMARY" ]; then
+    echo
+    echo "## Meshing (issue 16)"
+    echo
+    echo "\`sh bench/mesh.sh\`: peak MB is the process's maximum resident set."
+    echo
+    echo "$MESH_SUMMARY"
   fi
   if [ -f bench/callgrind.csv ]; then
     echo

@@ -73,22 +73,29 @@ else echo "FAIL mesh: .off: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 
 # OpenSCAD read-back: import() of qcs's STL rendered by OpenSCAD (z up:
 # the model turned so that qcs's y is up) against qcs's own render of the
-# object from the same camera; the silhouettes must agree
+# object from the same camera, looking down a through hole (the background
+# shows through it); the silhouettes must agree, and the same cube without
+# the hole must not (the comparison can fail)
 if command -v openscad > /dev/null 2>&1 && command -v xvfb-run > /dev/null 2>&1; then
   cat > "$tmp/os.qcs" <<'Q'
-hole = Shift (0.25, 0.8, 0.25) (Scale (0.5, 0.5, 0.5) UnitCube);
+hole = Shift (0.25, -0.5, 0.25) (Scale (0.5, 2, 0.5) UnitCube);
 obj = SetDifference (Rounded 0.07 UnitCube) hole;
+view = [Size 300 200, Camera (1.2, 4, 1.6) (0.5, 0.5, 0.5) 22.5, Quiet];
 meshWith [Tolerance 0.002, Quiet] "os.stl" obj
-renderWith [Size 300 200, Camera (3, 2.5, 4) (0.5, 0.5, 0.5) 22.5] "qcs.png" obj
+renderWith view "qcs.png" obj
+renderWith view "full.png" (Rounded 0.07 UnitCube)
 Q
   printf 'rotate([90, 0, 0]) import("os.stl");\n' > "$tmp/os.scad"
   if (cd "$tmp" && "$top/$QCS" os.qcs > out 2> err) &&
      (cd "$tmp" && xvfb-run -a openscad -o openscad.png --imgsize=300,200 \
-        --camera=3,-4,2.5,0.5,-0.5,0.5 --projection=p os.scad > osout 2>&1) &&
+        --camera=1.2,-1.6,4,0.5,-0.5,0.5 --projection=p os.scad > osout 2>&1) &&
      [ -s "$tmp/openscad.png" ]; then
     r=$(python3 tests/mesh_silhouette.py "$tmp/openscad.png" "$tmp/qcs.png" 0.99)
     if [ $? = 0 ]; then echo "ok mesh: OpenSCAD imports the STL: $r against qcs's render"
     else echo "FAIL mesh: OpenSCAD's picture of the STL: $r"; fi
+    r=$(python3 tests/mesh_silhouette.py "$tmp/openscad.png" "$tmp/full.png" 0.99)
+    if [ $? = 0 ]; then echo "FAIL mesh: the silhouette test passes a cube without its hole: $r"
+    else echo "ok mesh: the silhouette test tells the cube without its hole apart ($r)"; fi
   else echo "FAIL mesh: OpenSCAD read-back: $(tail -c 300 "$tmp/osout" "$tmp/err" 2>/dev/null | tr '\n' ' ')"; fi
 else
   echo "skip mesh: openscad or xvfb-run is not installed (apt-get install openscad xvfb)"

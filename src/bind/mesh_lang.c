@@ -30,7 +30,9 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
     fprintf(f, "  sharp cells given up: two of them decided a degenerate "
             "case apart; the mesh was made again without them\n");
   fprintf(f, "  distance to the surface: certified <= %.4g (requested %.4g; vertices within "
-          "%.2g of the surface)\n", r->certified, e, r->vtol);
+          "%.2g of the surface); measured %.3g (the largest along the normals "
+          "from %d points of the triangles)\n", r->certified, e, r->vtol,
+          r->measured, r->samples);
   fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",
           r->crossings - r->bisected, r->bisected);
 }
@@ -132,11 +134,13 @@ static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
       ms.max_triangles = (size_t)n;
     } else if (con_is(s, "Quiet")) {
       quiet = 1;
+    } else if (con_is(s, "Uniform")) {
+      ms.uniform = 1;
     } else {
       char buf[160];
       val_brief(s, buf, sizeof buf);
       qcs_error(sp, "not a mesh setting: %s (meshWith takes Tolerance, "
-                "Bounds, MaxTriangles, Quiet)", buf);
+                "Bounds, MaxTriangles, Quiet, Uniform)", buf);
     }
   }
   if (!mesh_is_mesh_path(path))

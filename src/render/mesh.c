@@ -1,4 +1,5 @@
-/* mesh.c: octree classification and marching tetrahedra (see mesh.h). */
+/* mesh.c: the adaptive octree, its conforming tetrahedra, marching and
+   exact (sharp) tetrahedra, the checks and the writers (see mesh.h). */
 #include "render/mesh.h"
 
 #include <math.h>
@@ -348,21 +349,25 @@ typedef struct {
   double l, h;             /* the value range */
   int n;                   /* leaves whose filter meets the box */
   int leaf[GR_MAX];
+  unsigned char step[GR_MAX]; /* a sharp leaf: no derivative, a jump */
   double cl[GR_MAX], ch[GR_MAX];
 } GrIv;
 
 /* r = sx x + sy y on the coefficients (sx, sy intervals); -1 when more
-   than GR_MAX leaves are live. */
+   than GR_MAX leaves are live. An operand multiplied by exactly 0 (a
+   product with a factor that is 0 over the whole box) drops out: the
+   result does not depend on its leaves there. */
 static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
                   const GrIv *y, double syl, double syh) {
   GrIv o;
   o.n = 0;
-  for (int i = 0; i < x->n; i++) {
+  for (int i = 0; i < x->n && !(sxl == 0 && sxh == 0); i++) {
     o.leaf[o.n] = x->leaf[i];
+    o.step[o.n] = x->step[i];
     iv_mul(sxl, sxh, x->cl[i], x->ch[i], &o.cl[o.n], &o.ch[o.n]);
     o.n++;
   }
-  for (int i = 0; i < y->n; i++) {
+  for (int i = 0; i < y->n && !(syl == 0 && syh == 0); i++) {
     double l, h;
     iv_mul(syl, syh, y->cl[i], y->ch[i], &l, &h);
     int j = 0;
@@ -370,11 +375,13 @@ static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
     if (j == o.n) {
       if (o.n == GR_MAX) return -1;
       o.leaf[o.n] = y->leaf[i];
+      o.step[o.n] = y->step[i];
       o.cl[o.n] = l;
       o.ch[o.n] = h;
       o.n++;
     } else {
       iv_add(o.cl[j], o.ch[j], l, h, &o.cl[j], &o.ch[j]);
+      o.step[j] |= y->step[i];
     }
   }
   o.l = r->l;
@@ -407,7 +414,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
         x->l = rh < 0 ? 1 : 0;
         x->h = rl > 0 ? 0 : 1;
         if (rl <= 0 && rh >= 0) { /* a step crossing the box */
-          step = 1;
+          x->step[0] = 1;
           x->leaf[0] = in->arg;
           x->cl[0] = x->ch[0] = 0;
           x->n = 1;
@@ -421,6 +428,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
           double m0 = a0 <= 0 && a1 >= 0 ? 0 : fmin(a0 * a0, a1 * a1);
           double m1 = fmax(a0 * a0, a1 * a1);
           x->leaf[0] = in->arg;
+          x->step[0] = 0;
           x->cl[0] = 0.75 * (m0 - 1) / lf->r;
           x->ch[0] = 0.75 * (m1 - 1) / lf->r;
           x->n = 1;
@@ -453,6 +461,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   }
   const GrIv *r = &st[0];
   memset(b, 0, sizeof *b);
+  for (int i = 0; i < r->n; i++) step |= r->step[i];
   if (r->n == 1) {
     b->planar = 1;
     return 0;
@@ -527,6 +536,7 @@ typedef struct {
   size_t nft, capft;
   const Leaf *cur;         /* the leaf being meshed */
   int sharp;               /* make LEAF_EXACT cells */
+  int uniform;             /* no leaf above the finest level */
   int *pls;                /* the planes of the sharp cells (node indices) */
   size_t npls, cappls;
   int *plmap;              /* per node of the subtree: 2 (plane) + flip */
@@ -635,7 +645,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   }
   Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0};
   int leaf = level == m->depth;
-  if (c == T_ONE && clip_in) {
+  if (c == T_ONE && clip_in && !m->uniform) {
     const ScNode *nd = &m->s->nodes[one];
     if (nd->kind == SC_HALFSPACE) {
       lf.kind = LEAF_PLANE;
@@ -652,7 +662,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
         if (b.planar) {
           lf.kind = LEAF_PLANE;
           leaf = 1;
-        } else if (m->vtol + b.w * (d + 2 * m->vtol) / b.gmin <= m->tol) {
+        } else if (m->vtol + b.w * (2.0 / 3) * (d + 2 * m->vtol) / b.gmin <= m->tol) {
           lf.kind = LEAF_SMOOTH;
           lf.w = b.w;
           lf.gmin = b.gmin;
@@ -831,7 +841,9 @@ static double tri_bound(const Mesher *m, int a, int b, int c) {
   case LEAF_EXACT: return m->vtol;
   case LEAF_SMOOTH: {
     double d = fmax(dist3(pa, pb), fmax(dist3(pb, pc), dist3(pa, pc)));
-    return m->vtol + m->cur->w * (d + 2 * m->vtol) / m->cur->gmin;
+    /* sum_i l_i |p - x_i| <= sum_i l_i (1 - l_i) D'' <= 2/3 D'', with
+       D'' <= d + 2 vtol the crossings' diameter (sum l_i^2 >= 1/3) */
+    return m->vtol + m->cur->w * (2.0 / 3) * (d + 2 * m->vtol) / m->cur->gmin;
   }
   default: return m->vtol + cover_radius(pa, pb, pc);
   }
@@ -1610,6 +1622,59 @@ static int face_paths(Mesher *m) {
   return 0;
 }
 
+/* The measured error: from n sample points of the triangles (a fixed
+   sequence), the distance along the triangle's normal to the nearest
+   crossing of the surface by the exact ray spans, within reach; the
+   largest, or INFINITY if some point found none (points within reach of a
+   user's clip box are skipped: its faces are not in the spans). */
+static double measured_error(Mesher *m, const Mesh *me, double reach, int n,
+                             int *used) {
+  uint64_t x = 0x2545F4914F6CDD1Dull;
+  double worst = 0;
+  *used = 0;
+  for (int k = 0; k < n && me->nt; k++) {
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    size_t i = (size_t)(x % me->nt);
+    double u = (double)(x >> 11 & 0xffff) / 65536.0, v = (double)(x >> 27 & 0xffff) / 65536.0;
+    if (u + v > 1) {
+      u = 1 - u;
+      v = 1 - v;
+    }
+    const int *t = me->t + 3 * i;
+    const double *a = me->v + 3 * t[0], *b = me->v + 3 * t[1], *c = me->v + 3 * t[2];
+    double p[3], ab[3], ac[3], nn[3];
+    for (int j = 0; j < 3; j++) {
+      p[j] = a[j] + u * (b[j] - a[j]) + v * (c[j] - a[j]);
+      ab[j] = b[j] - a[j];
+      ac[j] = c[j] - a[j];
+    }
+    vec3_cross(ab, ac, nn);
+    double l = sqrt(vec3_dot(nn, nn)), o[3], d[3];
+    if (!(l > 0)) continue;
+    int near_clip = 0;
+    for (int j = 0; j < 3; j++) {
+      near_clip |= p[j] - m->clo[j] < reach || m->chi[j] - p[j] < reach;
+      o[j] = p[j] - reach * nn[j] / l;
+      d[j] = 2 * reach * nn[j] / l;
+    }
+    if (near_clip) continue;
+    csg_span *sp;
+    ray_reset(m->ray);
+    int ns = ray_spans(m->s, m->node, o, d, 0, 1, m->ray, &sp);
+    double best = INFINITY;
+    for (int q = 0; q < ns; q++) {
+      double e[2] = {sp[q].t0, sp[q].t1};
+      for (int r = 0; r < 2; r++)
+        if (e[r] >= 0 && e[r] <= 1) best = fmin(best, fabs(e[r] - 0.5) * 2 * reach);
+    }
+    worst = fmax(worst, best);
+    (*used)++;
+  }
+  return worst;
+}
+
 static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
                     Mesh **out, MeshReport *rep, int *bad_node, char *err,
                     size_t errlen, int sharp) {
@@ -1677,7 +1742,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.h = L / ldexp(1, depth);
   m.tol = e;
   m.vtol = vtol;
-  m.sharp = sharp;
+  m.sharp = sharp && !ms->uniform;
+  m.uniform = ms->uniform;
   m.rep = rep;
   m.max_cells = ms->max_cells ? ms->max_cells : (size_t)1 << 24;
   for (int i = 0; i < 3; i++) {
@@ -1761,6 +1827,15 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_ENOMEM;
     goto done;
   }
+  /* the count above is a lower bound: crease paths split a few marching
+     triangles more */
+  if (ms->max_triangles && m.nt > ms->max_triangles) {
+    snprintf(err, errlen, "the mesh would have %zu triangles, over the "
+             "limit of %zu (max-triangles): give a larger tolerance than %g",
+             m.nt, ms->max_triangles, e);
+    rc = MESH_ELIMIT;
+    goto done;
+  }
   Mesh *me = malloc(sizeof *me);
   if (!me) {
     rc = MESH_ENOMEM;
@@ -1790,6 +1865,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   }
   rep->vertices = me->nv;
   rep->triangles = me->nt;
+  rep->measured = measured_error(&m, me, 2 * fmax(rep->certified, e), 1000,
+                                 &rep->samples);
   *out = me;
 done:
   if (rc == MESH_ENOMEM) snprintf(err, errlen, "out of memory while meshing");

@@ -1,4 +1,4 @@
-/* mesh.h: a compiled scene as a closed triangle mesh (issue 16, first part).
+/* mesh.h: a compiled scene as a closed triangle mesh (issue 16).
  *
  * Method. An octree over the object's box (its conservative bounds, or
  * the user's) is walked from the root; each cell is classified by proofs
@@ -7,34 +7,37 @@
  * interval arithmetic on its tape (interval.h) and by its outer and inner
  * bound solids (bounds.h), a soft object by interval bounds on each key's
  * field (soft_field_box), and the set operations by three-valued logic
- * (inside / outside / undecided). A cell proven inside or outside holds
- * no surface and is not visited further; undecided cells are split down
- * to one finest level, whose side h follows from the tolerance.
+ * that also notes when one node alone decides the solid in the cell, or
+ * sharp halfspaces alone. A cell proven inside or outside is dropped. An
+ * undecided cell becomes a surface leaf, at any size, when its error is
+ * proven within the tolerance: one plane (a halfspace, or a rounded tree
+ * with one live leaf), a rounded node whose gradient bound over the cell
+ * grown by the tolerance bounds its triangles' distance (mesh.c,
+ * grad_box), or a CSG of at most 8 planes (a sharp cell, meshed exactly);
+ * else it is split, down to the finest level whose side the tolerance
+ * fixes.
  *
- * Surface extraction is marching tetrahedra on the Kuhn (Freudenthal)
- * split of every finest cell into 6 tetrahedra around its main diagonal:
- * the corner signs come from scene_inside (Figure 4), and each edge whose
- * ends differ gets one vertex at a crossing found by the scene's exact
- * ray spans along the edge (scene/ray.h: the guaranteed root search for
- * rounded trees, the polynomial crossings of soft objects, planes
- * exactly), with bisection on scene_inside as the fallback. Why this and
- * not dual contouring: the result is the level set of a piecewise-linear
- * sign function on a conforming tetrahedral mesh, so it is a closed,
- * consistently oriented 2-manifold without self-intersections whatever
- * the vertex positions on the edges (each piece lies in its own closed
- * tetrahedron and neighbours share exactly the crossings of their common
- * face); dual contouring keeps sharp edges but needs extra machinery to
- * stay manifold. Sharp edges are therefore not reproduced exactly yet.
+ * The leaves of all sizes are cut into tetrahedra that meet face to face
+ * (the Kuhn split where a cell's faces are plain, else a centre point and
+ * fans through the corners of smaller cells), so the surface is closed
+ * across cells of different sizes. Sharp cells are meshed exactly in each
+ * tetrahedron (the planes' polygons split by each other, kept where the
+ * solid changes across them): their edges and corners are the solid's.
+ * The others by marching tetrahedra: corner signs from scene_inside, one
+ * vertex per sign-changing edge at a crossing found by the scene's exact
+ * ray spans along the edge (scene/ray.h), bisection as the fallback; a
+ * marching triangle edge on a face where a sharp neighbour's surface runs
+ * through crease points is split along that path.
  *
- * Error. Every vertex lies within vtol (the root tolerance) of the
- * surface; every point of a triangle lies within the triangle's covering
- * radius by its vertices (its circumradius if it is not obtuse, half its
- * longest side otherwise) of a vertex. The certified error reported is
- * the largest covering radius over all triangles plus vtol, computed on
- * the mesh itself; the grid is chosen so that it is at most the requested
- * tolerance. The other direction (every surface point near the mesh) is
- * not proven: a surface feature smaller than a finest cell whose corners
- * all agree is missed.
+ * Error. Each triangle is certified by its cell's proof (mesh.c,
+ * tri_bound): the vertices' tolerance vtol in plane and sharp cells, the
+ * gradient bound in smooth cells, vtol plus the triangle's covering radius
+ * in finest cells; the report gives the largest, and a measured error
+ * (sample points to the surface along the normals). That every part of
+ * the surface is near the mesh is proven in plane and sharp cells only.
+ * Closure is checked by edge counting before anything is returned; a
+ * failure caused by sharp cells deciding a degenerate case apart remakes
+ * the mesh without them (MeshReport.sharp_off).
  *
  * Memory: mesh_scene mallocs the mesh (mesh_free). Nothing here prints.
  * The scene is only read. */
@@ -52,6 +55,8 @@ typedef struct MeshSettings {
   double lo[3], hi[3];
   size_t max_triangles;    /* refuse a mesh with more (0: no limit) */
   size_t max_cells;        /* refuse an octree with more surface cells */
+  int uniform;             /* every surface cell at the finest level, no
+                              sharp cells: the uniform grid, to compare */
 } MeshSettings;
 
 typedef struct Mesh {
@@ -77,6 +82,10 @@ typedef struct MeshReport {
   double h;                /* finest cell side */
   double vtol;             /* the vertices' distance bound */
   double certified;        /* the proven bound, see above */
+  double measured;         /* the largest distance along the normal from
+                              sample points of the triangles to the
+                              surface (INFINITY: none within reach) */
+  int samples;             /* the sample points used */
   long crossings, bisected;/* edge vertices; of them found by bisection */
   size_t vertices, triangles;
   double seconds;

@@ -21,13 +21,19 @@
 
 static Interp *I;
 
-static Scene *compile(const char *text) {
+/* A source holding a copy of text (kept: values point into it). */
+static Src *src_of(const char *name, const char *text) {
   Src *src = calloc(1, sizeof *src);
   size_t n = strlen(text) + 1;
   char *copy = malloc(n);
   memcpy(copy, text, n);
-  src->name = "<test>";
+  src->name = name;
   src->text = copy;
+  return src;
+}
+
+static Scene *compile(const char *text) {
+  Src *src = src_of("<test>", text);
   ErrFrame f;
   Scene *volatile s = NULL;
   if (ERR_TRY(f)) {
@@ -382,12 +388,7 @@ static long self_intersections(const Mesh *m) {
 
 /* The value of a qcs expression (the language's own probes). */
 static Value *eval_text(const char *text) {
-  Src *src = calloc(1, sizeof *src);
-  size_t n = strlen(text) + 1;
-  char *copy = malloc(n);
-  memcpy(copy, text, n);
-  src->name = "<probe>";
-  src->text = copy;
+  Src *src = src_of("<probe>", text);
   ErrFrame f;
   Value *volatile v = NULL;
   if (ERR_TRY(f)) {
@@ -563,6 +564,64 @@ static void property(void) {
   CHECK("property test: most random scenes were not empty", total >= 18);
 }
 
+
+/* A rotated sharp cube: its 8 corners, computed here from the definition
+   (Rotate's convention: about x, y towards z; about z, x towards y), are
+   vertices of the mesh, and every vertex lies on one of its 6 planes. */
+static void sharp_corners(void) {
+  Scene *s = compile("Rotate \"z\" 30 (Rotate \"x\" 20 UnitCube)");
+  CHECK("rotated cube compiled", s != NULL);
+  if (!s) return;
+  MeshSettings ms = {0};
+  ms.tol = 0.001;
+  Mesh *m;
+  MeshReport rep;
+  char err[300];
+  int bad;
+  int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  CHECK("rotated cube meshed", rc == 0);
+  if (rc) {
+    scene_free(s);
+    return;
+  }
+  double ax = 20 * M_PI / 180, az = 30 * M_PI / 180, R[3][3];
+  /* R = Rz Rx */
+  double rx[3][3] = {{1, 0, 0}, {0, cos(ax), -sin(ax)}, {0, sin(ax), cos(ax)}};
+  double rz[3][3] = {{cos(az), -sin(az), 0}, {sin(az), cos(az), 0}, {0, 0, 1}};
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      R[i][j] = 0;
+      for (int k = 0; k < 3; k++) R[i][j] += rz[i][k] * rx[k][j];
+    }
+  int corners = 0;
+  for (int c = 0; c < 8; c++) {
+    double p[3] = {c & 1, c >> 1 & 1, c >> 2 & 1}, q[3];
+    for (int i = 0; i < 3; i++) q[i] = R[i][0] * p[0] + R[i][1] * p[1] + R[i][2] * p[2];
+    int found = 0;
+    for (size_t v = 0; v < m->nv && !found; v++) {
+      double d = 0;
+      for (int i = 0; i < 3; i++) d += (m->v[3 * v + i] - q[i]) * (m->v[3 * v + i] - q[i]);
+      found = sqrt(d) < 1e-9;
+    }
+    corners += found;
+  }
+  CHECK_NEAR("rotated cube: its 8 true corners are mesh vertices (1e-9)", corners, 8, 0);
+  long off = 0;
+  for (size_t v = 0; v < m->nv; v++) {
+    /* in the cube's own frame (R transposed), some coordinate is 0 or 1 */
+    double u[3];
+    for (int i = 0; i < 3; i++)
+      u[i] = R[0][i] * m->v[3 * v] + R[1][i] * m->v[3 * v + 1] + R[2][i] * m->v[3 * v + 2];
+    double best = 1e300;
+    for (int i = 0; i < 3; i++) best = fmin(best, fmin(fabs(u[i]), fabs(u[i] - 1)));
+    off += best > 1e-9;
+  }
+  CHECK_NEAR("rotated cube: every vertex on a face plane (1e-9)", (double)off, 0, 0);
+  printf("# rotated cube: %zu triangles, %zu vertices\n", m->nt, m->nv);
+  mesh_free(m);
+  scene_free(s);
+}
+
 static void bad_input(void) {
   Scene *s = compile("UnitCube");
   MeshSettings ms = {0};
@@ -653,6 +712,7 @@ int main(void) {
            "(SoftObject 0.5 [Key (1, 1, 1) 0.8 1])");
   one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
   bad_input();
+  sharp_corners();
   property();
   CHECK_DONE();
 }
