@@ -213,7 +213,7 @@ else
   printf 'render "ro/x.exr" scene\n' >>"$g/scene2.qcs"
   cat "$g/scene.qcs" "$g/scene2.qcs" >"$g/scene3.qcs"
   run exr-ro-script "$g" scene3.qcs
-  want 'scene3.qcs:2:1: error: cannot write ro/x.exr: Permission denied\n  render "ro/x.exr" scene\n  ^\n  in renderWith, called at <prelude>:74:21\n  in render, called at scene3.qcs:2:1\n'
+  want 'scene3.qcs:2:1: error: cannot write ro/x.exr: Permission denied\n  render "ro/x.exr" scene\n  ^\n  in renderWith, called at <prelude>:75:21\n  in render, called at scene3.qcs:2:1\n'
   judge gen/exr-read-only-folder-script "$g/want"
 fi
 RUNAS=""

@@ -17,8 +17,8 @@
       "FloatPixels" "FloorColour" "Halfspace" "Intersection" "Key" "Light"
       "MaxTriangles" "ObjectColour" "PointLight" "Product" "QuadricKey" "Quiet"
       "Rounded" "RoundedHalfspace" "Samples" "SetDifference" "Shadows" "Sides"
-      "Size" "SoftObject" "Sum" "Threads" "Tolerance" "Union"
-      "Up")
+      "Size" "SoftObject" "Sum" "Threads" "Tolerance" "Uniform"
+      "Union" "Up")
   "The constructors the prelude and the kit declare.")
 
 (defconst qcs-builtins

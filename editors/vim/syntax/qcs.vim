@@ -16,7 +16,7 @@ syn keyword qcsConstructor Halfspace Intersection Key Light MaxTriangles
 syn keyword qcsConstructor ObjectColour PointLight Product QuadricKey Quiet
 syn keyword qcsConstructor Rounded RoundedHalfspace Samples SetDifference
 syn keyword qcsConstructor Shadows Sides Size SoftObject Sum Threads Tolerance
-syn keyword qcsConstructor Union Up
+syn keyword qcsConstructor Uniform Union Up
 syn keyword qcsBuiltin Density Displacement Field Gradient InnerBounds LG
 syn keyword qcsBuiltin OuterBounds PointInObject Roots Trace TrueDensity abs
 syn keyword qcsBuiltin acos asin atan atan2 ceiling clock concatMap cos cross
