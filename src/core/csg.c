@@ -499,3 +499,42 @@ int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
   memcpy(out, scratch, (size_t)cnt[0] * sizeof *out);
   return cnt[0];
 }
+
+/* The three-valued set operations of csg_box_class. */
+static int box_op(csg_op op, int a, int b) {
+  switch (op) {
+  case CSG_UNION:
+    if (a == CSG_BOX_IN || b == CSG_BOX_IN) return CSG_BOX_IN;
+    return a == CSG_BOX_OUT && b == CSG_BOX_OUT ? CSG_BOX_OUT : CSG_BOX_MIX;
+  case CSG_INTER:
+    if (a == CSG_BOX_OUT || b == CSG_BOX_OUT) return CSG_BOX_OUT;
+    return a == CSG_BOX_IN && b == CSG_BOX_IN ? CSG_BOX_IN : CSG_BOX_MIX;
+  case CSG_DIFF:
+    if (a == CSG_BOX_OUT || b == CSG_BOX_IN) return CSG_BOX_OUT;
+    return a == CSG_BOX_IN && b == CSG_BOX_OUT ? CSG_BOX_IN : CSG_BOX_MIX;
+  default: /* the reversed difference, b - a */
+    return box_op(CSG_DIFF, b, a);
+  }
+}
+
+int csg_box_class(const csg_tape *t, const double lo[3], const double hi[3]) {
+  unsigned char st[CSG_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const csg_instr *in = &t->code[i];
+    if (in->op == CSG_PLANE) {
+      const csg_plane *p = &t->planes[in->arg];
+      double rl, rh;
+      vec3_plane_range(p->n, p->d, lo, hi, &rl, &rh);
+      st[sp++] = rh < 0 ? CSG_BOX_IN : (rl > 0 ? CSG_BOX_OUT : CSG_BOX_MIX);
+    } else if (in->op == CSG_EMPTY) {
+      st[sp++] = CSG_BOX_OUT;
+    } else if (in->op == CSG_ALL) {
+      st[sp++] = CSG_BOX_IN;
+    } else {
+      sp--;
+      st[sp - 1] = (unsigned char)box_op((csg_op)in->op, st[sp - 1], st[sp]);
+    }
+  }
+  return sp == 1 ? st[0] : CSG_BOX_MIX;
+}

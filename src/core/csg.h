@@ -87,6 +87,13 @@ int csg_is_all(const csg_tape *t);
  * p is strictly inside. */
 int csg_inside(const csg_tape *t, const double p[3]);
 
+/* The tape over the box [lo, hi]: CSG_BOX_OUT if no point of the box is
+   inside, CSG_BOX_IN if every point is, else CSG_BOX_MIX (undecided: the
+   box is classified plane by plane, so a box can be MIX and still all on
+   one side). */
+enum { CSG_BOX_OUT = 0, CSG_BOX_IN = 1, CSG_BOX_MIX = 2 };
+int csg_box_class(const csg_tape *t, const double lo[3], const double hi[3]);
+
 /* Scratch spans a ray query on t needs. */
 int csg_scratch_spans(const csg_tape *t);
 

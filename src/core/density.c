@@ -630,3 +630,37 @@ int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
                 dt_instr *buf, dt_tape *view) {
   return prune(t, NULL, NULL, rl, s0, s1, buf, view);
 }
+
+void dt_range_box(const dt_tape *t, const double lo[3], const double hi[3],
+                  double *dl, double *dh) {
+  double sl[DT_STACK_MAX], sh[DT_STACK_MAX];
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double rl, rh;
+      vec3_plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
+      /* the kernel falls as s grows */
+      sl[sp] = dt_halfspace(rh, lf->r);
+      sh[sp] = dt_halfspace(rl, lf->r);
+      if (lf->r <= 0) { /* a step: 0.5 on the plane itself */
+        if (rh >= 0) sl[sp] = 0;
+        if (rl <= 0) sh[sp] = 1;
+      }
+      sp++;
+    } else if (in->op == DT_CONST) {
+      sl[sp] = sh[sp] = in->c;
+      sp++;
+    } else {
+      sp--;
+      double l, h;
+      dt_range_op(in->op, sl[sp - 1], sh[sp - 1], sl[sp], sh[sp], &l, &h);
+      sl[sp - 1] = l;
+      sh[sp - 1] = h;
+    }
+  }
+  double m = 1e-12 * (fabs(sl[0]) + fabs(sh[0]) + 1);
+  *dl = sl[0] - m;
+  *dh = sh[0] + m;
+}

@@ -172,6 +172,12 @@ double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
  * smoothed with radius r.  level <= 0 gives r, level >= 1 gives -r. */
 double dt_displacement(double r, double level);
 
+/* The density's range [*dl, *dh] over the box [lo, hi]: each leaf's
+   kernel over its plane's range (vec3_plane_range), combined by the
+   interval rules (dt_range_op), widened by a relative 1e-12. */
+void dt_range_box(const dt_tape *t, const double lo[3], const double hi[3],
+                  double *dl, double *dh);
+
 /* M: the largest density the tape can take (Section 3.4.1), assuming each
  * leaf lies in [0,1]; > 1 flags an ill-formed tree (paper Figure 15b). */
 double dt_max(const dt_tape *t);

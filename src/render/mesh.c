@@ -134,112 +134,21 @@ static int kmap_put(kmap *h, const uint64_t *key, int v) {
 /* T_ONE: undecided, but the solid in the box is decided by one node's
    inside test; T_PL: undecided, and every undecided leaf below is a sharp
    halfspace. */
-enum { T_OUT = 0, T_IN = 1, T_MIX = 2, T_ONE = 3, T_PL = 4 };
-
-/* The range of n.x - d over the box. */
-static void plane_range(const double n[3], double d, const double lo[3],
-                        const double hi[3], double *rl, double *rh) {
-  double c = -d, r = 0;
-  for (int i = 0; i < 3; i++) {
-    double m = 0.5 * (lo[i] + hi[i]), e = 0.5 * (hi[i] - lo[i]);
-    c += n[i] * m;
-    r += fabs(n[i]) * e;
-  }
-  r += 1e-12 * (fabs(c) + r + 1); /* rounding */
-  *rl = c - r;
-  *rh = c + r;
-}
-
-static int tri_op(int op, int a, int b) {
-  switch (op) {
-  case 0: /* union */
-    if (a == T_IN || b == T_IN) return T_IN;
-    return a == T_OUT && b == T_OUT ? T_OUT : T_MIX;
-  case 1: /* intersection */
-    if (a == T_OUT || b == T_OUT) return T_OUT;
-    return a == T_IN && b == T_IN ? T_IN : T_MIX;
-  default: /* a - b */
-    if (a == T_OUT || b == T_IN) return T_OUT;
-    return a == T_IN && b == T_OUT ? T_IN : T_MIX;
-  }
-}
-
-/* A sharp CSG tape over the box. */
-static int csg_box(const csg_tape *t, const double lo[3], const double hi[3]) {
-  unsigned char st[CSG_STACK_MAX];
-  int sp = 0;
-  for (int i = 0; i < t->ncode; i++) {
-    const csg_instr *in = &t->code[i];
-    if (in->op == CSG_PLANE) {
-      const csg_plane *p = &t->planes[in->arg];
-      double rl, rh;
-      plane_range(p->n, p->d, lo, hi, &rl, &rh);
-      st[sp++] = rh < 0 ? T_IN : (rl > 0 ? T_OUT : T_MIX);
-    } else if (in->op == CSG_EMPTY) {
-      st[sp++] = T_OUT;
-    } else if (in->op == CSG_ALL) {
-      st[sp++] = T_IN;
-    } else {
-      sp--;
-      int x = st[sp - 1], y = st[sp];
-      switch (in->op) {
-      case CSG_UNION: st[sp - 1] = (unsigned char)tri_op(0, x, y); break;
-      case CSG_INTER: st[sp - 1] = (unsigned char)tri_op(1, x, y); break;
-      case CSG_DIFF: st[sp - 1] = (unsigned char)tri_op(2, x, y); break;
-      default: st[sp - 1] = (unsigned char)tri_op(2, y, x); break;
-      }
-    }
-  }
-  return sp == 1 ? st[0] : T_MIX;
-}
-
-/* A density tape's range over the box, by the interval rules. */
-static void dt_box(const dt_tape *t, const double lo[3], const double hi[3],
-                   double *dl, double *dh) {
-  double sl[DT_STACK_MAX], sh[DT_STACK_MAX];
-  int sp = 0;
-  for (int i = 0; i < t->ncode; i++) {
-    const dt_instr *in = &t->code[i];
-    if (in->op == DT_LEAF) {
-      const dt_leaf *lf = &t->leaves[in->arg];
-      double rl, rh;
-      plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
-      /* the kernel falls as s grows */
-      sl[sp] = dt_halfspace(rh, lf->r);
-      sh[sp] = dt_halfspace(rl, lf->r);
-      if (lf->r <= 0) { /* a step: 0.5 on the plane itself */
-        if (rh >= 0) sl[sp] = 0;
-        if (rl <= 0) sh[sp] = 1;
-      }
-      sp++;
-    } else if (in->op == DT_CONST) {
-      sl[sp] = sh[sp] = in->c;
-      sp++;
-    } else {
-      sp--;
-      double l, h;
-      dt_range_op(in->op, sl[sp - 1], sh[sp - 1], sl[sp], sh[sp], &l, &h);
-      sl[sp - 1] = l;
-      sh[sp - 1] = h;
-    }
-  }
-  double m = 1e-12 * (fabs(sl[0]) + fabs(sh[0]) + 1);
-  *dl = sl[0] - m;
-  *dh = sh[0] + m;
-}
+enum { T_OUT = CSG_BOX_OUT, T_IN = CSG_BOX_IN, T_MIX = CSG_BOX_MIX, T_ONE = 3,
+       T_PL = 4 };
 
 static int leaf_box(const ScNode *nd, const double lo[3], const double hi[3]) {
   switch (nd->kind) {
   case SC_HALFSPACE: {
     double rl, rh;
-    plane_range(nd->n, nd->d, lo, hi, &rl, &rh);
+    vec3_plane_range(nd->n, nd->d, lo, hi, &rl, &rh);
     return rh < 0 ? T_IN : (rl > 0 ? T_OUT : T_ONE);
   }
   case SC_ROUNDED: {
-    if (nd->outer && csg_box(nd->outer, lo, hi) == T_OUT) return T_OUT;
-    if (nd->inner && csg_box(nd->inner, lo, hi) == T_IN) return T_IN;
+    if (nd->outer && csg_box_class(nd->outer, lo, hi) == T_OUT) return T_OUT;
+    if (nd->inner && csg_box_class(nd->inner, lo, hi) == T_IN) return T_IN;
     double dl, dh;
-    dt_box(nd->tape, lo, hi, &dl, &dh);
+    dt_range_box(nd->tape, lo, hi, &dl, &dh);
     return dh < 0.5 ? T_OUT : (dl > 0.5 ? T_IN : T_ONE);
   }
   case SC_SOFT: {
@@ -408,7 +317,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
     if (in->op == DT_LEAF) {
       const dt_leaf *lf = &t->leaves[in->arg];
       double rl, rh;
-      plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
+      vec3_plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
       x->n = 0;
       if (lf->r <= 0) {
         x->l = rh < 0 ? 1 : 0;

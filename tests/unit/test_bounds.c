@@ -293,8 +293,50 @@ static void test_bounds_cube(void) {
   dt_tape_free(tp);
 }
 
+/* csg_box_class and dt_range_box (the mesher's cell proofs) against the
+ * references at points of the box: a box called OUT or IN has no sampled
+ * point on the other side, and every sampled density lies in the range
+ * (MPFR reference; 1e-12 for its own rounding). */
+static void test_box_proofs(void) {
+  rng_t g = {4242};
+  int bad_class = 0, bad_range = 0, decided = 0, boxes = 0;
+  for (int sc = 0; sc < 60; sc++) {
+    rtree t;
+    int root = rt_random_scene(&t, &g);
+    dt_tape *tp = rt_tape(&t, root);
+    csg_tape *ct = csg_of(&t, root);
+    for (int k = 0; k < 40; k++, boxes++) {
+      double lo[3], hi[3], w = rng_range(&g, 1e-3, 1.5);
+      for (int i = 0; i < 3; i++) {
+        lo[i] = rng_range(&g, -1.4, 2.4);
+        hi[i] = lo[i] + w * rng_range(&g, 0.2, 1);
+      }
+      int c = csg_box_class(ct, lo, hi);
+      double dl, dh;
+      dt_range_box(tp, lo, hi, &dl, &dh);
+      decided += c != CSG_BOX_MIX;
+      for (int j = 0; j < 30; j++) {
+        double p[3];
+        for (int i = 0; i < 3; i++) p[i] = rng_range(&g, lo[i], hi[i]);
+        int in = ref_in(&t, root, p);
+        if ((c == CSG_BOX_IN && !in) || (c == CSG_BOX_OUT && in)) bad_class++;
+        double rho = ref_density(&t, root, p);
+        if (rho < dl - 1e-12 || rho > dh + 1e-12) bad_range++;
+      }
+    }
+    dt_tape_free(tp);
+    csg_tape_free(ct);
+  }
+  printf("# box proofs: %d of %d boxes decided IN or OUT\n", decided, boxes);
+  CHECK("csg_box_class: no sampled point contradicts IN or OUT (72000 points)",
+        bad_class == 0 && decided > boxes / 10);
+  CHECK("dt_range_box: every sampled density within the range (MPFR)",
+        bad_range == 0);
+}
+
 int main(void) {
   check_prefix = "bounds";
+  test_box_proofs();
   test_csg_basics();
   test_csg_spans();
   test_bounds_cube();
