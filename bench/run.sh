@@ -304,52 +304,40 @@ echo
 echo "pictures at the prompt (from process start; medians of $PV_REPS):"
 echo "$PREVIEW" | tail -n +3 | sed 's/^| //; s/ |$//; s/ | /: /; s/ | / /g'
 
-# An animation in one process against one process a frame (issue 17):
-# bench/frames.sh, examples/lid.qcs at 160x100, frames 1-100.
-FRAMES_SUMMARY=""
-if [ "${FRAMES_BENCH:-1}" = 1 ]; then
-  FRAMES_SUMMARY=$(QCS="$QCS" sh bench/frames.sh "$THREADS" 2>&1)
-  echo
-  echo "animation, one process against one a frame (bench/frames.sh):"
-  echo "$FRAMES_SUMMARY"
-fi
-
-# A farm's tiles against the whole picture (issue 17): bench/tiles.sh.
-TILES_SUMMARY=""
-if [ "${TILES_BENCH:-1}" = 1 ]; then
-  TILES_SUMMARY=$(QCS="$QCS" sh bench/tiles.sh "$THREADS" 2>&1)
-  echo
-  echo "tiles as separate processes against the whole (bench/tiles.sh):"
-  echo "$TILES_SUMMARY"
-fi
-
-# The kit's patterns at scale (issue 19): bench/kit.sh, bench/grid1000.qcs.
-KIT_SUMMARY=""
-if [ "${KIT_BENCH:-1}" = 1 ]; then
-  KIT_SUMMARY=$(QCS="$QCS" SIZE="$SIZE" sh bench/kit.sh "$THREADS" 2>&1)
-  echo
-  echo "a 10x10x10 grid of rounded cubes (bench/kit.sh):"
-  echo "$KIT_SUMMARY"
-fi
-
-# The interpreter against Hugs (issue 18): bench/interp.sh.
-INTERP_SUMMARY=""
-if [ "${INTERP_BENCH:-1}" = 1 ]; then
-  INTERP_SUMMARY=$(QCS="$QCS" bash bench/interp.sh -n "$REPS" 2>&1)
-  echo
-  echo "the interpreter against Hugs (bench/interp.sh):"
-  echo "$INTERP_SUMMARY"
-fi
-
-# Meshing (issue 16): bench/mesh.sh, the figure12 objects at 1e-3 of their
-# size against a uniform grid, the unit cube at 1e-4, OpenSCAD's export.
-MESH_SUMMARY=""
-if [ "${MESH_BENCH:-1}" = 1 ]; then
-  MESH_SUMMARY=$(QCS="$QCS" sh bench/mesh.sh 2>&1)
-  echo
-  echo "meshing (bench/mesh.sh):"
-  echo "$MESH_SUMMARY"
-fi
+# The side benches, each a script of bench/ run unless its switch is 0;
+# its output is kept for bench/README.md.
+#   side VAR SWITCH LABEL COMMAND...: VAR=$(COMMAND), printed under LABEL
+side() {
+  local var=$1 switch=$2 label=$3 out=""
+  shift 3
+  if [ "${!switch:-1}" = 1 ]; then
+    out=$("$@" 2>&1)
+    echo
+    echo "$label"
+    echo "$out"
+  fi
+  printf -v "$var" '%s' "$out"
+}
+export QCS
+# An animation in one process against one a frame (issue 17):
+# examples/lid.qcs at 160x100, frames 1-100.
+side FRAMES_SUMMARY FRAMES_BENCH \
+  "animation, one process against one a frame (bench/frames.sh):" \
+  sh bench/frames.sh "$THREADS"
+# A farm's tiles against the whole picture (issue 17).
+side TILES_SUMMARY TILES_BENCH \
+  "tiles as separate processes against the whole (bench/tiles.sh):" \
+  sh bench/tiles.sh "$THREADS"
+# The kit's patterns at scale (issue 19): bench/grid1000.qcs.
+side KIT_SUMMARY KIT_BENCH \
+  "a 10x10x10 grid of rounded cubes (bench/kit.sh):" \
+  env SIZE="$SIZE" sh bench/kit.sh "$THREADS"
+# The interpreter against Hugs (issue 18).
+side INTERP_SUMMARY INTERP_BENCH \
+  "the interpreter against Hugs (bench/interp.sh):" bash bench/interp.sh -n "$REPS"
+# Meshing (issue 16): the figure12 objects at 1e-3 of their size against a
+# uniform grid, the unit cube at 1e-4, OpenSCAD's export.
+side MESH_SUMMARY MESH_BENCH "meshing (bench/mesh.sh):" sh bench/mesh.sh
 
 # Issue 7's targets.
 verdict() { if [ "$1" = "-" ] || [ -z "$1" ]; then echo "not measured"; elif awk "BEGIN { exit !($2) }"; then echo "met"; else echo "NOT met"; fi; }

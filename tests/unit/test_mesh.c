@@ -144,24 +144,29 @@ out:;
   return d;
 }
 
+/* A uniformly random point p of a random triangle of m, and the triangle's
+   normal nn (|nn| = twice its area, returned; 0 for a sliver). */
+static double triangle_point(const Mesh *m, double p[3], double nn[3]) {
+  size_t i = (size_t)(urand() * (double)m->nt);
+  const double *a = m->v + 3 * m->t[3 * i], *b = m->v + 3 * m->t[3 * i + 1],
+               *c = m->v + 3 * m->t[3 * i + 2];
+  double u = urand(), v = urand(), ab[3], ac[3];
+  if (u + v > 1) u = 1 - u, v = 1 - v;
+  for (int j = 0; j < 3; j++) {
+    p[j] = a[j] + u * (b[j] - a[j]) + v * (c[j] - a[j]);
+    ab[j] = b[j] - a[j];
+    ac[j] = c[j] - a[j];
+  }
+  vec3_cross(ab, ac, nn);
+  return sqrt(vec3_dot(nn, nn));
+}
+
 /* Triangle points: is there a sign change within distance e (along the
    triangle's normal and the axes)? Returns the number of failures. */
 static long mesh_to_surface(const Scene *s, const Mesh *m, double e, int n) {
   long bad = 0;
   for (int k = 0; k < n; k++) {
-    size_t i = (size_t)(urand() * (double)m->nt);
-    const double *a = m->v + 3 * m->t[3 * i], *b = m->v + 3 * m->t[3 * i + 1],
-                 *c = m->v + 3 * m->t[3 * i + 2];
-    double u = urand(), v = urand();
-    if (u + v > 1) u = 1 - u, v = 1 - v;
-    double p[3], nn[3], ab[3], ac[3];
-    for (int j = 0; j < 3; j++) {
-      p[j] = a[j] + u * (b[j] - a[j]) + v * (c[j] - a[j]);
-      ab[j] = b[j] - a[j];
-      ac[j] = c[j] - a[j];
-    }
-    vec3_cross(ab, ac, nn);
-    double l = sqrt(vec3_dot(nn, nn));
+    double p[3], nn[3], l = triangle_point(m, p, nn);
     double dirs[7][3] = {{nn[0] / l, nn[1] / l, nn[2] / l}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     int in0 = scene_inside(s, s->root, p), change = 0;
     for (int d = 0; d < 4 && !change && l > 0; d++)
@@ -412,18 +417,7 @@ static long probe_points(const char *obj, const char *tree, double radius,
   long bad = 0;
   char buf[4096];
   for (int k = 0; k < n; k++) {
-    size_t i = (size_t)(urand() * (double)m->nt);
-    const double *a = m->v + 3 * m->t[3 * i], *b = m->v + 3 * m->t[3 * i + 1],
-                 *c = m->v + 3 * m->t[3 * i + 2];
-    double u = urand(), v = urand(), p[3], ab[3], ac[3], nn[3];
-    if (u + v > 1) u = 1 - u, v = 1 - v;
-    for (int j = 0; j < 3; j++) {
-      p[j] = a[j] + u * (b[j] - a[j]) + v * (c[j] - a[j]);
-      ab[j] = b[j] - a[j];
-      ac[j] = c[j] - a[j];
-    }
-    vec3_cross(ab, ac, nn);
-    double l = sqrt(vec3_dot(nn, nn));
+    double p[3], nn[3], l = triangle_point(m, p, nn);
     if (!(l > 0)) continue; /* a sliver: its points are its edges' */
     double dirs[4][3] = {{nn[0] / l, nn[1] / l, nn[2] / l}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     int found = 0, dens = tree == NULL;
