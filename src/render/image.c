@@ -250,11 +250,19 @@ static unsigned char srgb8_exact(float v) {
 
 /* srgb8_exact is nondecreasing in v, so it is fixed by the least float at
    which each code starts: found once by bisection on the floats' bit
-   patterns (positive floats order as their bits do), then an encode is 8
-   comparisons instead of a pow (the PNG writer spent 8% of figure12's
-   instructions in pow). The same code as srgb8_exact for every float:
-   test_image checks every float in (0, 1). */
-static float srgb8_start[256];
+   patterns (positive floats order as their bits do). An encode is then a
+   look-up instead of a pow (the PNG writer spent 8% of figure12's
+   instructions in pow): (0, 1) is cut into SRGB8_BUCKETS equal buckets
+   (v * SRGB8_BUCKETS is exact, a power of two), each knowing the code at
+   its lower end; the encoding is steepest at 0, 255 * 12.92 codes per
+   unit, under one code per bucket, so a code is its bucket's or a step
+   up (a loop, so a coarser table would still be right). It replaced a
+   bisection of 8 comparisons per channel, 3% of figure12's instructions.
+   The same code as srgb8_exact for every float: test_image checks every
+   float in (0, 1). */
+#define SRGB8_BUCKETS 4096
+static float srgb8_start[257];
+static unsigned char srgb8_bucket[SRGB8_BUCKETS];
 static pthread_once_t srgb8_once = PTHREAD_ONCE_INIT;
 static atomic_int srgb8_ready;
 
@@ -270,6 +278,12 @@ static void srgb8_init(void) {
     }
     memcpy(&srgb8_start[c], &hi, sizeof hi);
   }
+  srgb8_start[256] = INFINITY; /* the loop's sentinel */
+  for (int b = 0, c = 0; b < SRGB8_BUCKETS; b++) {
+    float lo = (float)b / (float)SRGB8_BUCKETS;
+    while (c < 255 && lo >= srgb8_start[c + 1]) c++;
+    srgb8_bucket[b] = (unsigned char)c;
+  }
   atomic_store_explicit(&srgb8_ready, 1, memory_order_release);
 }
 
@@ -278,9 +292,8 @@ unsigned char img_srgb8(float v) {
   if (v >= 1.0f) return 255;
   if (!atomic_load_explicit(&srgb8_ready, memory_order_acquire))
     pthread_once(&srgb8_once, srgb8_init);
-  unsigned c = 0;
-  for (unsigned step = 128; step; step >>= 1)
-    if (v >= srgb8_start[c + step]) c += step;
+  unsigned c = srgb8_bucket[(int)(v * (float)SRGB8_BUCKETS)];
+  while (v >= srgb8_start[c + 1]) c++;
   return (unsigned char)c;
 }
 
