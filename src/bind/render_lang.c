@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "lang/builtins.h"
@@ -376,10 +377,17 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
   ImgWriteOptions wo = {0};
   wo.float_pixels = float_pixels;
   wo.alpha = rs.alpha;
+  struct timespec w0, w1;
+  clock_gettime(CLOCK_MONOTONIC, &w0);
   int wr = img_write(im, path, &wo, err, sizeof err);
+  clock_gettime(CLOCK_MONOTONIC, &w1);
   img_free(im);
   if (wr) qcs_error(pos, "%s", err);
-  if (!quiet) report_render(stderr, &rep, path);
+  if (!quiet) {
+    report_render(stderr, &rep, path);
+    report_written(stderr, (double)(w1.tv_sec - w0.tv_sec) +
+                               1e-9 * (double)(w1.tv_nsec - w0.tv_nsec));
+  }
   return val_str(path);
 }
 

@@ -47,6 +47,10 @@ void report_render(FILE *out, const RenderReport *r, const char *path) {
           r->prims, r->prims == 1 ? "" : "s", r->bounded_prims);
 }
 
+void report_written(FILE *out, double seconds) {
+  fprintf(out, "  file written in %.3f s\n", seconds);
+}
+
 void report_progress(void *ud, double frac, double seconds_left) {
   (void)ud;
   if (frac >= 1) fprintf(stderr, "\r%40s\r", "");

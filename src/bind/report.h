@@ -16,6 +16,10 @@
    tolerance in force. */
 void report_render(FILE *out, const RenderReport *rep, const char *path);
 
+/* The report's last line: the seconds spent encoding and writing the file
+   (PNG compression, EXR, PPM), which the render's time leaves out. */
+void report_written(FILE *out, double seconds);
+
 /* One line about a compiled scene, for the picture at the prompt:
    "WHAT: KIND, N leaves, box (x, y, z) .. (x, y, z)" (or "unbounded"),
    where WHAT is the caller's short text (the value as printed, cut). */
