@@ -208,4 +208,23 @@ double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
 int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
                 dt_instr *buf, dt_tape *view);
 
+/* The specialisation of t to a region where the leaves' classes are
+ * known: cls[i] is 0 or 1 for a leaf constant there at that value, -1 for
+ * a live one (render.c decides them over a tile's frustum).  Folds as
+ * dt_prune_ray does, so pruning the result over a ray segment inside the
+ * region gives the code pruning t itself would give there, to the last
+ * bit.  Writes at most t->ncode instructions to buf (the view's code).
+ * Without a prune program, the live leaves are copied in code order to
+ * leaves (room for t->nleaves) and renumbered, so a ray's leaf table
+ * (dt_ray_leaves) covers only them.  With one, the view keeps t's leaves
+ * and gets a program *prog sharing t's group tables, whose code (at most
+ * t->prog->npcode instructions, in pbuf) keeps each live group as one
+ * DT_GROUP instruction whose c is the mask of the group's leaves that may
+ * be live (the others are 1 there), so the pruning functions still copy a
+ * group's code for its live set.  *view borrows buf, leaves or t's, and
+ * prog; it keeps t's range, depth and rmax.  Returns the code length. */
+int dt_prune_class(const dt_tape *t, const signed char *cls, dt_instr *buf,
+                   dt_leaf *leaves, dt_instr *pbuf, dt_prune_prog *prog,
+                   dt_tape *view);
+
 #endif
