@@ -1091,20 +1091,19 @@ static void shade_hit(Worker *W, const double o[3], const double d[3],
     nrm[0] = nrm[1] = nrm[2] = 0;
     return;
   }
-  Hit h = *hp;
   double p[3], n[3];
-  for (int i = 0; i < 3; i++) p[i] = o[i] + h.t * d[i];
-  if (h.has_grad) { /* outward is down the density gradient */
-    double g[3] = {-h.grad[0], -h.grad[1], -h.grad[2]};
-    ray_normal_grad(g, h.flip, n);
+  for (int i = 0; i < 3; i++) p[i] = o[i] + hp->t * d[i];
+  if (hp->has_grad) { /* outward is down the density gradient */
+    double g[3] = {-hp->grad[0], -hp->grad[1], -hp->grad[2]};
+    ray_normal_grad(g, hp->flip, n);
   } else {
-    ray_normal(T->s, h.id, h.flip, p, n);
+    ray_normal(T->s, hp->id, hp->flip, p, n);
   }
   if (vec3_dot(n, d) > 0)
     for (int i = 0; i < 3; i++) n[i] = -n[i];
-  *z = h.t; /* d is unit length: t is the distance */
+  *z = hp->t; /* d is unit length: t is the distance */
   memcpy(nrm, n, sizeof n);
-  const double *col = T->prims[h.prim].colour;
+  const double *col = T->prims[hp->prim].colour;
   for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
   double scale = fmax(1.0, sqrt(vec3_dot(p, p)));
   double eps = T->eps * scale;
@@ -1156,7 +1155,7 @@ static void progress(Tracer *T) {
 
 /* A pixel's values from its g x g samples' radiance, central AOVs and
    hits (render_tile's two forms). */
-static void put_pixel(const Tracer *T, int x, int y, const double sum[3],
+static inline void put_pixel(const Tracer *T, int x, int y, const double sum[3],
                       int hits, double zmin, const double nrm0[3],
                       long cost) {
   Image *im = T->im;
