@@ -281,6 +281,15 @@ double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
 
 void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],
                    dt_ray_leaf *rl) {
+  if (t->live) {
+    for (int k = 0; k < t->nlive; k++) {
+      int i = t->live[k];
+      const dt_leaf *lf = &t->leaves[i];
+      rl[i].base = dt_leaf_dist(lf, o);
+      rl[i].nd = vec3_dot(lf->n, d);
+    }
+    return;
+  }
   for (int i = 0; i < t->nleaves; i++) {
     const dt_leaf *lf = &t->leaves[i];
     rl[i].base = dt_leaf_dist(lf, o);
@@ -645,14 +654,28 @@ int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
 
 int dt_prune_class(const dt_tape *t, const signed char *cls, dt_instr *buf,
                    dt_leaf *leaves, dt_instr *pbuf, dt_prune_prog *prog,
-                   dt_tape *view) {
+                   int *live, dt_tape *view) {
   int n = prune(t, NULL, NULL, NULL, cls, 0, 0, 0, buf, view);
+  view->live = NULL;
+  view->nlive = 0;
   if (t->prog) {   /* the parent's groups are kept: so are its leaves */
     dt_tape pv;
     *prog = *t->prog;
     prog->pcode = pbuf;
     prog->npcode = prune(t, NULL, NULL, NULL, cls, 1, 0, 0, pbuf, &pv);
     view->prog = prog;
+    /* the leaves of the live code; in t's order (a view of a view has
+       only the live ones among its parent's) */
+    int m = 0;
+    if (t->live) {
+      for (int i = 0; i < t->nlive; i++)
+        if (cls[t->live[i]] < 0) live[m++] = t->live[i];
+    } else {
+      for (int i = 0; i < t->nleaves; i++)
+        if (cls[i] < 0) live[m++] = i;
+    }
+    view->live = live;
+    view->nlive = m;
     return n;
   }
   int nl = 0;

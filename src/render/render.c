@@ -588,7 +588,7 @@ static int hull_meets_box(const void *ctx, const double blo[3],
    tracer's, bit for bit (test_render checks). */
 typedef struct TileSet {
   int node;
-  size_t code, leaves, pcode; /* its view's offsets into the arenas */
+  size_t code, leaves, pcode, live; /* its view's offsets into the arenas */
 } TileSet;
 
 typedef struct TileCull {
@@ -607,6 +607,8 @@ typedef struct TileCull {
   size_t ncode, capcode;
   dt_leaf *leaves;
   size_t nleaves, capleaves;
+  int *live;                 /* arena of the grouped views' live lists */
+  size_t nlv, caplv;
   signed char *cls;
   size_t capcls;
   int *stack;                /* the BVH walk's */
@@ -624,6 +626,7 @@ static void tile_cull_free(TileCull *tc) {
   free(tc->pcode);
   free(tc->code);
   free(tc->leaves);
+  free(tc->live);
   free(tc->cls);
   free(tc->stack);
   memset(tc, 0, sizeof *tc);
@@ -765,16 +768,19 @@ static int tile_prune_node(const Tracer *T, TileCull *tc, const Frustum *f,
       reserve((void **)&tc->pcode, &tc->cappcode, tc->npcode, np,
               sizeof *tc->pcode) ||
       reserve((void **)&tc->leaves, &tc->capleaves, tc->nleaves, nl,
-              sizeof *tc->leaves))
+              sizeof *tc->leaves) ||
+      reserve((void **)&tc->live, &tc->caplv, tc->nlv, nl,
+              sizeof *tc->live))
     return -1;
   dt_tape *v = &tc->views[k];
   dt_prune_prog *pg = &tc->progs[k];
   dt_prune_class(t, tc->cls, tc->code + tc->ncode, tc->leaves + tc->nleaves,
-                 tc->pcode + tc->npcode, pg, v);
-  tc->set[k] = (TileSet){id, tc->ncode, tc->nleaves, tc->npcode};
+                 tc->pcode + tc->npcode, pg, tc->live + tc->nlv, v);
+  tc->set[k] = (TileSet){id, tc->ncode, tc->nleaves, tc->npcode, tc->nlv};
   tc->ncode += (size_t)v->ncode;
   if (v->prog) {
     tc->npcode += (size_t)pg->npcode;
+    tc->nlv += (size_t)v->nlive;
     tc->leaves_out += live;
   } else {
     tc->nleaves += (size_t)v->nleaves;
@@ -806,7 +812,7 @@ static int cull_bvh(const Tracer *T, TileCull *tc, BoxTest meets,
   tc->one = -1;
   if (tc->tape) {
     for (size_t k = 0; k < tc->nset; k++) tc->tape[tc->set[k].node] = NULL;
-    tc->nset = tc->ncode = tc->nleaves = 0;
+    tc->nset = tc->ncode = tc->nleaves = tc->npcode = tc->nlv = 0;
     if (++tc->tile == 0) { /* the stamps wrapped */
       memset(tc->stamp, 0, sizeof *tc->stamp * (size_t)(T->s->n + 1));
       tc->tile = 1;
@@ -846,6 +852,7 @@ static int cull_bvh(const Tracer *T, TileCull *tc, BoxTest meets,
     if (v->prog) { /* its leaves are the whole tape's */
       v->prog = &tc->progs[k];
       v->prog->pcode = tc->pcode + tc->set[k].pcode;
+      v->live = tc->live + tc->set[k].live;
     } else {
       v->leaves = tc->leaves + tc->set[k].leaves;
     }

@@ -485,6 +485,9 @@ static void test_prune_class(void) {
     dt_instr *v2 = malloc((size_t)tp->ncode * sizeof *v2);
     dt_leaf *lv = malloc((size_t)tp->nleaves * sizeof *lv);
     signed char *cls = malloc((size_t)tp->nleaves);
+    int *lives = malloc((size_t)tp->nleaves * sizeof *lives);
+    dt_ray_leaf *rl1 = malloc((size_t)tp->nleaves * sizeof *rl1);
+    dt_ray_leaf *rl2 = malloc((size_t)tp->nleaves * sizeof *rl2);
     grouped += tp->prog != NULL;
     for (int k = 0; k < 20; k++) {
       double o[3] = {rng_range(&g, -2, 2), rng_range(&g, -2, 2),
@@ -507,7 +510,7 @@ static void test_prune_class(void) {
       }
       dt_prune_prog pg;
       dt_tape tile;
-      dt_prune_class(tp, cls, buf, lv, pbuf, &pg, &tile);
+      dt_prune_class(tp, cls, buf, lv, pbuf, &pg, lives, &tile);
       if (live < tp->nleaves) cut++;
       for (int q = 0; q < 3; q++) {
         double s0 = rng_range(&g, r0, r1), s1 = rng_range(&g, s0, r1);
@@ -523,6 +526,21 @@ static void test_prune_class(void) {
           if (memcmp(&x, &y, sizeof x) || memcmp(&d1, &d2, sizeof d1))
             bad_value++;
         }
+        /* the same through the leaf tables, the cut tape's filled only
+           for its live leaves (the rest NaN: read, they would show) */
+        for (int j = 0; j < tp->nleaves; j++) rl2[j].base = rl2[j].nd = NAN;
+        dt_ray_leaves(tp, o, d, rl1);
+        dt_ray_leaves(&tile, o, d, rl2);
+        dt_prune_rl(tp, rl1, s0, s1, v1, &a);
+        dt_prune_rl(&tile, rl2, s0, s1, v2, &b);
+        if (!same_code(&a, &b)) bad_code++;
+        for (int j = 0; j <= 8; j++) {
+          double s = s0 + (s1 - s0) * j / 8, d1, d2;
+          double x = dt_density_rl(&a, rl1, s, &d1);
+          double y = dt_density_rl(&b, rl2, s, &d2);
+          if (memcmp(&x, &y, sizeof x) || memcmp(&d1, &d2, sizeof d1))
+            bad_value++;
+        }
       }
     }
     free(buf);
@@ -531,6 +549,9 @@ static void test_prune_class(void) {
     free(v2);
     free(lv);
     free(cls);
+    free(lives);
+    free(rl1);
+    free(rl2);
     dt_tape_free(tp);
   }
   if (getenv("QCS_TEST_VERBOSE"))
