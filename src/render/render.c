@@ -17,9 +17,9 @@
 #include "scene/ray.h"
 
 #define TILE 16
-#ifndef CULL_BLOCK
+/* Tiles are traced in blocks of CULL_BLOCK x CULL_BLOCK pixels, each
+   culled and pruned to its own rays (TileCull). */
 #define CULL_BLOCK 8
-#endif
 
 /* ---- boxes ---- */
 
@@ -1064,7 +1064,7 @@ typedef struct Worker {
   long rounded_hits, rounded_hit_evals;
   TileCull tc;                /* the current tile's primary rays' */
   TileCull sh[RENDER_MAX_LIGHTS]; /* its shadow rays', per light */
-  Sample *samples;            /* TILE x TILE x grid^2 */
+  Sample *samples;            /* CULL_BLOCK^2 x grid^2 */
 } Worker;
 
 /* The primary ray of one camera sample: its hit, if any (counted). */
@@ -1177,8 +1177,8 @@ static inline void put_pixel(const Tracer *T, int x, int y, const double sum[3],
   if (im->cost) im->cost[k] = (float)cost;
 }
 
-/* The tile's pixels [x0, x1) x [y0, y1) in two passes: every primary ray
-   (culled and pruned to the tile's frustum), then the shading, whose
+/* A block's pixels [x0, x1) x [y0, y1) in two passes: every primary ray
+   (culled and pruned to the block's frustum), then the shading, whose
    shadow rays are culled to the hull of their origins and each light.
    Rays do not depend on each other, so the pixels are those of the one
    pass form, bit for bit. */
@@ -1583,7 +1583,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
     workers[i].c = ray_ctx_new(s, rs->tol);
     if (!workers[i].c) goto oom;
     if (T.tiled) {
-      size_t ns = (size_t)TILE * TILE * (size_t)grid * (size_t)grid;
+      size_t ns = (size_t)CULL_BLOCK * CULL_BLOCK * (size_t)grid * (size_t)grid;
       workers[i].samples = malloc(sizeof *workers[i].samples * ns);
       if (!workers[i].samples || tile_cull_init(&T, &workers[i].tc, 1))
         goto oom;
