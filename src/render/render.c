@@ -449,6 +449,38 @@ static int box_hit(const double lo[3], const double hi[3], const double o[3],
 }
 
 
+/* A ray's slab test set up once: inv = 1/d, and whether some component of
+   d is 0 or NaN (then box_hit, with its NaN rule, is used). */
+typedef struct RaySlab {
+  const double *o;
+  double inv[3];
+  int parallel;
+} RaySlab;
+
+/* box_hit for a ray without a zero component: with inv > 0 the low face
+   is entered first, with inv < 0 the high one, so the swap is decided by
+   the sign and no product is NaN; the same t0, t1 and answer. */
+static inline int slab_hit(const double lo[3], const double hi[3],
+                           const RaySlab *r, double t0, double t1,
+                           double *enter) {
+  if (r->parallel) return box_hit(lo, hi, r->o, r->inv, t0, t1, enter);
+  for (int k = 0; k < 3; k++) {
+    double a = (lo[k] - r->o[k]) * r->inv[k];
+    double c = (hi[k] - r->o[k]) * r->inv[k];
+    if (r->inv[k] < 0) {
+      double tmp = a;
+      a = c;
+      c = tmp;
+    }
+    if (a > t0) t0 = a;
+    if (c < t1) t1 = c;
+    if (t0 > t1) return 0;
+  }
+  *enter = t0;
+  return 1;
+}
+
+
 /* ---- tiles: the frustum, culled primitives and pruned tapes ---- */
 
 /* The rays of a tile: from the eye along fwd + u right + v up for (u, v)
@@ -982,13 +1014,14 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
     }
   }
   if (!T->bvh.nnodes || (tc && tc->nlive == 0)) goto out;
-  double inv[3] = {1 / d[0], 1 / d[1], 1 / d[2]};
+  RaySlab rs = {o, {1 / d[0], 1 / d[1], 1 / d[2]},
+                !(fabs(d[0]) > 0 && fabs(d[1]) > 0 && fabs(d[2]) > 0)};
   if (tc && tc->nlive == 1) { /* its ancestors' boxes hold its box */
     int pi = T->bounded[tc->one];
     const Box *pb = &T->prims[pi].box;
     double e2;
     Hit h;
-    if (box_hit(pb->lo, pb->hi, o, inv, t0, t1, &e2) &&
+    if (slab_hit(pb->lo, pb->hi, &rs, t0, t1, &e2) &&
         prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
       *best = h;
       found = 1;
@@ -1002,14 +1035,14 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
     if (tc && !tc->node_live[ni]) continue;
     const bvh_node *b = &T->bvh.nodes[ni];
     double enter;
-    if (!box_hit(b->lo, b->hi, o, inv, t0, t1, &enter)) continue;
+    if (!slab_hit(b->lo, b->hi, &rs, t0, t1, &enter)) continue;
     if (b->count) {
       for (int i = b->first; i < b->first + b->count; i++) {
         if (tc && !tc->slot_live[i]) continue;
         int pi = T->bounded[i];
         const Box *pb = &T->prims[pi].box;
         double e2;
-        if (!box_hit(pb->lo, pb->hi, o, inv, t0, t1, &e2)) continue;
+        if (!slab_hit(pb->lo, pb->hi, &rs, t0, t1, &e2)) continue;
         Hit h;
         if (prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
           *best = h;
@@ -1023,8 +1056,8 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
     /* Visit the nearer child first. */
     const bvh_node *l = &T->bvh.nodes[b->first], *r = l + 1;
     double el = INFINITY, er = INFINITY;
-    int hl = box_hit(l->lo, l->hi, o, inv, t0, t1, &el);
-    int hr = box_hit(r->lo, r->hi, o, inv, t0, t1, &er);
+    int hl = slab_hit(l->lo, l->hi, &rs, t0, t1, &el);
+    int hr = slab_hit(r->lo, r->hi, &rs, t0, t1, &er);
     if (hl && hr) {
       if (el < er) {
         stack[sp++] = b->first + 1;
@@ -1068,7 +1101,7 @@ typedef struct Worker {
 } Worker;
 
 /* The primary ray of one camera sample: its hit, if any (counted). */
-static int primary_hit(Worker *W, const double o[3], const double d[3],
+static inline int primary_hit(Worker *W, const double o[3], const double d[3],
                        Hit *h, const TileCull *tc) {
   const Tracer *T = W->T;
   RayCtx *c = W->c;
@@ -1086,7 +1119,7 @@ static int primary_hit(Worker *W, const double o[3], const double d[3],
 /* A camera sample's radiance from its primary hit h (found, else the
    background), and for the AOVs the hit's distance and normal; sh[l]:
    the culling of shadow rays towards light l, or NULL. */
-static void shade_hit(Worker *W, const double o[3], const double d[3],
+static inline void shade_hit(Worker *W, const double o[3], const double d[3],
                       int found, const Hit *hp, double rgb[3], double *z,
                       double nrm[3], const TileCull *const *sh) {
   const Tracer *T = W->T;
