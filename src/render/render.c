@@ -425,49 +425,39 @@ static int build_bvh(Tracer *T) {
   return err;
 }
 
-/* Slab test: the part of [t0, t1] inside the box. */
-static int box_hit(const double lo[3], const double hi[3], const double o[3],
-                   const double inv[3], double t0, double t1, double *enter) {
-  for (int k = 0; k < 3; k++) {
-    double a = (lo[k] - o[k]) * inv[k];
-    double c = (hi[k] - o[k]) * inv[k];
-    if (isnan(a) || isnan(c)) { /* parallel and on a slab plane */
-      if (o[k] < lo[k] || o[k] > hi[k]) return 0;
-      continue;
-    }
-    if (a > c) {
-      double tmp = a;
-      a = c;
-      c = tmp;
-    }
-    if (a > t0) t0 = a;
-    if (c < t1) t1 = c;
-    if (t0 > t1) return 0;
-  }
-  *enter = t0;
-  return 1;
-}
-
-
-/* A ray's slab test set up once: inv = 1/d, and whether some component of
-   d is 0 or NaN (then box_hit, with its NaN rule, is used). */
+/* A ray's slab test set up once: o, inv = 1/d, and which components of d
+   are 0 or NaN. */
 typedef struct RaySlab {
   const double *o;
   double inv[3];
-  int parallel;
+  unsigned char flat[3], any_flat;
 } RaySlab;
 
-/* box_hit for a ray without a zero component: with inv > 0 the low face
-   is entered first, with inv < 0 the high one, so the swap is decided by
-   the sign and no product is NaN; the same t0, t1 and answer. */
-static inline int slab_hit(const double lo[3], const double hi[3],
-                           const RaySlab *r, double t0, double t1,
-                           double *enter) {
-  if (r->parallel) return box_hit(lo, hi, r->o, r->inv, t0, t1, enter);
+static void ray_slab(RaySlab *r, const double o[3], const double d[3]) {
+  r->o = o;
+  for (int k = 0; k < 3; k++) {
+    r->inv[k] = 1 / d[k];
+    r->flat[k] = !(fabs(d[k]) > 0);
+  }
+  r->any_flat = r->flat[0] || r->flat[1] || r->flat[2];
+}
+
+/* Slab test: the part of [t0, t1] inside the box, its start in *enter.
+   The near face is lo's when 1/d > 0 and hi's when it is < 0 (rounding
+   is monotonic, so the products keep that order, ties aside); on an axis
+   the ray does not move along a product may be NaN (the origin on a face
+   plane): the origin decides. */
+static inline int slab_core(const double lo[3], const double hi[3],
+                            const RaySlab *r, double t0, double t1,
+                            double *enter, int flat) {
   for (int k = 0; k < 3; k++) {
     double a = (lo[k] - r->o[k]) * r->inv[k];
     double c = (hi[k] - r->o[k]) * r->inv[k];
-    if (r->inv[k] < 0) {
+    if (flat && r->flat[k] && (isnan(a) || isnan(c))) {
+      if (r->o[k] < lo[k] || r->o[k] > hi[k]) return 0;
+      continue;
+    }
+    if (r->inv[k] < 0) { /* a >= c: (hi - o) >= (lo - o), times 1/d < 0 */
       double tmp = a;
       a = c;
       c = tmp;
@@ -480,6 +470,14 @@ static inline int slab_hit(const double lo[3], const double hi[3],
   return 1;
 }
 
+/* slab_core made twice by the compiler: without the NaN rule for the
+   usual ray, with it for one with a zero component. */
+static inline int slab_hit(const double lo[3], const double hi[3],
+                           const RaySlab *r, double t0, double t1,
+                           double *enter) {
+  return r->any_flat ? slab_core(lo, hi, r, t0, t1, enter, 1)
+                     : slab_core(lo, hi, r, t0, t1, enter, 0);
+}
 
 /* ---- tiles: the frustum, culled primitives and pruned tapes ---- */
 
@@ -614,7 +612,7 @@ static int hull_meets_box(const void *ctx, const double blo[3],
    frustum inside its outer bound's box (NULL: the whole tape); or, for
    the tile's shadow rays towards one light (shadow_begin), the nodes and
    slots the hull of their origins and the light meets. A culled box is
-   one box_hit refuses for every ray of the tile, and a pruned tape is
+   one slab_hit refuses for every ray of the tile, and a pruned tape is
    one whose views over any searched interval are the whole tape's
    (density.h, dt_prune_class): the tile's pictures are the untiled
    tracer's, bit for bit (test_render checks). */
@@ -1014,8 +1012,8 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
     }
   }
   if (!T->bvh.nnodes || (tc && tc->nlive == 0)) goto out;
-  RaySlab rs = {o, {1 / d[0], 1 / d[1], 1 / d[2]},
-                !(fabs(d[0]) > 0 && fabs(d[1]) > 0 && fabs(d[2]) > 0)};
+  RaySlab rs;
+  ray_slab(&rs, o, d);
   if (tc && tc->nlive == 1) { /* its ancestors' boxes hold its box */
     int pi = T->bounded[tc->one];
     const Box *pb = &T->prims[pi].box;
