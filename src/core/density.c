@@ -281,6 +281,15 @@ double dt_density_ray(const dt_tape *t, const double o[3], const double d[3],
 
 void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],
                    dt_ray_leaf *rl) {
+  if (t->live) {
+    for (int k = 0; k < t->nlive; k++) {
+      int i = t->live[k];
+      const dt_leaf *lf = &t->leaves[i];
+      rl[i].base = dt_leaf_dist(lf, o);
+      rl[i].nd = vec3_dot(lf->n, d);
+    }
+    return;
+  }
   for (int i = 0; i < t->nleaves; i++) {
     const dt_leaf *lf = &t->leaves[i];
     rl[i].base = dt_leaf_dist(lf, o);
@@ -463,8 +472,8 @@ static inline void fold_op(fold_state *f, const dt_instr *in, dt_instr *buf) {
  * finished tape is pruned through its prune program (density.h), with the
  * same result. */
 static int prune(const dt_tape *t, const double o[3], const double d[3],
-                 const dt_ray_leaf *rl, double s0, double s1, dt_instr *buf,
-                 dt_tape *view) {
+                 const dt_ray_leaf *rl, const signed char *cls, int groups,
+                 double s0, double s1, dt_instr *buf, dt_tape *view) {
   fold_state f;
   f.sp = f.n = 0;
   const dt_prune_prog *pp = t->prog;
@@ -479,19 +488,28 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
       const dt_group *g = op == DT_GROUP ? &pp->groups[in->arg] : NULL;
       int nl = g ? g->n : 1;
       unsigned live = 0;
+      /* a group of a dt_prune_class program: only the leaves of its mask
+         may be live (the others are 1) */
+      unsigned mask = g && in->c > 0 ? (unsigned)in->c : ~0u;
       double c = 1;
       for (int k = 0; k < nl; k++) {
+        if (!((mask >> k) & 1)) continue;
         int li = g ? pp->gleaf[g->leaf0 + k] : in->arg;
         const dt_leaf *lf = &t->leaves[li];
-        double base, nd;
-        if (rl) {
-          base = rl[li].base;
-          nd = rl[li].nd;
+        double lc;
+        if (cls) {
+          lc = cls[li];
         } else {
-          nd = vec3_dot(lf->n, d);
-          base = dt_leaf_dist(lf, o);
+          double base, nd;
+          if (rl) {
+            base = rl[li].base;
+            nd = rl[li].nd;
+          } else {
+            nd = vec3_dot(lf->n, d);
+            base = dt_leaf_dist(lf, o);
+          }
+          lc = leaf_const(lf, base, nd, s0, s1);
         }
-        double lc = leaf_const(lf, base, nd, s0, s1);
         if (lc == 0) { c = 0; break; }   /* a product with a 0 is 0 */
         if (lc < 0) live |= 1u << k;
       }
@@ -499,6 +517,9 @@ static int prune(const dt_tape *t, const double o[3], const double d[3],
         fold_leaf(&f, in, !live || c == 0, c, buf);
       } else if (c == 0 || !live) {
         fold_leaf(&f, in, 1, c, buf);
+      } else if (groups) {   /* the group stays, masked to its live set */
+        dt_instr gi = {DT_GROUP, in->arg, (double)live};
+        fold_leaf(&f, &gi, 0, 0, buf);
       } else {
         int a = pp->gsnip[(unsigned)g->snip0 + live], b = pp->gsnip[(unsigned)g->snip0 + live + 1];
         f.start[f.sp] = f.n;
@@ -621,14 +642,51 @@ static int prune_program(dt_tape *t) {
 
 int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
                  double s0, double s1, dt_instr *buf, dt_tape *view) {
-  int n = prune(t, o, d, NULL, s0, s1, buf, view);
+  int n = prune(t, o, d, NULL, NULL, 0, s0, s1, buf, view);
   tape_range(view);
   return n;
 }
 
 int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
                 dt_instr *buf, dt_tape *view) {
-  return prune(t, NULL, NULL, rl, s0, s1, buf, view);
+  return prune(t, NULL, NULL, rl, NULL, 0, s0, s1, buf, view);
+}
+
+int dt_prune_class(const dt_tape *t, const signed char *cls, dt_instr *buf,
+                   dt_leaf *leaves, dt_instr *pbuf, dt_prune_prog *prog,
+                   int *live, dt_tape *view) {
+  int n = prune(t, NULL, NULL, NULL, cls, 0, 0, 0, buf, view);
+  view->live = NULL;
+  view->nlive = 0;
+  if (t->prog) {   /* the parent's groups are kept: so are its leaves */
+    dt_tape pv;
+    *prog = *t->prog;
+    prog->pcode = pbuf;
+    prog->npcode = prune(t, NULL, NULL, NULL, cls, 1, 0, 0, pbuf, &pv);
+    view->prog = prog;
+    /* the leaves of the live code; in t's order (a view of a view has
+       only the live ones among its parent's) */
+    int m = 0;
+    if (t->live) {
+      for (int i = 0; i < t->nlive; i++)
+        if (cls[t->live[i]] < 0) live[m++] = t->live[i];
+    } else {
+      for (int i = 0; i < t->nleaves; i++)
+        if (cls[i] < 0) live[m++] = i;
+    }
+    view->live = live;
+    view->nlive = m;
+    return n;
+  }
+  int nl = 0;
+  for (int i = 0; i < n; i++)
+    if (buf[i].op == DT_LEAF) {
+      leaves[nl] = t->leaves[buf[i].arg];
+      buf[i].arg = nl++;
+    }
+  view->leaves = leaves;
+  view->nleaves = nl;
+  return n;
 }
 
 void dt_range_box(const dt_tape *t, const double lo[3], const double hi[3],

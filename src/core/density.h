@@ -72,6 +72,11 @@ typedef struct dt_tape {
   /* The prune program, made by dt_builder_finish for the pruning
    * functions (NULL in views and when the tape has no group). */
   struct dt_prune_prog *prog;
+  /* The leaves the code can reach, when a dt_prune_class view keeps its
+   * parent's leaves: live[0 .. nlive) (NULL: all of them).  A ray's leaf
+   * table (dt_ray_leaves) is filled for these only. */
+  const int *live;
+  int nlive;
 } dt_tape;
 
 /* The prune program: pcode is the tape's code with every maximal subtree
@@ -194,7 +199,9 @@ int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
  * at s = 0) and nd = n.d, computed once per ray instead of at every
  * evaluation.  The _rl functions take t's table (t->nleaves entries,
  * indexed like t->leaves, so a view's table is its parent's) and give the
- * results of their o, d counterparts to the last bit. */
+ * results of their o, d counterparts to the last bit.  For a tape with a
+ * live list dt_ray_leaves fills only those entries, the only ones its
+ * code and its views' code read. */
 typedef struct dt_ray_leaf {
   double base, nd;
 } dt_ray_leaf;
@@ -207,5 +214,26 @@ double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
  * bounds the view's) instead of recomputing it; t may itself be a view. */
 int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
                 dt_instr *buf, dt_tape *view);
+
+/* The specialisation of t to a region where the leaves' classes are
+ * known: cls[i] is 0 or 1 for a leaf constant there at that value, -1 for
+ * a live one (render.c decides them over a tile's frustum).  Folds as
+ * dt_prune_ray does, so pruning the result over a ray segment inside the
+ * region gives the code pruning t itself would give there, to the last
+ * bit.  Writes at most t->ncode instructions to buf (the view's code).
+ * Without a prune program, the live leaves are copied in code order to
+ * leaves (room for t->nleaves) and renumbered, so a ray's leaf table
+ * (dt_ray_leaves) covers only them.  With one, the view keeps t's leaves
+ * and gets a program *prog sharing t's group tables, whose code (at most
+ * t->prog->npcode instructions, in pbuf) keeps each live group as one
+ * DT_GROUP instruction whose c is the mask of the group's leaves that may
+ * be live (the others are 1 there), so the pruning functions still copy a
+ * group's code for its live set, and the indices of the leaves that may
+ * be live go to live (room for t->nleaves) as view->live.  *view borrows
+ * buf, leaves or t's, prog and live; it keeps t's range, depth and rmax.
+ * Returns the code length. */
+int dt_prune_class(const dt_tape *t, const signed char *cls, dt_instr *buf,
+                   dt_leaf *leaves, dt_instr *pbuf, dt_prune_prog *prog,
+                   int *live, dt_tape *view);
 
 #endif

@@ -17,6 +17,9 @@
 #include "scene/ray.h"
 
 #define TILE 16
+/* Tiles are traced in blocks of CULL_BLOCK x CULL_BLOCK pixels, each
+   culled and pruned to its own rays (TileCull). */
+#define CULL_BLOCK 8
 
 /* ---- boxes ---- */
 
@@ -323,6 +326,13 @@ typedef struct Tracer {
   int progressed;             /* the progress callback was called */
   int grid;                   /* n of the n x n samples */
   atomic_int oom;             /* a worker ran out of memory: all stop */
+  int tiled;                  /* per-tile culling and pruning (TileCull) */
+  double tile_pad;            /* how far a searched point may stray from
+                                 a box it was bounded by (scene units) */
+  Box *rbox;                  /* per scene node: a rounded node's outer
+                                 bound's box (others unused) */
+  int *prim_r, *prim_r0;      /* the rounded nodes of prim i's subtree:
+                                 prim_r[prim_r0[i] .. prim_r0[i + 1]) */
 } Tracer;
 
 static double now(void) {
@@ -415,17 +425,39 @@ static int build_bvh(Tracer *T) {
   return err;
 }
 
-/* Slab test: the part of [t0, t1] inside the box. */
-static int box_hit(const double lo[3], const double hi[3], const double o[3],
-                   const double inv[3], double t0, double t1, double *enter) {
+/* A ray's slab test set up once: o, inv = 1/d, and which components of d
+   are 0 or NaN. */
+typedef struct RaySlab {
+  const double *o;
+  double inv[3];
+  unsigned char flat[3], any_flat;
+} RaySlab;
+
+static void ray_slab(RaySlab *r, const double o[3], const double d[3]) {
+  r->o = o;
   for (int k = 0; k < 3; k++) {
-    double a = (lo[k] - o[k]) * inv[k];
-    double c = (hi[k] - o[k]) * inv[k];
-    if (isnan(a) || isnan(c)) { /* parallel and on a slab plane */
-      if (o[k] < lo[k] || o[k] > hi[k]) return 0;
+    r->inv[k] = 1 / d[k];
+    r->flat[k] = !(fabs(d[k]) > 0);
+  }
+  r->any_flat = r->flat[0] || r->flat[1] || r->flat[2];
+}
+
+/* Slab test: the part of [t0, t1] inside the box, its start in *enter.
+   The near face is lo's when 1/d > 0 and hi's when it is < 0 (rounding
+   is monotonic, so the products keep that order, ties aside); on an axis
+   the ray does not move along a product may be NaN (the origin on a face
+   plane): the origin decides. */
+static inline int slab_core(const double lo[3], const double hi[3],
+                            const RaySlab *r, double t0, double t1,
+                            double *enter, int flat) {
+  for (int k = 0; k < 3; k++) {
+    double a = (lo[k] - r->o[k]) * r->inv[k];
+    double c = (hi[k] - r->o[k]) * r->inv[k];
+    if (flat && r->flat[k] && (isnan(a) || isnan(c))) {
+      if (r->o[k] < lo[k] || r->o[k] > hi[k]) return 0;
       continue;
     }
-    if (a > c) {
+    if (r->inv[k] < 0) { /* a >= c: (hi - o) >= (lo - o), times 1/d < 0 */
       double tmp = a;
       a = c;
       c = tmp;
@@ -436,6 +468,439 @@ static int box_hit(const double lo[3], const double hi[3], const double o[3],
   }
   *enter = t0;
   return 1;
+}
+
+/* slab_core made twice by the compiler: without the NaN rule for the
+   usual ray, with it for one with a zero component. */
+static inline int slab_hit(const double lo[3], const double hi[3],
+                           const RaySlab *r, double t0, double t1,
+                           double *enter) {
+  return r->any_flat ? slab_core(lo, hi, r, t0, t1, enter, 1)
+                     : slab_core(lo, hi, r, t0, t1, enter, 0);
+}
+
+/* ---- tiles: the frustum, culled primitives and pruned tapes ---- */
+
+/* The rays of a tile: from the eye along fwd + u right + v up for (u, v)
+   in a rectangle, so inside the cone of its four corner directions c
+   (c . fwd = 1). m are the cone's side planes through the eye, unit
+   normals pointing in. */
+typedef struct Frustum {
+  double eye[3], fwd[3];
+  double c[4][3], m[4][3];
+} Frustum;
+
+static void tile_frustum(const Camera *cam, double px0, double px1,
+                         double py0, double py1, Frustum *f) {
+  double h = cam->tan_half;
+  double u0 = (2 * px0 / cam->width - 1) * h * cam->aspect;
+  double u1 = (2 * px1 / cam->width - 1) * h * cam->aspect;
+  double v0 = (1 - 2 * py1 / cam->height) * h; /* v falls as y grows */
+  double v1 = (1 - 2 * py0 / cam->height) * h;
+  /* widened past the rounding of camera_ray's directions */
+  double wu = 1e-9 * (h * cam->aspect + fabs(u0) + fabs(u1));
+  double wv = 1e-9 * (h + fabs(v0) + fabs(v1));
+  u0 -= wu, u1 += wu, v0 -= wv, v1 += wv;
+  double uv[4][2] = {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}};
+  memcpy(f->eye, cam->eye, sizeof f->eye);
+  memcpy(f->fwd, cam->fwd, sizeof f->fwd);
+  for (int k = 0; k < 4; k++)
+    for (int i = 0; i < 3; i++)
+      f->c[k][i] = cam->fwd[i] + uv[k][0] * cam->right[i] + uv[k][1] * cam->upv[i];
+  double mid[3];
+  for (int i = 0; i < 3; i++)
+    mid[i] = cam->fwd[i] + 0.5 * (u0 + u1) * cam->right[i] +
+             0.5 * (v0 + v1) * cam->upv[i];
+  for (int k = 0; k < 4; k++) {
+    double *m = f->m[k];
+    vec3_cross(f->c[k], f->c[(k + 1) % 4], m);
+    double len = sqrt(vec3_dot(m, m));
+    double sg = vec3_dot(m, mid) < 0 ? -1 : 1;
+    for (int i = 0; i < 3; i++) m[i] = len > 0 ? sg * m[i] / len : 0;
+  }
+}
+
+/* The largest of n . (x - eye) over the box [lo, hi]. */
+static double box_max_dot(const double n[3], const double eye[3],
+                          const double lo[3], const double hi[3]) {
+  double s = 0;
+  for (int i = 0; i < 3; i++) {
+    if (n[i] == 0) continue;
+    double a = n[i] * (lo[i] - eye[i]), b = n[i] * (hi[i] - eye[i]);
+    s += a > b ? a : b;
+  }
+  return s;
+}
+
+/* 0 if no point of the box, grown by pad, lies in the frustum in front
+   of the eye (proved by a side plane or the eye's plane), else 1. */
+static int frustum_meets_box(const void *ctx, const double lo[3],
+                             const double hi[3], double pad) {
+  const Frustum *f = ctx;
+  if (box_max_dot(f->fwd, f->eye, lo, hi) < -pad) return 0;
+  for (int k = 0; k < 4; k++)
+    if (box_max_dot(f->m[k], f->eye, lo, hi) < -pad) return 0;
+  return 1;
+}
+
+/* The segments from a box of points P (shadow rays' origins) to a point
+   L (a light) fill the hull of P and L. */
+typedef struct Hull {
+  double lo[3], hi[3], L[3];
+  double grow;               /* the segments may stray this far from it */
+} Hull;
+
+/* The range of (x_i - L_i) / w for x_i - L_i in [a, b], w in [w0, w1],
+   0 < w0 <= w1. */
+static void ratio_range(double a, double b, double w0, double w1,
+                        double *lo, double *hi) {
+  double q[4] = {a / w0, a / w1, b / w0, b / w1};
+  *lo = *hi = q[0];
+  for (int k = 1; k < 4; k++) {
+    if (q[k] < *lo) *lo = q[k];
+    if (q[k] > *hi) *hi = q[k];
+  }
+  double e = 1e-12 * (fabs(*lo) + fabs(*hi)) + 1e-300;
+  *lo -= e;
+  *hi += e;
+}
+
+/* 0 if the box grown by pad misses the hull (proved by the hull's box, or
+   seen from L along an axis on one side of which all of P lies: beyond
+   P, behind L, or outside P's rectangle in the central projection from
+   L), else 1. */
+static int hull_meets_box(const void *ctx, const double blo[3],
+                          const double bhi[3], double pad) {
+  const Hull *H = ctx;
+  double lo[3], hi[3];
+  pad += H->grow;
+  for (int i = 0; i < 3; i++) {
+    lo[i] = blo[i] - pad;
+    hi[i] = bhi[i] + pad;
+    double hl = H->lo[i] < H->L[i] ? H->lo[i] : H->L[i];
+    double hh = H->hi[i] > H->L[i] ? H->hi[i] : H->L[i];
+    if (hi[i] < hl || lo[i] > hh) return 0;
+  }
+  int k = -1;
+  double gap = 0, sg = 1;
+  for (int i = 0; i < 3; i++) {
+    double a = H->lo[i] - H->L[i], b = H->L[i] - H->hi[i];
+    if (a > gap) gap = a, k = i, sg = 1;
+    if (b > gap) gap = b, k = i, sg = -1;
+  }
+  if (k < 0) return 1;
+  /* w = sg (x_k - L_k): P's in [gap, pmax], the box's in [bl, bh] */
+  double pmax = sg > 0 ? H->hi[k] - H->L[k] : H->L[k] - H->lo[k];
+  double bl = sg > 0 ? lo[k] - H->L[k] : H->L[k] - hi[k];
+  double bh = sg > 0 ? hi[k] - H->L[k] : H->L[k] - lo[k];
+  double e = 1e-12 * (fabs(pmax) + fabs(bl) + fabs(bh));
+  if (bh < -e || bl > pmax + e) return 0;
+  if (bl <= e) return 1; /* the box reaches L's side: no projection */
+  for (int i = 0; i < 3; i++) {
+    if (i == k) continue;
+    double pl, ph, ql, qh;
+    ratio_range(H->lo[i] - H->L[i], H->hi[i] - H->L[i], gap, pmax, &pl, &ph);
+    ratio_range(lo[i] - H->L[i], hi[i] - H->L[i], bl, bh, &ql, &qh);
+    if (qh < pl || ql > ph) return 0;
+  }
+  return 1;
+}
+
+/* What one worker knows of its current tile (tile_begin): which BVH
+   nodes and slots (T->bounded order) the tile's primary rays can meet,
+   and, per rounded scene node, its tape pruned to the part of the
+   frustum inside its outer bound's box (NULL: the whole tape); or, for
+   the tile's shadow rays towards one light (shadow_begin), the nodes and
+   slots the hull of their origins and the light meets. A culled box is
+   one slab_hit refuses for every ray of the tile, and a pruned tape is
+   one whose views over any searched interval are the whole tape's
+   (density.h, dt_prune_class): the tile's pictures are the untiled
+   tracer's, bit for bit (test_render checks). */
+typedef struct TileSet {
+  int node;
+  size_t code, leaves, pcode, live; /* its view's offsets into the arenas */
+} TileSet;
+
+typedef struct TileCull {
+  unsigned char *node_live, *slot_live;
+  int nlive, one;            /* live slots; the slot when nlive == 1 */
+  const dt_tape **tape;      /* per scene node, or NULL (no pruning) */
+  unsigned *stamp;           /* per scene node: the tile it was pruned for */
+  unsigned tile;             /* this tile's stamp (1, 2, ...) */
+  TileSet *set;              /* the pruned nodes, and their views: */
+  dt_tape *views;
+  dt_prune_prog *progs;      /* the views' prune programs, if any */
+  size_t nset, capset, capviews, capprogs;
+  dt_instr *pcode;           /* arena of the programs' code */
+  size_t npcode, cappcode;
+  dt_instr *code;            /* arenas of the views' code and leaves */
+  size_t ncode, capcode;
+  dt_leaf *leaves;
+  size_t nleaves, capleaves;
+  int *live;                 /* arena of the grouped views' live lists */
+  size_t nlv, caplv;
+  signed char *cls;
+  size_t capcls;
+  int *stack;                /* the BVH walk's */
+  long leaves_in, leaves_out; /* leaves before and after pruning */
+} TileCull;
+
+static void tile_cull_free(TileCull *tc) {
+  free(tc->node_live);
+  free(tc->slot_live);
+  free(tc->tape);
+  free(tc->stamp);
+  free(tc->set);
+  free(tc->views);
+  free(tc->progs);
+  free(tc->pcode);
+  free(tc->code);
+  free(tc->leaves);
+  free(tc->live);
+  free(tc->cls);
+  free(tc->stack);
+  memset(tc, 0, sizeof *tc);
+}
+
+/* prune: with the tape table (primary rays), else culling alone. */
+static int tile_cull_init(const Tracer *T, TileCull *tc, int prune) {
+  memset(tc, 0, sizeof *tc);
+  size_t nn = (size_t)T->bvh.nnodes + 1, ns = (size_t)T->nbounded + 1;
+  size_t sn = (size_t)T->s->n + 1;
+  tc->node_live = malloc(nn);
+  tc->slot_live = malloc(ns);
+  tc->stack = malloc(sizeof *tc->stack * BVH_STACK);
+  int bad = !tc->node_live || !tc->slot_live || !tc->stack;
+  if (prune && !bad) {
+    tc->tape = calloc(sn, sizeof *tc->tape);
+    tc->stamp = calloc(sn, sizeof *tc->stamp);
+    bad = !tc->tape || !tc->stamp;
+  }
+  if (bad) {
+    tile_cull_free(tc);
+    return -1;
+  }
+  return 0;
+}
+
+/* Room for n more elements of size sz in *p (capacity *cap, used). */
+static int reserve(void **p, size_t *cap, size_t used, size_t n, size_t sz) {
+  if (used + n <= *cap) return 0;
+  size_t c = *cap * 2 > used + n ? *cap * 2 : used + n;
+  void *q = realloc(*p, c * sz);
+  if (!q) return -1;
+  *p = q;
+  *cap = c;
+  return 0;
+}
+
+/* The region a tile's rays can search a rounded node in: the node's
+   outer bound's box and the hull of a few points (the frustum's part of
+   the box's depth range, or a shadow hull), each grown by pad. */
+typedef struct Region {
+  double P[9][3];
+  int np;
+  double pad;
+} Region;
+
+/* The region of a frustum over the box [lo, hi]: the frustum cut to the
+   box's depth range along fwd, the hull of eight points. 0, or -1 if
+   the box lies behind the eye. */
+static int frustum_region(const Frustum *f, const double lo[3],
+                          const double hi[3], Region *r) {
+  double nf[3] = {-f->fwd[0], -f->fwd[1], -f->fwd[2]};
+  double zh = box_max_dot(f->fwd, f->eye, lo, hi);
+  double zl = -box_max_dot(nf, f->eye, lo, hi);
+  if (!(zh >= 0)) return -1;
+  if (zl < 0) zl = 0;
+  r->np = 8;
+  for (int k = 0; k < 4; k++)
+    for (int i = 0; i < 3; i++) {
+      r->P[k][i] = f->eye[i] + zl * f->c[k][i];
+      r->P[k + 4][i] = f->eye[i] + zh * f->c[k][i];
+    }
+  return 0;
+}
+
+/* The leaves of a rounded node's tape t over the part of the region in
+   its outer bound's box b (both grown by pad): 0 or 1 where a leaf's
+   filter misses that part on its outer or inner side, -1 where it may be
+   touched. A plane's range over the part is within its range over the
+   box and over the hull of the region's points (the range over their
+   vertices). Returns the live count, or -1 if the box is unbounded or
+   the region empty (no pruning). */
+static int classify_leaves(const dt_tape *t, const Frustum *f,
+                           const Hull *H, const Box *b, double pad,
+                           signed char *cls) {
+  double lo[3], hi[3];
+  for (int i = 0; i < 3; i++) {
+    lo[i] = b->lo[i] - pad;
+    hi[i] = b->hi[i] + pad;
+    if (!isfinite(lo[i]) || !isfinite(hi[i])) return -1;
+  }
+  Region r;
+  if (f) {
+    if (frustum_region(f, lo, hi, &r)) return -1;
+  } else {
+    r.np = 9;
+    for (int k = 0; k < 8; k++)
+      for (int i = 0; i < 3; i++) r.P[k][i] = (k >> i) & 1 ? H->hi[i] : H->lo[i];
+    memcpy(r.P[8], H->L, sizeof r.P[8]);
+    pad += H->grow;
+    for (int i = 0; i < 3; i++) {
+      lo[i] -= H->grow;
+      hi[i] += H->grow;
+    }
+  }
+  int live = 0;
+  for (int j = 0; j < t->nleaves; j++) {
+    const dt_leaf *lf = &t->leaves[j];
+    double pl = INFINITY, ph = -INFINITY;
+    for (int k = 0; k < r.np; k++) {
+      double sd = dt_leaf_dist(lf, r.P[k]);
+      if (sd < pl) pl = sd;
+      if (sd > ph) ph = sd;
+    }
+    double bl, bh;
+    vec3_plane_range(lf->n, lf->d, lo, hi, &bl, &bh);
+    /* the hull's range widened like the box's and by pad; the tighter */
+    double w = 1e-12 * (fabs(pl) + fabs(ph) + 1) + pad;
+    pl -= w;
+    ph += w;
+    double l = pl > bl ? pl : bl, h = ph < bh ? ph : bh;
+    if (l > lf->r) cls[j] = 0;
+    else if (h < -lf->r) cls[j] = 1;
+    else cls[j] = -1, live++;
+  }
+  return live;
+}
+
+/* Prune rounded node id for the tile, once; its view is added to the
+   arenas (tile_begin points tape[id] at it once all are made). */
+static int tile_prune_node(const Tracer *T, TileCull *tc, const Frustum *f,
+                           const Hull *H, int id) {
+  if (tc->stamp[id] == tc->tile) return 0;
+  tc->stamp[id] = tc->tile;
+  const dt_tape *t = T->s->nodes[id].tape;
+  size_t nl = (size_t)t->nleaves, nc = (size_t)t->ncode;
+  if (reserve((void **)&tc->cls, &tc->capcls, 0, nl, 1)) return -1;
+  int live = classify_leaves(t, f, H, &T->rbox[id], T->tile_pad, tc->cls);
+  tc->leaves_in += t->nleaves;
+  if (live < 0 || live == t->nleaves) {
+    tc->leaves_out += t->nleaves;
+    return 0;
+  }
+  size_t k = tc->nset, np = t->prog ? (size_t)t->prog->npcode : 0;
+  if (reserve((void **)&tc->set, &tc->capset, k, 1, sizeof *tc->set) ||
+      reserve((void **)&tc->views, &tc->capviews, k, 1, sizeof *tc->views) ||
+      reserve((void **)&tc->progs, &tc->capprogs, k, 1, sizeof *tc->progs) ||
+      reserve((void **)&tc->code, &tc->capcode, tc->ncode, nc, sizeof *tc->code) ||
+      reserve((void **)&tc->pcode, &tc->cappcode, tc->npcode, np,
+              sizeof *tc->pcode) ||
+      reserve((void **)&tc->leaves, &tc->capleaves, tc->nleaves, nl,
+              sizeof *tc->leaves) ||
+      reserve((void **)&tc->live, &tc->caplv, tc->nlv, nl,
+              sizeof *tc->live))
+    return -1;
+  dt_tape *v = &tc->views[k];
+  dt_prune_prog *pg = &tc->progs[k];
+  dt_prune_class(t, tc->cls, tc->code + tc->ncode, tc->leaves + tc->nleaves,
+                 tc->pcode + tc->npcode, pg, tc->live + tc->nlv, v);
+  tc->set[k] = (TileSet){id, tc->ncode, tc->nleaves, tc->npcode, tc->nlv};
+  tc->ncode += (size_t)v->ncode;
+  if (v->prog) {
+    tc->npcode += (size_t)pg->npcode;
+    tc->nlv += (size_t)v->nlive;
+    tc->leaves_out += live;
+  } else {
+    tc->nleaves += (size_t)v->nleaves;
+    tc->leaves_out += v->nleaves;
+  }
+  tc->nset++;
+  return 0;
+}
+
+/* The rounded nodes of prim pi, pruned for the tile. */
+static int tile_prune_prim(const Tracer *T, TileCull *tc, const Frustum *f,
+                           const Hull *H, int pi) {
+  if (!T->prim_r || (!f && !H)) return 0;
+  for (int k = T->prim_r0[pi]; k < T->prim_r0[pi + 1]; k++)
+    if (tile_prune_node(T, tc, f, H, T->prim_r[k])) return -1;
+  return 0;
+}
+
+typedef int (*BoxTest)(const void *ctx, const double lo[3], const double hi[3],
+                       double pad);
+
+/* The BVH top down, dead subtrees skipped: node_live, slot_live, nlive
+   and one by meets; with f, the live prims' rounded nodes pruned to f
+   (tc's tapes set once all are made). 0, or -1 without memory. */
+static int cull_bvh(const Tracer *T, TileCull *tc, BoxTest meets,
+                    const void *ctx, const Frustum *f, const Hull *H) {
+  double pad = T->tile_pad;
+  tc->nlive = 0;
+  tc->one = -1;
+  if (tc->tape) {
+    for (size_t k = 0; k < tc->nset; k++) tc->tape[tc->set[k].node] = NULL;
+    tc->nset = tc->ncode = tc->nleaves = tc->npcode = tc->nlv = 0;
+    if (++tc->tile == 0) { /* the stamps wrapped */
+      memset(tc->stamp, 0, sizeof *tc->stamp * (size_t)(T->s->n + 1));
+      tc->tile = 1;
+    }
+  } else {
+    f = NULL;
+    H = NULL;
+  }
+  if (T->bvh.nnodes) {
+    int sp = 0;
+    tc->stack[sp++] = 0;
+    while (sp) {
+      int ni = tc->stack[--sp];
+      const bvh_node *b = &T->bvh.nodes[ni];
+      tc->node_live[ni] = (unsigned char)meets(ctx, b->lo, b->hi, pad);
+      if (!tc->node_live[ni]) continue;
+      if (!b->count) {
+        tc->stack[sp++] = b->first;
+        tc->stack[sp++] = b->first + 1;
+        continue;
+      }
+      for (int i = b->first; i < b->first + b->count; i++) {
+        const Box *pb = &T->prims[T->bounded[i]].box;
+        tc->slot_live[i] = (unsigned char)meets(ctx, pb->lo, pb->hi, pad);
+        if (!tc->slot_live[i]) continue;
+        tc->nlive++;
+        tc->one = i;
+        if (tile_prune_prim(T, tc, f, H, T->bounded[i])) goto oom;
+      }
+    }
+  }
+  for (int i = 0; i < T->nunbounded; i++)
+    if (tile_prune_prim(T, tc, f, H, T->unbounded[i])) goto oom;
+  for (size_t k = 0; k < tc->nset; k++) {
+    dt_tape *v = &tc->views[k];
+    v->code = tc->code + tc->set[k].code;
+    if (v->prog) { /* its leaves are the whole tape's */
+      v->prog = &tc->progs[k];
+      v->prog->pcode = tc->pcode + tc->set[k].pcode;
+      v->live = tc->live + tc->set[k].live;
+    } else {
+      v->leaves = tc->leaves + tc->set[k].leaves;
+    }
+    tc->tape[tc->set[k].node] = v;
+  }
+  return 0;
+oom:
+  tc->nset = 0;
+  return -1;
+}
+
+/* tc for the primary rays of the pixel coordinates [px0, px1] x [py0,
+   py1] (the extreme samples): culled to their frustum, tapes pruned. */
+static int cull_bvh_frustum(const Tracer *T, TileCull *tc, double px0,
+                            double px1, double py0, double py1) {
+  Frustum f;
+  tile_frustum(&T->cam, px0, px1, py0, py1, &f);
+  return cull_bvh(T, tc, frustum_meets_box, &f, &f, NULL);
 }
 
 /* ---- hits ---- */
@@ -473,7 +938,8 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
     lg_root roots[8];
     double tol = ray_dist_tol(c, o, d);
     long unsplit = c->stats.lg.overflows;
-    lg_query q = {.tape = n->tape, .o = o, .d = d, .t0 = t0, .t1 = t1,
+    const dt_tape *tape = c->tapes && c->tapes[node] ? c->tapes[node] : n->tape;
+    lg_query q = {.tape = tape, .o = o, .d = d, .t0 = t0, .t1 = t1,
                   .tol = tol, .out = roots, .maxout = 8, .stats = &c->stats.lg,
                   .mode = any ? LG_ANY : LG_FIRST, .grad = any ? NULL : h->grad};
     int nr = lg_search_bounded(&q, n->outer, n->inner);
@@ -527,39 +993,60 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
   return 1;
 }
 
-/* The nearest hit in (t0, t1); with any != 0, the first one found. */
+/* The nearest hit in (t0, t1); with any != 0, the first one found.
+   With tc (a ray of tc's tile): only the BVH nodes and slots tc found
+   live are visited, and rounded nodes are searched on tc's tapes (the
+   same answer: TileCull). */
 static int trace(const Tracer *T, const double o[3], const double d[3],
-                 double t0, double t1, RayCtx *c, Hit *best, int any) {
+                 double t0, double t1, RayCtx *c, Hit *best, int any,
+                 const TileCull *tc) {
   int found = 0;
+  c->tapes = tc ? tc->tape : NULL;
   for (int i = 0; i < T->nunbounded; i++) {
     Hit h;
     if (prim_hit(T, T->unbounded[i], o, d, t0, t1, c, &h, any)) {
       *best = h;
       t1 = h.t;
       found = 1;
-      if (any) return 1;
+      if (any) goto out;
     }
   }
-  if (!T->bvh.nnodes) return found;
-  double inv[3] = {1 / d[0], 1 / d[1], 1 / d[2]};
+  if (!T->bvh.nnodes || (tc && tc->nlive == 0)) goto out;
+  RaySlab rs;
+  ray_slab(&rs, o, d);
+  if (tc && tc->nlive == 1) { /* its ancestors' boxes hold its box */
+    int pi = T->bounded[tc->one];
+    const Box *pb = &T->prims[pi].box;
+    double e2;
+    Hit h;
+    if (slab_hit(pb->lo, pb->hi, &rs, t0, t1, &e2) &&
+        prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
+      *best = h;
+      found = 1;
+    }
+    goto out;
+  }
   int stack[BVH_STACK], sp = 0;   /* enough for any tree (core/bvh.h) */
   stack[sp++] = 0;
   while (sp) {
-    const bvh_node *b = &T->bvh.nodes[stack[--sp]];
+    int ni = stack[--sp];
+    if (tc && !tc->node_live[ni]) continue;
+    const bvh_node *b = &T->bvh.nodes[ni];
     double enter;
-    if (!box_hit(b->lo, b->hi, o, inv, t0, t1, &enter)) continue;
+    if (!slab_hit(b->lo, b->hi, &rs, t0, t1, &enter)) continue;
     if (b->count) {
       for (int i = b->first; i < b->first + b->count; i++) {
+        if (tc && !tc->slot_live[i]) continue;
         int pi = T->bounded[i];
         const Box *pb = &T->prims[pi].box;
         double e2;
-        if (!box_hit(pb->lo, pb->hi, o, inv, t0, t1, &e2)) continue;
+        if (!slab_hit(pb->lo, pb->hi, &rs, t0, t1, &e2)) continue;
         Hit h;
         if (prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
           *best = h;
           t1 = h.t;
           found = 1;
-          if (any) return 1;
+          if (any) goto out;
         }
       }
       continue;
@@ -567,8 +1054,8 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
     /* Visit the nearer child first. */
     const bvh_node *l = &T->bvh.nodes[b->first], *r = l + 1;
     double el = INFINITY, er = INFINITY;
-    int hl = box_hit(l->lo, l->hi, o, inv, t0, t1, &el);
-    int hr = box_hit(r->lo, r->hi, o, inv, t0, t1, &er);
+    int hl = slab_hit(l->lo, l->hi, &rs, t0, t1, &el);
+    int hr = slab_hit(r->lo, r->hi, &rs, t0, t1, &er);
     if (hl && hr) {
       if (el < er) {
         stack[sp++] = b->first + 1;
@@ -583,6 +1070,8 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
       stack[sp++] = b->first + 1;
     }
   }
+out:
+  c->tapes = NULL;
   return found;
 }
 
@@ -590,48 +1079,69 @@ static long ray_work(const RayCtx *c) {
   return c->stats.lg.segments + c->stats.lg.rf_steps + c->stats.soft.intervals;
 }
 
+/* One camera sample of a tile, between its two passes. */
+typedef struct Sample {
+  Hit h;
+  double d[3];
+  long work;                  /* the primary ray's (ray_work) */
+  int found;
+} Sample;
+
 typedef struct Worker {
   Tracer *T;
   RayCtx *c;
   long primary, shadow, max_work;
   long hits;                  /* primary rays that met a surface */
   long rounded_hits, rounded_hit_evals;
+  TileCull tc;                /* the current tile's primary rays' */
+  TileCull sh[RENDER_MAX_LIGHTS]; /* its shadow rays', per light */
+  Sample *samples;            /* CULL_BLOCK^2 x grid^2 */
 } Worker;
 
-/* One camera sample: radiance, and for the AOVs the hit's distance and
-   normal. */
-static void shade_sample(Worker *W, const double o[3], const double d[3],
-                         double rgb[3], double *z, double nrm[3]) {
+/* The primary ray of one camera sample: its hit, if any (counted). */
+static inline int primary_hit(Worker *W, const double o[3], const double d[3],
+                       Hit *h, const TileCull *tc) {
+  const Tracer *T = W->T;
+  RayCtx *c = W->c;
+  long evals0 = c->stats.lg.evals;
+  W->primary++;
+  if (!trace(T, o, d, 0, INFINITY, c, h, 0, tc)) return 0;
+  W->hits++;
+  if (T->s->nodes[h->id].kind == SC_ROUNDED) {
+    W->rounded_hits++;
+    W->rounded_hit_evals += c->stats.lg.evals - evals0;
+  }
+  return 1;
+}
+
+/* A camera sample's radiance from its primary hit h (found, else the
+   background), and for the AOVs the hit's distance and normal; sh[l]:
+   the culling of shadow rays towards light l, or NULL. */
+static inline void shade_hit(Worker *W, const double o[3], const double d[3],
+                      int found, const Hit *hp, double rgb[3], double *z,
+                      double nrm[3], const TileCull *const *sh) {
   const Tracer *T = W->T;
   RayCtx *c = W->c;
   const RenderSettings *rs = T->rs;
-  Hit h;
-  long evals0 = c->stats.lg.evals;
-  W->primary++;
-  if (!trace(T, o, d, 0, INFINITY, c, &h, 0)) {
+  if (!found) {
     memcpy(rgb, rs->background, 3 * sizeof(double));
     *z = INFINITY;
     nrm[0] = nrm[1] = nrm[2] = 0;
     return;
   }
-  W->hits++;
-  if (T->s->nodes[h.id].kind == SC_ROUNDED) {
-    W->rounded_hits++;
-    W->rounded_hit_evals += c->stats.lg.evals - evals0;
-  }
   double p[3], n[3];
-  for (int i = 0; i < 3; i++) p[i] = o[i] + h.t * d[i];
-  if (h.has_grad) { /* outward is down the density gradient */
-    double g[3] = {-h.grad[0], -h.grad[1], -h.grad[2]};
-    ray_normal_grad(g, h.flip, n);
+  for (int i = 0; i < 3; i++) p[i] = o[i] + hp->t * d[i];
+  if (hp->has_grad) { /* outward is down the density gradient */
+    double g[3] = {-hp->grad[0], -hp->grad[1], -hp->grad[2]};
+    ray_normal_grad(g, hp->flip, n);
   } else {
-    ray_normal(T->s, h.id, h.flip, p, n);
+    ray_normal(T->s, hp->id, hp->flip, p, n);
   }
   if (vec3_dot(n, d) > 0)
     for (int i = 0; i < 3; i++) n[i] = -n[i];
-  *z = h.t; /* d is unit length: t is the distance */
+  *z = hp->t; /* d is unit length: t is the distance */
   memcpy(nrm, n, sizeof n);
-  const double *col = T->prims[h.prim].colour;
+  const double *col = T->prims[hp->prim].colour;
   for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
   double scale = fmax(1.0, sqrt(vec3_dot(p, p)));
   double eps = T->eps * scale;
@@ -646,9 +1156,9 @@ static void shade_sample(Worker *W, const double o[3], const double d[3],
     if (rs->shadows) {
       double so[3];
       for (int i = 0; i < 3; i++) so[i] = p[i] + eps * n[i];
-      Hit sh;
+      Hit shh;
       W->shadow++;
-      if (trace(T, so, L, 0, dist, c, &sh, 1)) continue;
+      if (trace(T, so, L, 0, dist, c, &shh, 1, sh ? sh[l] : NULL)) continue;
     }
     double H[3] = {L[0] - d[0], L[1] - d[1], L[2] - d[2]};
     double hl = sqrt(vec3_dot(H, H));
@@ -681,6 +1191,94 @@ static void progress(Tracer *T) {
   pthread_mutex_unlock(&T->lock);
 }
 
+/* A pixel's values from its g x g samples' radiance, central AOVs and
+   hits (render_tile's two forms). */
+static inline void put_pixel(const Tracer *T, int x, int y, const double sum[3],
+                      int hits, double zmin, const double nrm0[3],
+                      long cost) {
+  Image *im = T->im;
+  const RenderSettings *rs = T->rs;
+  int g = T->grid;
+  size_t k = img_index(im, x - im->x0, y - im->y0);
+  for (int i = 0; i < 3; i++) im->rgba[4 * k + (size_t)i] = (float)(sum[i] / (g * g));
+  im->rgba[4 * k + 3] = rs->alpha ? (float)hits / (float)(g * g) : 1;
+  if (im->z) im->z[k] = (float)zmin;
+  if (im->n)
+    for (int i = 0; i < 3; i++) im->n[3 * k + (size_t)i] = (float)nrm0[i];
+  if (im->cost) im->cost[k] = (float)cost;
+}
+
+/* A block's pixels [x0, x1) x [y0, y1) in two passes: every primary ray
+   (culled and pruned to the block's frustum), then the shading, whose
+   shadow rays are culled to the hull of their origins and each light.
+   Rays do not depend on each other, so the pixels are those of the one
+   pass form, bit for bit. */
+static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
+  Tracer *T = W->T;
+  const RenderSettings *rs = T->rs;
+  int g = T->grid;
+  const TileCull *tc = NULL;
+  if (cull_bvh_frustum(T, &W->tc, x0 + 0.5 / g, x1 - 1 + (g - 0.5) / g,
+                       y0 + 0.5 / g, y1 - 1 + (g - 0.5) / g) == 0)
+    tc = &W->tc;
+  Hull H;
+  for (int i = 0; i < 3; i++) H.lo[i] = INFINITY, H.hi[i] = -INFINITY;
+  double pmax = 1;
+  Sample *sp = W->samples;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++)
+      for (int sy = 0; sy < g; sy++)
+        for (int sx = 0; sx < g; sx++, sp++) {
+          camera_ray(&T->cam, x + (sx + 0.5) / g, y + (sy + 0.5) / g, sp->d);
+          long w0 = ray_work(W->c);
+          sp->found = primary_hit(W, T->cam.eye, sp->d, &sp->h, tc);
+          sp->work = ray_work(W->c) - w0;
+          if (!sp->found) continue;
+          for (int i = 0; i < 3; i++) {
+            double p = T->cam.eye[i] + sp->h.t * sp->d[i];
+            if (p < H.lo[i]) H.lo[i] = p;
+            if (p > H.hi[i]) H.hi[i] = p;
+            if (fabs(p) > pmax) pmax = fabs(p);
+          }
+        }
+  /* a shadow ray runs from its hit point moved by eps along the normal
+     (shade_hit) to the light moved alike: within eps of the segment from
+     the hit point to the light */
+  const TileCull *sh[RENDER_MAX_LIGHTS] = {NULL};
+  if (rs->shadows && H.lo[0] <= H.hi[0]) {
+    H.grow = 2 * T->eps * pmax * sqrt(3.0);
+    for (int l = 0; l < T->nlights; l++) {
+      memcpy(H.L, T->lights[l], sizeof H.L);
+      if (cull_bvh(T, &W->sh[l], hull_meets_box, &H, NULL, &H) == 0)
+        sh[l] = &W->sh[l];
+    }
+  }
+  sp = W->samples;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++) {
+      double sum[3] = {0, 0, 0}, zmin = INFINITY, nrm0[3] = {0, 0, 0};
+      long cost = 0;
+      int hits = 0;
+      for (int sy = 0; sy < g; sy++)
+        for (int sx = 0; sx < g; sx++, sp++) {
+          double rgb[3], z, nrm[3];
+          long w0 = ray_work(W->c);
+          shade_hit(W, T->cam.eye, sp->d, sp->found, &sp->h, rgb, &z, nrm, sh);
+          long w = ray_work(W->c) - w0 + sp->work;
+          cost += w;
+          if (w > W->max_work) W->max_work = w;
+          if (z < INFINITY) hits++;
+          if (z < INFINITY || !rs->alpha)
+            for (int i = 0; i < 3; i++) sum[i] += rgb[i];
+          if (sx == g / 2 && sy == g / 2) { /* AOVs from the central sample */
+            zmin = z;
+            memcpy(nrm0, nrm, sizeof nrm0);
+          }
+        }
+      put_pixel(T, x, y, sum, hits, zmin, nrm0, cost);
+    }
+}
+
 static void render_tile(Worker *W, int tile) {
   Tracer *T = W->T;
   const RenderSettings *rs = T->rs;
@@ -691,6 +1289,13 @@ static void render_tile(Worker *W, int tile) {
   int xe = im->x0 + im->width, ye = im->y0 + im->height;
   int x1 = x0 + TILE < xe ? x0 + TILE : xe;
   int y1 = y0 + TILE < ye ? y0 + TILE : ye;
+  if (T->tiled) { /* culled and pruned per block of the tile */
+    for (int by = y0; by < y1; by += CULL_BLOCK)
+      for (int bx = x0; bx < x1; bx += CULL_BLOCK)
+        render_tile_culled(W, bx, bx + CULL_BLOCK < x1 ? bx + CULL_BLOCK : x1,
+                           by, by + CULL_BLOCK < y1 ? by + CULL_BLOCK : y1);
+    return;
+  }
   int g = T->grid;
   for (int y = y0; y < y1; y++)
     for (int x = x0; x < x1; x++) {
@@ -702,7 +1307,9 @@ static void render_tile(Worker *W, int tile) {
           double d[3], rgb[3], z, nrm[3];
           camera_ray(&T->cam, x + (sx + 0.5) / g, y + (sy + 0.5) / g, d);
           long w0 = ray_work(W->c);
-          shade_sample(W, T->cam.eye, d, rgb, &z, nrm);
+          Hit h;
+          int found = primary_hit(W, T->cam.eye, d, &h, NULL);
+          shade_hit(W, T->cam.eye, d, found, &h, rgb, &z, nrm, NULL);
           long w = ray_work(W->c) - w0;
           if (w > W->max_work) W->max_work = w;
           if (z < INFINITY) hits++;
@@ -713,13 +1320,7 @@ static void render_tile(Worker *W, int tile) {
             memcpy(nrm0, nrm, sizeof nrm0);
           }
         }
-      size_t k = img_index(im, x - im->x0, y - im->y0);
-      for (int i = 0; i < 3; i++) im->rgba[4 * k + (size_t)i] = (float)(sum[i] / (g * g));
-      im->rgba[4 * k + 3] = rs->alpha ? (float)hits / (float)(g * g) : 1;
-      if (im->z) im->z[k] = (float)zmin;
-      if (im->n)
-        for (int i = 0; i < 3; i++) im->n[3 * k + (size_t)i] = (float)nrm0[i];
-      if (im->cost) im->cost[k] = (float)(ray_work(W->c) - work0);
+      put_pixel(T, x, y, sum, hits, zmin, nrm0, ray_work(W->c) - work0);
     }
 }
 
@@ -740,6 +1341,43 @@ static void *worker_main(void *arg) {
     progress(T);
   }
   return NULL;
+}
+
+/* Per-tile culling and pruning (TileCull), unless the environment says
+   QCS_TILES=0: the pad, the rounded nodes' outer boxes and each
+   primitive's rounded nodes. 0, or -1 without memory. */
+static int tiles_setup(Tracer *T) {
+  const char *e = getenv("QCS_TILES");
+  T->tiled = !(e && !strcmp(e, "0"));
+  if (!T->tiled) return 0;
+  T->tile_pad = 2 * fmax(T->rs->tol, RAY_TOL_FLOOR * T->coord_scale) +
+                1e-9 * T->coord_scale;
+  const Scene *s = T->s;
+  if (!(s->flags & SCENE_HAS_ROUNDED)) return 0;
+  size_t total = 0;
+  for (int i = 0; i < T->nprims; i++) {
+    int node = T->prims[i].node;
+    for (int k = s->nodes[node].first; k <= node; k++)
+      total += s->nodes[k].kind == SC_ROUNDED;
+  }
+  /* shared subtrees could make the lists longer than the scene: then no
+     pruning (the culling stays) */
+  if (total > 4 * (size_t)s->n + 1024) return 0;
+  T->rbox = malloc(sizeof *T->rbox * (size_t)s->n);
+  T->prim_r = malloc(sizeof *T->prim_r * (total + 1));
+  T->prim_r0 = malloc(sizeof *T->prim_r0 * (size_t)(T->nprims + 1));
+  if (!T->rbox || !T->prim_r || !T->prim_r0) return -1;
+  for (int k = 0; k < s->n; k++)
+    if (s->nodes[k].kind == SC_ROUNDED) T->rbox[k] = csg_box(s->nodes[k].outer);
+  int m = 0;
+  for (int i = 0; i < T->nprims; i++) {
+    T->prim_r0[i] = m;
+    int node = T->prims[i].node;
+    for (int k = s->nodes[node].first; k <= node; k++)
+      if (s->nodes[k].kind == SC_ROUNDED) T->prim_r[m++] = k;
+  }
+  T->prim_r0[T->nprims] = m;
+  return 0;
 }
 
 void render_defaults(RenderSettings *rs) {
@@ -952,6 +1590,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   }
   if (T.nbounded && build_bvh(&T)) goto oom;
   if (setup_camera(&T, err, errlen)) goto fail;
+  if (tiles_setup(&T)) goto oom;
   im = img_new(cx1 - cx0, cy1 - cy0, rs->aovs);
   if (!im) goto oom;
   im->x0 = cx0;
@@ -974,6 +1613,14 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
     workers[i].T = &T;
     workers[i].c = ray_ctx_new(s, rs->tol);
     if (!workers[i].c) goto oom;
+    if (T.tiled) {
+      size_t ns = (size_t)CULL_BLOCK * CULL_BLOCK * (size_t)grid * (size_t)grid;
+      workers[i].samples = malloc(sizeof *workers[i].samples * ns);
+      if (!workers[i].samples || tile_cull_init(&T, &workers[i].tc, 1))
+        goto oom;
+      for (int l = 0; l < T.nlights; l++)
+        if (tile_cull_init(&T, &workers[i].sh[l], 1)) goto oom;
+    }
   }
   int started = 0;
   for (int i = 1; i < nthreads; i++)
@@ -1026,12 +1673,20 @@ fail:
   im = NULL;
 done:
   if (workers)
-    for (int i = 0; i < nthreads; i++) ray_ctx_free(workers[i].c);
+    for (int i = 0; i < nthreads; i++) {
+      ray_ctx_free(workers[i].c);
+      tile_cull_free(&workers[i].tc);
+      for (int l = 0; l < RENDER_MAX_LIGHTS; l++) tile_cull_free(&workers[i].sh[l]);
+      free(workers[i].samples);
+    }
   free(workers);
   free(threads);
   free(T.prims);
   free(T.bounded);
   free(T.unbounded);
+  free(T.rbox);
+  free(T.prim_r);
+  free(T.prim_r0);
   bvh_free(&T.bvh);
   pthread_mutex_destroy(&T.lock);
   return im;

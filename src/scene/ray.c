@@ -139,7 +139,8 @@ static int rounded_spans(const ScNode *n, int id, const double o[3],
                          csg_span *out) {
   lg_root roots[MAX_LEAF_ROOTS];
   long unsplit = c->stats.lg.overflows;
-  lg_query q = {.tape = n->tape, .o = o, .d = d, .t0 = t0, .t1 = t1,
+  const dt_tape *tape = c->tapes && c->tapes[id] ? c->tapes[id] : n->tape;
+  lg_query q = {.tape = tape, .o = o, .d = d, .t0 = t0, .t1 = t1,
                 .tol = ray_dist_tol(c, o, d), .out = roots,
                 .maxout = MAX_LEAF_ROOTS, .stats = &c->stats.lg,
                 .hook = c->hook, .mode = LG_ALL};

@@ -69,6 +69,11 @@ typedef struct RayCtx {
                           sets it, and so may the caller's own queries) */
   int unresolved_node; /* a rounded node whose search left segments unsplit
                           (lg_stats.overflows grew), or -1 */
+  /* Optional (NULL: none), per scene node: a rounded node's tape pruned
+     to a region (dt_prune_class), searched in its place. The caller
+     (render.c's tiles) sets it only for rays whose searched intervals
+     lie in that region, where both give the same views and roots. */
+  const dt_tape *const *tapes;
 } RayCtx;
 
 /* The finest root tolerance doubles allow at coordinates of size scale

@@ -2,6 +2,8 @@
  * against MPFR and long double references from ref_density.h, which share
  * no code with src/core/density.c. */
 #include <float.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "check.h"
 #include "core/density.h"
@@ -433,6 +435,136 @@ static void test_prune(void) {
   CHECK("pruning shortens most views", shrunk > 400);
 }
 
+/* dt_prune_class (the renderer's tiles): a tape cut to a region where
+ * some leaves are constant, then pruned to a ray segment inside the
+ * region, gives the very code (leaf for leaf, constant for constant) and
+ * the very densities, to the bit, that pruning the whole tape to that
+ * segment gives. The region is a longer stretch of the same ray; the
+ * leaves' classes there come from the test's own long double distances
+ * at its ends, kept a margin away from the filters' edges. */
+static int same_code(const dt_tape *a, const dt_tape *b) {
+  if (a->ncode != b->ncode) return 0;
+  for (int i = 0; i < a->ncode; i++) {
+    const dt_instr *x = &a->code[i], *y = &b->code[i];
+    if (x->op != y->op) return 0;
+    if (x->op == DT_CONST && x->c != y->c) return 0;
+    if (x->op == DT_LEAF &&
+        memcmp(&a->leaves[x->arg], &b->leaves[y->arg], sizeof(dt_leaf)))
+      return 0;
+  }
+  return 1;
+}
+
+static void test_prune_class(void) {
+  rng_t g = {77};
+  int bad_code = 0, bad_value = 0, cut = 0, grouped = 0, segs = 0;
+  for (int sc = 0; sc < 60; sc++) {
+    dt_tape *tp;
+    if (sc % 2) {
+      rtree t;
+      int root = rt_random_scene(&t, &g);
+      tp = rt_tape(&t, root);
+    } else { /* sums, differences and unions only: no product groups */
+      dt_builder *b = dt_builder_new();
+      int n = 3 + (int)rng_range(&g, 0, 10);
+      for (int j = 0; j < n; j++) {
+        double nn[3] = {rng_range(&g, -1, 1), rng_range(&g, -1, 1),
+                        rng_range(&g, -1, 1)};
+        dt_builder_leaf(b, nn, rng_range(&g, -1, 1), rng_range(&g, 0.05, 0.5));
+        if (j) {
+          static const dt_op ops[] = {DT_SUM, DT_DIFF, DT_UNION};
+          dt_builder_op(b, ops[(int)rng_range(&g, 0, 2.999)]);
+        }
+      }
+      tp = dt_builder_finish(b, NULL);
+    }
+    int np = tp->prog ? tp->prog->npcode : 1;
+    dt_instr *buf = malloc((size_t)tp->ncode * sizeof *buf);
+    dt_instr *pbuf = malloc((size_t)np * sizeof *pbuf);
+    dt_instr *v1 = malloc((size_t)tp->ncode * sizeof *v1);
+    dt_instr *v2 = malloc((size_t)tp->ncode * sizeof *v2);
+    dt_leaf *lv = malloc((size_t)tp->nleaves * sizeof *lv);
+    signed char *cls = malloc((size_t)tp->nleaves);
+    int *lives = malloc((size_t)tp->nleaves * sizeof *lives);
+    dt_ray_leaf *rl1 = malloc((size_t)tp->nleaves * sizeof *rl1);
+    dt_ray_leaf *rl2 = malloc((size_t)tp->nleaves * sizeof *rl2);
+    grouped += tp->prog != NULL;
+    for (int k = 0; k < 20; k++) {
+      double o[3] = {rng_range(&g, -2, 2), rng_range(&g, -2, 2),
+                     rng_range(&g, -2, 2)};
+      double d[3] = {rng_range(&g, -1, 1), rng_range(&g, -1, 1),
+                     rng_range(&g, -1, 1)};
+      double r0 = rng_range(&g, 0, 3), r1 = r0 + rng_range(&g, 0, 1.5);
+      int live = 0;
+      for (int j = 0; j < tp->nleaves; j++) {
+        const dt_leaf *lf = &tp->leaves[j];
+        long double e0 = -lf->d, e1 = -lf->d;
+        for (int i = 0; i < 3; i++) {
+          e0 += (long double)lf->n[i] * (o[i] + (long double)r0 * d[i]);
+          e1 += (long double)lf->n[i] * (o[i] + (long double)r1 * d[i]);
+        }
+        long double lo = e0 < e1 ? e0 : e1, hi = e0 < e1 ? e1 : e0;
+        long double m = 1e-9L;
+        cls[j] = lo > lf->r + m ? 0 : hi < -lf->r - m ? 1 : -1;
+        live += cls[j] < 0;
+      }
+      dt_prune_prog pg;
+      dt_tape tile;
+      dt_prune_class(tp, cls, buf, lv, pbuf, &pg, lives, &tile);
+      if (live < tp->nleaves) cut++;
+      for (int q = 0; q < 3; q++) {
+        double s0 = rng_range(&g, r0, r1), s1 = rng_range(&g, s0, r1);
+        dt_tape a, b;
+        dt_prune_ray(tp, o, d, s0, s1, v1, &a);
+        dt_prune_ray(&tile, o, d, s0, s1, v2, &b);
+        segs++;
+        if (!same_code(&a, &b)) bad_code++;
+        for (int j = 0; j <= 8; j++) {
+          double s = s0 + (s1 - s0) * j / 8, d1, d2;
+          double x = dt_density_ray(&a, o, d, s, &d1);
+          double y = dt_density_ray(&b, o, d, s, &d2);
+          if (memcmp(&x, &y, sizeof x) || memcmp(&d1, &d2, sizeof d1))
+            bad_value++;
+        }
+        /* the same through the leaf tables, the cut tape's filled only
+           for its live leaves (the rest NaN: read, they would show) */
+        for (int j = 0; j < tp->nleaves; j++) rl2[j].base = rl2[j].nd = NAN;
+        dt_ray_leaves(tp, o, d, rl1);
+        dt_ray_leaves(&tile, o, d, rl2);
+        dt_prune_rl(tp, rl1, s0, s1, v1, &a);
+        dt_prune_rl(&tile, rl2, s0, s1, v2, &b);
+        if (!same_code(&a, &b)) bad_code++;
+        for (int j = 0; j <= 8; j++) {
+          double s = s0 + (s1 - s0) * j / 8, d1, d2;
+          double x = dt_density_rl(&a, rl1, s, &d1);
+          double y = dt_density_rl(&b, rl2, s, &d2);
+          if (memcmp(&x, &y, sizeof x) || memcmp(&d1, &d2, sizeof d1))
+            bad_value++;
+        }
+      }
+    }
+    free(buf);
+    free(pbuf);
+    free(v1);
+    free(v2);
+    free(lv);
+    free(cls);
+    free(lives);
+    free(rl1);
+    free(rl2);
+    dt_tape_free(tp);
+  }
+  if (getenv("QCS_TEST_VERBOSE"))
+    printf("# prune_class: %d segments, %d cuts, %d grouped tapes\n", segs,
+           cut, grouped);
+  CHECK("a tape cut to a region, then to a segment in it: the segment's "
+        "code, leaf for leaf", bad_code == 0);
+  CHECK("... and its densities and derivatives, bit for bit",
+        bad_value == 0);
+  CHECK("the regions cut leaves, in tapes with and without groups",
+        cut > 300 && grouped > 0 && grouped < 60);
+}
+
 int main(void) {
   check_prefix = "density";
   test_paper_values();
@@ -446,5 +578,6 @@ int main(void) {
   test_sharp_leaves();
   test_deep_chain();
   test_prune();
+  test_prune_class();
   CHECK_DONE();
 }

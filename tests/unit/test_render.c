@@ -2,6 +2,7 @@
  * renders of the canonical scenes against stored reference images, the
  * EXR read back through the OpenEXR library, shading checked against an
  * independent long double computation, determinism across thread counts,
+ * the per-tile culling and pruning against the untiled tracer,
  * and an interrupted render leaving no file.
  *
  * Reference images live in tests/images/NAME.png (150 x 95). After a
@@ -10,6 +11,8 @@
  * this program write them instead of comparing. */
 #include <gc.h>
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 #include <unistd.h>
 
 #include "check.h"
@@ -237,6 +240,174 @@ static void tolerance_test(void) {
   }
 }
 
+/* Tiles: the per-tile culling and pruning (render.c, TileCull) against
+   the untiled tracer (QCS_TILES=0): the same pixels, depths, normals and
+   cost, bit for bit, and the same counts of rays, hits, density
+   evaluations, segments and polishing steps (the root searches did the
+   same work on the same views). A leaf the tile dropped that a ray needed
+   would change a root or a count; a box culled wrongly, a hit. */
+typedef struct TileCase {
+  int width, height, spp, threads;
+  int renders, same, counts_same;
+  long primary;
+} TileCase;
+
+static Image *render_tiles(const struct Scene *s, const RenderSettings *rs,
+                           int tiled, RenderReport *rep, char *err,
+                           size_t errlen) {
+  if (tiled) unsetenv("QCS_TILES");
+  else setenv("QCS_TILES", "0", 1);
+  Image *im = render_scene(s, rs, rep, NULL, err, errlen);
+  unsetenv("QCS_TILES");
+  return im;
+}
+
+static int tiles_capture(void *ctx, const struct Scene *s,
+                         const struct RenderSettings *rs, const char *path,
+                         char *err, size_t errlen) {
+  (void)path;
+  TileCase *tc = ctx;
+  RenderSettings r = *rs;
+  r.width = tc->width;
+  r.height = tc->height;
+  r.spp = tc->spp;
+  r.threads = tc->threads;
+  r.aovs = IMG_Z | IMG_N | IMG_COST;
+  r.progress = NULL;
+  RenderReport ra, rb;
+  Image *a = render_tiles(s, &r, 0, &ra, err, errlen);
+  Image *b = a ? render_tiles(s, &r, 1, &rb, err, errlen) : NULL;
+  if (!a || !b) {
+    img_free(a);
+    return -1;
+  }
+  size_t n = (size_t)a->width * (size_t)a->height;
+  int same = a->width == b->width && a->height == b->height &&
+             !memcmp(a->rgba, b->rgba, n * 4 * sizeof(float)) &&
+             !memcmp(a->z, b->z, n * sizeof(float)) &&
+             !memcmp(a->n, b->n, n * 3 * sizeof(float)) &&
+             !memcmp(a->cost, b->cost, n * sizeof(float));
+  int counts = ra.primary == rb.primary && ra.shadow == rb.shadow &&
+               ra.hits == rb.hits && ra.evals == rb.evals &&
+               ra.segments == rb.segments && ra.steps == rb.steps &&
+               ra.soft_solves == rb.soft_solves &&
+               ra.max_ray_work == rb.max_ray_work;
+  if (getenv("QCS_TEST_VERBOSE"))
+    printf("# tiles: %d same %d counts %d primary %ld shadow %ld evals %ld/%ld\n",
+           tc->renders, same, counts, ra.primary, ra.shadow, ra.evals, rb.evals);
+  tc->renders++;
+  tc->same += same;
+  tc->counts_same += counts;
+  tc->primary += ra.primary;
+  img_free(a);
+  img_free(b);
+  return 0;
+}
+
+static void tiles_run(TileCase *tc, const char *file, const char *src) {
+  RenderOverrides o = {0};
+  o.capture = tiles_capture;
+  o.capture_ctx = tc;
+  render_set_overrides(I, &o);
+  int st = file ? interp_run_file(I, file)
+                : interp_run_string(I, "<tiles>", src, MODE_SCRIPT);
+  render_set_overrides(I, NULL);
+  if (st != RUN_OK) tc->renders = -1000;
+}
+
+static void tiles_examples_test(void) {
+  static const char *const scenes[] = {
+      "figure12", "figure12-sharp", "figure13", "figure15a",
+      "figure15b", "soft-cloud", "teapot", "mould", "staplers"};
+  for (size_t i = 0; i < sizeof scenes / sizeof *scenes; i++) {
+    char ex[256], name[300];
+    snprintf(ex, sizeof ex, "examples/%s.qcs", scenes[i]);
+    /* 150 x 95 on 2 threads (partial tiles at the edges), and figure12
+       with 3 x 3 samples a pixel */
+    for (int spp = 1; spp <= 9; spp += 8) {
+      if (spp > 1 && i > 0) break;
+      TileCase tc = {150, 95, spp, 2, 0, 0, 0, 0};
+      tiles_run(&tc, ex, NULL);
+      snprintf(name, sizeof name, "tiles: %s (%d spp) tiled = untiled, "
+               "bit for bit", scenes[i], spp);
+      CHECK(name, tc.renders >= 1 && tc.same == tc.renders &&
+                      tc.primary == 150L * 95 * spp * tc.renders);
+      snprintf(name, sizeof name, "tiles: %s (%d spp) the same rays and "
+               "root-search work", scenes[i], spp);
+      CHECK(name, tc.renders >= 1 && tc.counts_same == tc.renders);
+    }
+  }
+}
+
+/* xorshift64*: the random scenes' numbers in [0, 1) */
+static unsigned long long tile_rng = 0x9E3779B97F4A7C15ULL;
+static double urand(void) {
+  tile_rng ^= tile_rng >> 12;
+  tile_rng ^= tile_rng << 25;
+  tile_rng ^= tile_rng >> 27;
+  return (double)((tile_rng * 2685821657736338717ULL) >> 11) * 0x1p-53;
+}
+
+/* A box: UnitCube scaled, turned and moved, as qcs source. */
+static int rand_box(char *b, size_t n) {
+  static const char *const ax[] = {"x", "y", "z"};
+  return snprintf(b, n, "(Shift (%.3f, %.3f, %.3f) (Rotate \"%s\" %.1f "
+                  "(Scale (%.3f, %.3f, %.3f) UnitCube)))",
+                  4 * urand() - 2, 2 * urand() - 0.5, 4 * urand() - 2,
+                  ax[(int)(3 * urand())], 360 * urand(), 0.3 + 1.5 * urand(),
+                  0.3 + 1.5 * urand(), 0.3 + 1.5 * urand());
+}
+
+static void tiles_random_test(void) {
+  int scenes = 24, ok = 0, counts = 0, ran = 0;
+  for (int k = 0; k < scenes; k++) {
+    char src[8192], b1[256], b2[256];
+    size_t m = 0;
+    int nobj = 2 + (int)(5 * urand());
+    m += (size_t)snprintf(src + m, sizeof src - m, "scene = foldr1 Union [");
+    for (int j = 0; j < nobj; j++) {
+      rand_box(b1, sizeof b1);
+      rand_box(b2, sizeof b2);
+      double r = 0.02 + 0.3 * urand();
+      int kind = (int)(6 * urand());
+      const char *sep = j ? ", " : "";
+      if (kind == 0)
+        m += (size_t)snprintf(src + m, sizeof src - m, "%sRounded %.3f %s", sep, r, b1);
+      else if (kind == 1)
+        m += (size_t)snprintf(src + m, sizeof src - m, "%sRounded %.3f (Difference %s %s)", sep, r, b1, b2);
+      else if (kind == 2)
+        m += (size_t)snprintf(src + m, sizeof src - m, "%sSetDifference (Rounded %.3f %s) %s", sep, r, b1, b2);
+      else if (kind == 3)
+        m += (size_t)snprintf(src + m, sizeof src - m, "%sRounded %.3f (Sum %s %s)", sep, r, b1, b2);
+      else if (kind == 4)
+        m += (size_t)snprintf(src + m, sizeof src - m, "%sIntersection (Rounded %.3f %s) (Rounded %.3f %s)", sep, r, b1, 0.5 * r, b2);
+      else
+        m += (size_t)snprintf(src + m, sizeof src - m, "%s%s", sep, b1);
+    }
+    if (urand() < 0.6)
+      m += (size_t)snprintf(src + m, sizeof src - m, ", Halfspace ((0, 1, 0), -0.5)");
+    double th = 6.2831853 * urand(), ph = 0.2 + 1.1 * urand(), R = 5 + 6 * urand();
+    m += (size_t)snprintf(src + m, sizeof src - m,
+                          "];\nrenderWith [Camera (%.3f, %.3f, %.3f) (%.3f, %.3f, %.3f) %.1f, "
+                          "Light (%.3f, %.3f, %.3f)] \"x.png\" scene\n",
+                          R * cos(th) * cos(ph), R * sin(ph), R * sin(th) * cos(ph),
+                          urand() - 0.5, urand(), urand() - 0.5, 20 + 50 * urand(),
+                          12 * urand() - 6, 4 + 6 * urand(), 12 * urand() - 6);
+    TileCase tc = {61 + (int)(40 * urand()), 37 + (int)(30 * urand()),
+                   urand() < 0.3 ? 4 : 1, 2, 0, 0, 0, 0};
+    tiles_run(&tc, NULL, src);
+    if (tc.renders == 1) ran++;
+    if (tc.renders == 1 && tc.same == 1) ok++;
+    else if (getenv("QCS_TEST_VERBOSE")) printf("# differs:\n%s", src);
+    if (tc.renders == 1 && tc.counts_same == 1) counts++;
+  }
+  CHECK("tiles: 24 random rounded scenes render", ran == scenes);
+  CHECK("tiles: 24 random rounded scenes tiled = untiled, bit for bit",
+        ok == scenes);
+  CHECK("tiles: 24 random rounded scenes, the same root-search work",
+        counts == scenes);
+}
+
 static void interrupt_test(void) {
   char out[512];
   snprintf(out, sizeof out, "%s/interrupted.png", tmpdir);
@@ -266,6 +437,8 @@ int main(void) {
     exr_test();
     tolerance_test();
     determinism_test();
+    tiles_examples_test();
+    tiles_random_test();
     interrupt_test();
   }
   char cmd[600];
