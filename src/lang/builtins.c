@@ -239,11 +239,15 @@ static Value *bi_concatMap(Interp *I, Value **args, Pos pos) {
     Value **rest = val_array(2);
     rest[0] = args[0];
     rest[1] = v->u.cons.tail;
-    Value **app = val_array(2);
-    app[0] = ys;
     static Value *concatmap_fn;
     if (!concatmap_fn) concatmap_fn = eval_builtin_value(&concatmap_builtin);
-    app[1] = delay_apply(concatmap_fn, 2, rest);
+    Value *more = delay_apply(concatmap_fn, 2, rest);
+    /* [y] ++ more is y : more: a comprehension's element (its result is
+       one cons onto an evaluated []) costs no delayed append */
+    if (ys->u.cons.tail->kind == V_NIL) return val_cons(ys->u.cons.head, more);
+    Value **app = val_array(2);
+    app[0] = ys;
+    app[1] = more;
     return bi_append(I, app, pos);
   }
 }

@@ -203,13 +203,23 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
   }
 }
 
+/* The value of a literal, one per place it is written. */
+static Value *lit_num(Expr *e) {
+  if (!e->lit) e->lit = val_num(e->u.num);
+  return e->lit;
+}
+static Value *lit_str(Expr *e) {
+  if (!e->lit) e->lit = val_str(e->u.str);
+  return e->lit;
+}
+
 Value *delay(Interp *I, Expr *e, Env *env) {
   double x;
   if ((e->kind == E_BINOP || e->kind == E_NEG) && known_num(I, e, env, &x))
     return val_num(x);
   switch (e->kind) {
-  case E_NUM: return val_num(e->u.num);
-  case E_STR: return val_str(e->u.str);
+  case E_NUM: return lit_num(e);
+  case E_STR: return lit_str(e);
   case E_BOOL: return val_bool(I, e->u.b);
   case E_VAR: return lookup(I, e, env);
   default: return mk_thunk(I, e, env);
@@ -605,7 +615,8 @@ static int after_minus(Pos pos) {
 /* Apply f to n arguments. Returns 1 with (*body, *benv) set when the result
    is a function body to evaluate in tail position, or 0 with *result. */
 static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
-                Value **result, Expr **body, Env **benv, int depth) {
+                const Pos *spos, Value **result, Expr **body, Env **benv,
+                int depth) {
   /* A function given more arguments than it takes applies its result to
      the rest: if that is no function, the message says so by name. */
   const char *over_name = NULL;
@@ -657,9 +668,13 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
       memcpy(cargs, args, sizeof(Value *) * (size_t)a);
       *result = val_con(c, a, cargs);
       if (pos.src) { /* scene errors found later point back here */
-        Pos *p = GC_MALLOC(sizeof *p);
-        *p = eval_user_pos(I, pos);
-        (*result)->u.con.pos = p;
+        if (spos && !pos.src->prelude) {
+          (*result)->u.con.pos = spos;  /* the call's own, in its Expr */
+        } else {
+          Pos *p = val_small(sizeof *p);
+          *p = eval_user_pos(I, pos);
+          (*result)->u.con.pos = p;
+        }
       }
       return 0;
     }
@@ -674,9 +689,13 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
          here (eval() puts the origin back when it returns) */
       if (pos.src && !pos.src->prelude && d->pos.src &&
           d->pos.src->prelude) {
-        Pos *o = GC_MALLOC(sizeof *o);
-        *o = pos;
-        I->origin = o;
+        if (spos) {
+          I->origin = spos;
+        } else {
+          Pos *o = val_small(sizeof *o);
+          *o = pos;
+          I->origin = o;
+        }
       }
       Env *env;
       Expr *b = select_clause(I, d, f->u.fn.env, args, pos, &env);
@@ -715,7 +734,7 @@ Value *apply(Interp *I, Value *f, int n, Value **args, Pos pos) {
   Expr *body;
   Env *env;
   int depth = I->ntrace;
-  if (call(I, f, n, args, pos, &r, &body, &env, depth)) r = eval(I, body, env);
+  if (call(I, f, n, args, pos, NULL, &r, &body, &env, depth)) r = eval(I, body, env);
   I->ntrace = depth;
   return r;
 }
@@ -726,11 +745,51 @@ static int values_equal(Interp *I, Value *a, Value *b, Pos pos);
 
 static Value *arith(Interp *I, TokKind op, Value *a, Value *b, Pos pos);
 
+/* A tuple of n Reals as one block: the tuple, its item array and the n
+   Reals (the items point into the block). One allocation instead of
+   n + 2, and one object for the collector to mark. */
+#define VEC_BLOCK_MAX 4
+static Value *vec_block(int n, const double *x) {
+  Value *t = val_small(sizeof(Value) * (size_t)(n + 1) +
+                       sizeof(Value *) * (size_t)n);
+  Value *nums = t + 1;
+  Value **it = (Value **)(nums + n);
+  for (int i = 0; i < n; i++) {
+    nums[i].kind = V_NUM;
+    nums[i].u.num = x[i];
+    it[i] = &nums[i];
+  }
+  t->kind = V_TUPLE;
+  t->u.tup.n = n;
+  t->u.tup.items = it;
+  return t;
+}
+
+static double num_op(TokKind op, double x, double y) {
+  switch (op) {
+  case T_PLUS: return x + y;
+  case T_MINUS: return x - y;
+  case T_STAR: return x * y;
+  case T_SLASH: return x / y;
+  default: return pow(x, y); /* T_CARET */
+  }
+}
+
 static Value *vec_map2(Interp *I, TokKind op, Value *a, Value *b, Pos pos) {
   if (a->u.tup.n != b->u.tup.n)
     qcs_error(pos, "'%s' on tuples of different sizes (%d and %d)",
               op_text(op), a->u.tup.n, b->u.tup.n);
   int n = a->u.tup.n;
+  if (n <= VEC_BLOCK_MAX) { /* Reals on both sides: no cell per item */
+    double x[VEC_BLOCK_MAX];
+    int i = 0;
+    for (; i < n; i++) {
+      Value *p = force(I, a->u.tup.items[i]), *q = force(I, b->u.tup.items[i]);
+      if (p->kind != V_NUM || q->kind != V_NUM) break;
+      x[i] = num_op(op, p->u.num, q->u.num);
+    }
+    if (i == n) return vec_block(n, x);
+  }
   Value **it = val_array(n);
   for (int i = 0; i < n; i++)
     it[i] = arith(I, op, force(I, a->u.tup.items[i]),
@@ -741,6 +800,17 @@ static Value *vec_map2(Interp *I, TokKind op, Value *a, Value *b, Pos pos) {
 static Value *vec_scale(Interp *I, TokKind op, Value *t, Value *s, int s_first,
                         Pos pos) {
   int n = t->u.tup.n;
+  if (n <= VEC_BLOCK_MAX && s->kind == V_NUM) {
+    double x[VEC_BLOCK_MAX];
+    int i = 0;
+    for (; i < n; i++) {
+      Value *p = force(I, t->u.tup.items[i]);
+      if (p->kind != V_NUM) break;
+      x[i] = s_first ? num_op(op, s->u.num, p->u.num)
+                     : num_op(op, p->u.num, s->u.num);
+    }
+    if (i == n) return vec_block(n, x);
+  }
   Value **it = val_array(n);
   for (int i = 0; i < n; i++) {
     Value *x = force(I, t->u.tup.items[i]);
@@ -1022,10 +1092,10 @@ Value *eval(Interp *I, Expr *e, Env *env) {
     eval_check(I, e->pos);
     switch (e->kind) {
     case E_NUM:
-      result = val_num(e->u.num);
+      result = lit_num(e);
       goto done;
     case E_STR:
-      result = val_str(e->u.str);
+      result = lit_str(e);
       goto done;
     case E_BOOL:
       result = val_bool(I, e->u.b);
@@ -1042,7 +1112,8 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
       Expr *body;
       Env *benv;
-      if (call(I, f, n, args, e->pos, &result, &body, &benv, tslot)) {
+      if (call(I, f, n, args, e->pos, &e->pos, &result, &body, &benv,
+               tslot)) {
         tslot = depth + 1;
         e = body;
         env = benv;
