@@ -19,9 +19,10 @@
 /* ---- numbers ---- */
 
 #define MATH1(cname, expr, doc)                                  \
+  static double num_##cname(double x) { return expr; }           \
   static Value *bi_##cname(Interp *I, Value **args, Pos pos) {   \
     double x = ARGNUM(0, "the argument of " #cname);             \
-    return val_num(expr);                                        \
+    return val_num(num_##cname(x));                              \
   }
 MATH1(sqrt, sqrt(x), "")
 MATH1(sin, sin(x), "")
@@ -37,20 +38,57 @@ MATH1(ceiling, ceil(x), "")
 MATH1(round, round(x), "")
 MATH1(truncate, trunc(x), "")
 MATH1(abs, fabs(x), "")
+MATH1(fract, x - floor(x), "")
 
+static double num_atan2(double y, double x);
+static double num_min(double a, double b);
+static double num_max(double a, double b);
 static Value *bi_atan2(Interp *I, Value **args, Pos pos) {
-  return val_num(atan2(ARGNUM(0, "y of atan2"), ARGNUM(1, "x of atan2")));
+  double y = ARGNUM(0, "y of atan2");
+  return val_num(num_atan2(y, ARGNUM(1, "x of atan2")));
 }
 static Value *bi_min(Interp *I, Value **args, Pos pos) {
   double a = ARGNUM(0, "the first argument of min");
   double b = ARGNUM(1, "the second argument of min");
-  return val_num(b < a ? b : a);
+  return val_num(num_min(a, b));
 }
 static Value *bi_max(Interp *I, Value **args, Pos pos) {
   double a = ARGNUM(0, "the first argument of max");
   double b = ARGNUM(1, "the second argument of max");
-  return val_num(b > a ? b : a);
+  return val_num(num_max(a, b));
 }
+static double num_atan2(double y, double x) { return atan2(y, x); }
+static double num_min(double a, double b) { return b < a ? b : a; }
+static double num_max(double a, double b) { return b > a ? b : a; }
+
+/* The functions above: defined for every Real (NaN and infinities give a
+   Real), so the evaluator may apply them to known Reals at once. */
+static const struct { BuiltinFn bi; double (*f1)(double); } num1[] = {
+    {bi_sqrt, num_sqrt},   {bi_sin, num_sin},     {bi_cos, num_cos},
+    {bi_tan, num_tan},     {bi_asin, num_asin},   {bi_acos, num_acos},
+    {bi_atan, num_atan},   {bi_exp, num_exp},     {bi_log, num_log},
+    {bi_floor, num_floor}, {bi_ceiling, num_ceiling}, {bi_round, num_round},
+    {bi_truncate, num_truncate}, {bi_abs, num_abs}, {bi_fract, num_fract}};
+static const struct { BuiltinFn bi; double (*f2)(double, double); } num2[] = {
+    {bi_atan2, num_atan2}, {bi_min, num_min}, {bi_max, num_max}};
+
+int builtin_num(const Builtin *b, int n, const double *x, double *out) {
+  if (n == 1) {
+    for (size_t i = 0; i < sizeof num1 / sizeof *num1; i++)
+      if (num1[i].bi == b->fn) {
+        *out = num1[i].f1(x[0]);
+        return 1;
+      }
+  } else if (n == 2) {
+    for (size_t i = 0; i < sizeof num2 / sizeof *num2; i++)
+      if (num2[i].bi == b->fn) {
+        *out = num2[i].f2(x[0], x[1]);
+        return 1;
+      }
+  }
+  return 0;
+}
+
 /* mod x y has the sign of y, like Haskell's mod. */
 static Value *bi_mod(Interp *I, Value **args, Pos pos) {
   double x = ARGNUM(0, "the first argument of mod");

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "lang/builtins.h"
 #include "lang/parse.h"
 #include "lang/print.h"
 #include "lang/resolve.h"
@@ -169,6 +170,18 @@ static Value *mk_thunk(Interp *I, Expr *e, Env *env) {
    it now cannot fail or loop, so laziness is unchanged, and an accumulator
    such as `count (n - 1) (acc + 1)` stays a number instead of growing a
    chain of a million thunks that would then be forced recursively. */
+/* What e, an E_VAR, is bound to now, as lookup() finds it, or NULL
+   (a constructor, or a name not defined: lookup() reports that). */
+static Value *known_var(Expr *e, Env *env) {
+  Value *v = lookup_local(e, env);
+  if (v) return v;
+  Sym *s = e->u.var;
+  if (s->con_arity >= 0) return NULL;
+  if (e->pos.src && e->pos.src->prelude && s->prelude_value)
+    return s->prelude_value;
+  return s->global;
+}
+
 static int known_num(Interp *I, Expr *e, Env *env, double *out) {
   char probe; /* a chain of a million '+' is left to eval, which checks */
   if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
@@ -177,10 +190,21 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
     *out = e->u.num;
     return 1;
   case E_VAR: {
-    Value *v = lookup_local(e, env);
+    Value *v = known_var(e, env);
     if (!v || v->kind != V_NUM) return 0;
     *out = v->u.num;
     return 1;
+  }
+  case E_APP: { /* floor x, min a b, ...: built-ins defined on every Real */
+    if (e->u.app.fn->kind != E_VAR || e->u.app.n > 2) return 0;
+    Value *f = known_var(e->u.app.fn, env);
+    if (!f || f->kind != V_FUNC || f->u.fn.kind != F_BUILTIN ||
+        f->u.fn.arity != e->u.app.n)
+      return 0;
+    double x[2];
+    for (int i = 0; i < e->u.app.n; i++)
+      if (!known_num(I, e->u.app.args[i], env, &x[i])) return 0;
+    return builtin_num(f->u.fn.u.bi, e->u.app.n, x, out);
   }
   case E_NEG:
     if (!known_num(I, e->u.neg, env, out)) return 0;
@@ -213,10 +237,104 @@ static Value *lit_str(Expr *e) {
   return e->lit;
 }
 
+/* A tuple of at most VEC_BLOCK_MAX Reals known the same way (literals,
+   variables bound to evaluated ones, and the tuple arithmetic of arith()
+   on them when the sizes agree): its size, with the Reals in out[], or 0.
+   The arithmetic is arith()'s own (num_op), so the values are the same. */
+#define VEC_BLOCK_MAX 4
+static double num_op(TokKind op, double x, double y);
+static Value *vec_block(int n, const double *x);
+
+static int known_vec(Interp *I, Expr *e, Env *env, double *out) {
+  char probe;
+  if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
+  switch (e->kind) {
+  case E_VAR: {
+    Value *v = known_var(e, env);
+    if (!v || v->kind != V_TUPLE || v->u.tup.n > VEC_BLOCK_MAX) return 0;
+    for (int i = 0; i < v->u.tup.n; i++) {
+      Value *x = v->u.tup.items[i];
+      if (x->kind != V_NUM) return 0;
+      out[i] = x->u.num;
+    }
+    return v->u.tup.n;
+  }
+  case E_TUPLE: {
+    int n = e->u.tuple.n;
+    if (n > VEC_BLOCK_MAX) return 0;
+    for (int i = 0; i < n; i++)
+      if (!known_num(I, e->u.tuple.items[i], env, &out[i])) return 0;
+    return n;
+  }
+  case E_NEG: { /* as eval's: (-1) * t */
+    int n = known_vec(I, e->u.neg, env, out);
+    for (int i = 0; i < n; i++) out[i] = num_op(T_STAR, -1, out[i]);
+    return n;
+  }
+  case E_BINOP: {
+    TokKind op = e->u.bin.op;
+    double a[VEC_BLOCK_MAX], b[VEC_BLOCK_MAX], s;
+    if (op == T_PLUS || op == T_MINUS) {
+      int n = known_vec(I, e->u.bin.a, env, a);
+      if (!n || known_vec(I, e->u.bin.b, env, b) != n) return 0;
+      for (int i = 0; i < n; i++) out[i] = num_op(op, a[i], b[i]);
+      return n;
+    }
+    if (op == T_STAR && e->u.bin.a->kind != E_TUPLE &&
+        known_num(I, e->u.bin.a, env, &s)) {
+      int n = known_vec(I, e->u.bin.b, env, b);
+      for (int i = 0; i < n; i++) out[i] = num_op(op, s, b[i]);
+      return n;
+    }
+    if (op == T_STAR || op == T_SLASH) {
+      int n = known_vec(I, e->u.bin.a, env, a);
+      if (!n || !known_num(I, e->u.bin.b, env, &s)) return 0;
+      for (int i = 0; i < n; i++) out[i] = num_op(op, a[i], s);
+      return n;
+    }
+    return 0;
+  }
+  default:
+    return 0;
+  }
+}
+
+/* A constructor applied to all its arguments, in the user's code, is
+   built at once: that cannot fail, and its arguments stay delayed. */
+static Value *known_con(Interp *I, Expr *e, Env *env) {
+  Expr *fe = e->u.app.fn;
+  if (fe->kind != E_VAR || !e->pos.src || e->pos.src->prelude) return NULL;
+  Sym *c = fe->u.var;
+  if (c->con_arity != e->u.app.n || c->con_arity <= 0) return NULL;
+  if (lookup_local(fe, env)) return NULL; /* a local of that name */
+  int n = e->u.app.n;
+  Value **args = val_array(n);
+  for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
+  Value *v = val_con(c, n, args);
+  v->u.con.pos = &e->pos;
+  return v;
+}
+
 Value *delay(Interp *I, Expr *e, Env *env) {
-  double x;
-  if ((e->kind == E_BINOP || e->kind == E_NEG) && known_num(I, e, env, &x))
-    return val_num(x);
+  double x, t[VEC_BLOCK_MAX];
+  int n;
+  switch (e->kind) {
+  case E_BINOP: case E_NEG:
+    if (known_num(I, e, env, &x)) return val_num(x);
+    if ((n = known_vec(I, e, env, t)) > 0) return vec_block(n, t);
+    break;
+  case E_TUPLE:
+    if ((n = known_vec(I, e, env, t)) > 0) return vec_block(n, t);
+    break;
+  case E_APP: {
+    if (known_num(I, e, env, &x)) return val_num(x);
+    Value *c = known_con(I, e, env);
+    if (c) return c;
+    break;
+  }
+  default:
+    break;
+  }
   switch (e->kind) {
   case E_NUM: return lit_num(e);
   case E_STR: return lit_str(e);
@@ -748,7 +866,6 @@ static Value *arith(Interp *I, TokKind op, Value *a, Value *b, Pos pos);
 /* A tuple of n Reals as one block: the tuple, its item array and the n
    Reals (the items point into the block). One allocation instead of
    n + 2, and one object for the collector to mark. */
-#define VEC_BLOCK_MAX 4
 static Value *vec_block(int n, const double *x) {
   Value *t = val_small(sizeof(Value) * (size_t)(n + 1) +
                        sizeof(Value *) * (size_t)n);
@@ -1145,7 +1262,13 @@ Value *eval(Interp *I, Expr *e, Env *env) {
               : e->u.cond.f;
       continue;
     case E_TUPLE: {
-      int n = e->u.tuple.n;
+      double t[VEC_BLOCK_MAX];
+      int n = known_vec(I, e, env, t);
+      if (n > 0) {
+        result = vec_block(n, t);
+        goto done;
+      }
+      n = e->u.tuple.n;
       Value **items = val_array(n);
       for (int i = 0; i < n; i++) items[i] = delay(I, e->u.tuple.items[i], env);
       result = val_tuple(n, items);
