@@ -72,19 +72,32 @@ static const struct { BuiltinFn bi; double (*f1)(double); } num1[] = {
 static const struct { BuiltinFn bi; double (*f2)(double, double); } num2[] = {
     {bi_atan2, num_atan2}, {bi_min, num_min}, {bi_max, num_max}};
 
-int builtin_num(const Builtin *b, int n, const double *x, double *out) {
-  if (n == 1) {
+static const Builtin builtins[];
+static const size_t nbuiltins;
+/* Per entry of builtins[]: its Real function, or NULL (builtin_install). */
+static double (*num1_of[128])(double);
+static double (*num2_of[128])(double, double);
+
+static void num_index(void) {
+  for (size_t j = 0; j < nbuiltins && j < 128; j++) {
     for (size_t i = 0; i < sizeof num1 / sizeof *num1; i++)
-      if (num1[i].bi == b->fn) {
-        *out = num1[i].f1(x[0]);
-        return 1;
-      }
-  } else if (n == 2) {
+      if (num1[i].bi == builtins[j].fn) num1_of[j] = num1[i].f1;
     for (size_t i = 0; i < sizeof num2 / sizeof *num2; i++)
-      if (num2[i].bi == b->fn) {
-        *out = num2[i].f2(x[0], x[1]);
-        return 1;
-      }
+      if (num2[i].bi == builtins[j].fn) num2_of[j] = num2[i].f2;
+  }
+}
+
+int builtin_num(const Builtin *b, int n, const double *x, double *out) {
+  if (b < builtins || b >= builtins + nbuiltins) return 0; /* not the table's */
+  size_t j = (size_t)(b - builtins);
+  if (j >= 128) return 0;
+  if (n == 1 && num1_of[j]) {
+    *out = num1_of[j](x[0]);
+    return 1;
+  }
+  if (n == 2 && num2_of[j]) {
+    *out = num2_of[j](x[0], x[1]);
+    return 1;
   }
   return 0;
 }
@@ -295,6 +308,7 @@ static const Builtin builtins[] = {
     BUILTINS(X)
 #undef X
 };
+static const size_t nbuiltins = sizeof builtins / sizeof *builtins;
 
 /* A table's doc is "WHAT; e.g. EXAMPLE": split at the last "; e.g. ". */
 void builtin_define(Interp *I, const Builtin *b) {
@@ -316,6 +330,8 @@ void builtin_define(Interp *I, const Builtin *b) {
 }
 
 void builtins_install(Interp *I) {
+  static int indexed;
+  if (!indexed) num_index(), indexed = 1;
   for (size_t i = 0; i < sizeof builtins / sizeof *builtins; i++)
     builtin_define(I, &builtins[i]);
 }
