@@ -27,8 +27,10 @@ static __attribute__((noinline)) void scrub_stack(void) {
   __asm__ volatile("" : : "r"(pad) : "memory");
 }
 
-/* Runs at every evaluation step: no system calls, no allocation. */
-void eval_check(Interp *I, Pos pos) {
+/* eval_check (eval.h) found something to do: I->steps is counted and,
+   unless a check before failed, I->memcheck too. No system calls, no
+   allocation. */
+void eval_check_slow(Interp *I, Pos pos) {
   char probe;
   if (atomic_load_explicit(&qcs_interrupted, memory_order_relaxed)) {
     atomic_store(&qcs_interrupted, 0);
@@ -37,10 +39,10 @@ void eval_check(Interp *I, Pos pos) {
   if ((size_t)(I->stack_base - &probe) > I->stack_limit)
     eval_stack_error(I, pos, "recursion too deep: nested calls use",
                      "; is a base case missing?");
-  if (++I->steps > I->max_steps && I->max_steps)
+  if (I->steps > I->max_steps && I->max_steps)
     eval_limit_error(I, pos, "max-steps", "evaluation stopped after %llu steps",
                      I->max_steps);
-  if (++I->memcheck >= 4096) {
+  if (I->memcheck >= 4096) {
     I->memcheck = 0;
     if ((size_t)(I->stack_base - &probe) + 2 * STACK_SCRUB < I->stack_reserved)
       scrub_stack();
@@ -669,13 +671,24 @@ static void brief_args(Interp *I, int n, Value **args, char *buf, size_t size) {
    returns the body and its environment for the caller to evaluate. */
 static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
                            Pos pos, Env **out_env) {
+  Env *spare = NULL; /* the frame of a clause that did not match */
   for (int c = 0; c < d->nclauses; c++) {
     Clause *cl = d->clauses[c];
-    Env *frame = env_new(env, cl->npats + cl->nwhere + 1);
+    Env *frame;
+    if (spare && spare->cap >= cl->npats + cl->nwhere + 1) {
+      frame = spare; /* nothing made by a failed match refers to it */
+      frame->n = 0;
+      spare = NULL;
+    } else {
+      frame = env_new(env, cl->npats + cl->nwhere + 1);
+    }
     int ok = 1;
     for (int i = 0; i < cl->npats && ok; i++)
       ok = match(I, cl->pats[i], args[i], frame);
-    if (!ok) continue;
+    if (!ok) {
+      spare = frame;
+      continue;
+    }
     if (cl->nwhere) bind_defs(I, cl->nwhere, cl->where, frame);
     for (int b = 0; b < cl->nbodies; b++) {
       Expr *g = cl->guards[b];

@@ -98,7 +98,7 @@ Value *val_str(const char *s) {
 }
 
 Value **val_array(int n) {
-  return val_small(sizeof(Value *) * (size_t)(n > 0 ? n : 1));
+  return GC_MALLOC(sizeof(Value *) * (size_t)(n > 0 ? n : 1));
 }
 
 Value *val_tuple(int n, Value **items) {
