@@ -26,11 +26,12 @@
       "OuterBounds" "PointInObject" "Roots" "Trace" "TrueDensity" "abs"
       "acos" "asin" "atan" "atan2" "ceiling" "clock"
       "concatMap" "cos" "cross" "dot" "error" "exp"
-      "floor" "foldl" "frame" "isInfinite" "isNaN" "length"
-      "log" "max" "meshWith" "min" "mod" "norm"
-      "not" "pi" "plotConvolution" "plotDisplacement" "plotField" "plotRay"
-      "plotSlice" "product" "renderWith" "round" "seq" "show"
-      "showReal" "sin" "sqrt" "sum" "tan" "truncate")
+      "floor" "foldl" "fract" "frame" "isInfinite" "isNaN"
+      "length" "log" "max" "meshWith" "min" "mod"
+      "norm" "not" "pi" "plotConvolution" "plotDisplacement" "plotField"
+      "plotRay" "plotSlice" "product" "renderWith" "round" "seq"
+      "show" "showReal" "sin" "sqrt" "sum" "tan"
+      "truncate")
   "The functions built into qcs.")
 
 (defconst qcs-prelude-functions
@@ -46,14 +47,14 @@
       "UnionAll" "UnitCube" "Wedge" "all" "any" "ballFaces"
       "concat" "const" "cosd" "cycle" "cyclic3" "drop"
       "dropWhile" "elem" "facetSides" "fibonacciSphere" "filter" "finiteReal"
-      "flip" "foldTree" "foldl1" "foldr" "foldr1" "fract"
-      "fst" "head" "id" "init" "iterate" "kitCount"
-      "kitSides" "kitSize" "last" "lookup" "map" "maximum"
-      "mesh" "minimum" "mmul" "noNegZero" "normalize" "null"
-      "otherwise" "phi" "polygonPlanes" "polyhedronOf" "positiveReal" "productOf"
-      "render" "repeat" "replicate" "reverse" "row4" "signs3"
-      "sind" "snd" "tail" "take" "takeWhile" "transpose"
-      "transposeRows" "unzip" "wholeNumber" "zip" "zip3" "zipWith")
+      "flip" "foldTree" "foldl1" "foldr" "foldr1" "fst"
+      "head" "id" "init" "iterate" "kitCount" "kitSides"
+      "kitSize" "last" "lookup" "map" "maximum" "mesh"
+      "minimum" "mmul" "noNegZero" "normalize" "null" "otherwise"
+      "phi" "polygonPlanes" "polyhedronOf" "positiveReal" "productOf" "render"
+      "repeat" "replicate" "reverse" "row4" "signs3" "sind"
+      "snd" "tail" "take" "takeWhile" "transpose" "transposeRows"
+      "unzip" "wholeNumber" "zip" "zip3" "zipWith")
   "The functions of the prelude (stdlib/prelude.qcs) and the kit (stdlib/kit.qcs).")
 
 (defconst qcs-font-lock-keywords

@@ -313,10 +313,18 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   err_defer(&cu, free, keys);
   {
     Value *l = force(I, v->u.con.args[1]);
+    Sym *last = NULL;  /* the constructor of the key before, and its kind */
+    ConKind lastk = K_NONE;
     while (l->kind == V_CONS) {
       eval_check(I, pos);
       Value *k = force(I, l->u.cons.head);
-      ConKind kk = con_kind(k);
+      ConKind kk;
+      if (k->kind == V_CON && k->u.con.con == last) {
+        kk = lastk;  /* no name comparisons for the next million keys */
+      } else {
+        kk = con_kind(k);
+        if (k->kind == V_CON) last = k->u.con.con, lastk = kk;
+      }
       Pos kpos = vpos(C, k);
       if (n == cap) {
         soft_key *nk = realloc(keys, sizeof *keys * (cap *= 2));

@@ -45,6 +45,8 @@ typedef struct Qual {
 struct Expr {
   ExprKind kind;
   Pos pos;
+  struct Value *lit;  /* E_NUM, E_STR: the value, made on first use and
+                         shared (a Real or String value is never changed) */
   union {
     double num;
     const char *str;

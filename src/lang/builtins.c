@@ -19,9 +19,10 @@
 /* ---- numbers ---- */
 
 #define MATH1(cname, expr, doc)                                  \
+  static double num_##cname(double x) { return expr; }           \
   static Value *bi_##cname(Interp *I, Value **args, Pos pos) {   \
     double x = ARGNUM(0, "the argument of " #cname);             \
-    return val_num(expr);                                        \
+    return val_num(num_##cname(x));                              \
   }
 MATH1(sqrt, sqrt(x), "")
 MATH1(sin, sin(x), "")
@@ -37,20 +38,70 @@ MATH1(ceiling, ceil(x), "")
 MATH1(round, round(x), "")
 MATH1(truncate, trunc(x), "")
 MATH1(abs, fabs(x), "")
+MATH1(fract, x - floor(x), "")
 
+static double num_atan2(double y, double x);
+static double num_min(double a, double b);
+static double num_max(double a, double b);
 static Value *bi_atan2(Interp *I, Value **args, Pos pos) {
-  return val_num(atan2(ARGNUM(0, "y of atan2"), ARGNUM(1, "x of atan2")));
+  double y = ARGNUM(0, "y of atan2");
+  return val_num(num_atan2(y, ARGNUM(1, "x of atan2")));
 }
 static Value *bi_min(Interp *I, Value **args, Pos pos) {
   double a = ARGNUM(0, "the first argument of min");
   double b = ARGNUM(1, "the second argument of min");
-  return val_num(b < a ? b : a);
+  return val_num(num_min(a, b));
 }
 static Value *bi_max(Interp *I, Value **args, Pos pos) {
   double a = ARGNUM(0, "the first argument of max");
   double b = ARGNUM(1, "the second argument of max");
-  return val_num(b > a ? b : a);
+  return val_num(num_max(a, b));
 }
+static double num_atan2(double y, double x) { return atan2(y, x); }
+static double num_min(double a, double b) { return b < a ? b : a; }
+static double num_max(double a, double b) { return b > a ? b : a; }
+
+/* The functions above: defined for every Real (NaN and infinities give a
+   Real), so the evaluator may apply them to known Reals at once. */
+static const struct { BuiltinFn bi; double (*f1)(double); } num1[] = {
+    {bi_sqrt, num_sqrt},   {bi_sin, num_sin},     {bi_cos, num_cos},
+    {bi_tan, num_tan},     {bi_asin, num_asin},   {bi_acos, num_acos},
+    {bi_atan, num_atan},   {bi_exp, num_exp},     {bi_log, num_log},
+    {bi_floor, num_floor}, {bi_ceiling, num_ceiling}, {bi_round, num_round},
+    {bi_truncate, num_truncate}, {bi_abs, num_abs}, {bi_fract, num_fract}};
+static const struct { BuiltinFn bi; double (*f2)(double, double); } num2[] = {
+    {bi_atan2, num_atan2}, {bi_min, num_min}, {bi_max, num_max}};
+
+static const Builtin builtins[];
+static const size_t nbuiltins;
+/* Per entry of builtins[]: its Real function, or NULL (builtin_install). */
+static double (*num1_of[128])(double);
+static double (*num2_of[128])(double, double);
+
+static void num_index(void) {
+  for (size_t j = 0; j < nbuiltins && j < 128; j++) {
+    for (size_t i = 0; i < sizeof num1 / sizeof *num1; i++)
+      if (num1[i].bi == builtins[j].fn) num1_of[j] = num1[i].f1;
+    for (size_t i = 0; i < sizeof num2 / sizeof *num2; i++)
+      if (num2[i].bi == builtins[j].fn) num2_of[j] = num2[i].f2;
+  }
+}
+
+int builtin_num(const Builtin *b, int n, const double *x, double *out) {
+  if (b < builtins || b >= builtins + nbuiltins) return 0; /* not the table's */
+  size_t j = (size_t)(b - builtins);
+  if (j >= 128) return 0;
+  if (n == 1 && num1_of[j]) {
+    *out = num1_of[j](x[0]);
+    return 1;
+  }
+  if (n == 2 && num2_of[j]) {
+    *out = num2_of[j](x[0], x[1]);
+    return 1;
+  }
+  return 0;
+}
+
 /* mod x y has the sign of y, like Haskell's mod. */
 static Value *bi_mod(Interp *I, Value **args, Pos pos) {
   double x = ARGNUM(0, "the first argument of mod");
@@ -239,11 +290,15 @@ static Value *bi_concatMap(Interp *I, Value **args, Pos pos) {
     Value **rest = val_array(2);
     rest[0] = args[0];
     rest[1] = v->u.cons.tail;
-    Value **app = val_array(2);
-    app[0] = ys;
     static Value *concatmap_fn;
     if (!concatmap_fn) concatmap_fn = eval_builtin_value(&concatmap_builtin);
-    app[1] = delay_apply(concatmap_fn, 2, rest);
+    Value *more = delay_apply(concatmap_fn, 2, rest);
+    /* [y] ++ more is y : more: a comprehension's element (its result is
+       one cons onto an evaluated []) costs no delayed append */
+    if (ys->u.cons.tail->kind == V_NIL) return val_cons(ys->u.cons.head, more);
+    Value **app = val_array(2);
+    app[0] = ys;
+    app[1] = more;
     return bi_append(I, app, pos);
   }
 }
@@ -253,6 +308,7 @@ static const Builtin builtins[] = {
     BUILTINS(X)
 #undef X
 };
+static const size_t nbuiltins = sizeof builtins / sizeof *builtins;
 
 /* A table's doc is "WHAT; e.g. EXAMPLE": split at the last "; e.g. ". */
 void builtin_define(Interp *I, const Builtin *b) {
@@ -274,6 +330,8 @@ void builtin_define(Interp *I, const Builtin *b) {
 }
 
 void builtins_install(Interp *I) {
+  static int indexed;
+  if (!indexed) num_index(), indexed = 1;
   for (size_t i = 0; i < sizeof builtins / sizeof *builtins; i++)
     builtin_define(I, &builtins[i]);
 }

@@ -37,6 +37,7 @@
     "atan2 y x: angle of (x, y) in radians; e.g. atan2 1 0")                 \
   X("exp", 1, bi_exp, "exp x: e to the power x; e.g. exp 1")                 \
   X("log", 1, bi_log, "log x: natural logarithm; e.g. log (exp 2)")          \
+  X("fract", 1, bi_fract, "fract x: x less its floor, in [0, 1); e.g. fract 2.25") \
   X("floor", 1, bi_floor, "floor x: the whole number at or below x; e.g. floor (-1.5)") \
   X("ceiling", 1, bi_ceiling, "ceiling x: the whole number at or above x; e.g. ceiling 1.2") \
   X("round", 1, bi_round, "round x: halves away from zero; e.g. round 2.5")  \
@@ -73,6 +74,11 @@
   X("%concatMap", 2, bi_concatMap, NULL)
 
 void builtins_install(Interp *I);
+
+/* If b is a Real function of n Reals defined everywhere (sqrt, floor,
+   min, ...: no error, no loop for any Real), sets *out to its value at x
+   and returns 1; else returns 0. */
+int builtin_num(const Builtin *b, int n, const double *x, double *out);
 /* Install one built-in as a global (the layers above use it for theirs).
    Its doc reads "NAME ARGS: what it does; e.g. EXAMPLE": :doc and :info
    show both parts, and the suite runs the example. */

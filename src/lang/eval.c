@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "lang/builtins.h"
 #include "lang/parse.h"
 #include "lang/print.h"
 #include "lang/resolve.h"
@@ -26,8 +27,10 @@ static __attribute__((noinline)) void scrub_stack(void) {
   __asm__ volatile("" : : "r"(pad) : "memory");
 }
 
-/* Runs at every evaluation step: no system calls, no allocation. */
-void eval_check(Interp *I, Pos pos) {
+/* eval_check (eval.h) found something to do: I->steps is counted and,
+   unless a check before failed, I->memcheck too. No system calls, no
+   allocation. */
+void eval_check_slow(Interp *I, Pos pos) {
   char probe;
   if (atomic_load_explicit(&qcs_interrupted, memory_order_relaxed)) {
     atomic_store(&qcs_interrupted, 0);
@@ -36,10 +39,10 @@ void eval_check(Interp *I, Pos pos) {
   if ((size_t)(I->stack_base - &probe) > I->stack_limit)
     eval_stack_error(I, pos, "recursion too deep: nested calls use",
                      "; is a base case missing?");
-  if (++I->steps > I->max_steps && I->max_steps)
+  if (I->steps > I->max_steps && I->max_steps)
     eval_limit_error(I, pos, "max-steps", "evaluation stopped after %llu steps",
                      I->max_steps);
-  if (++I->memcheck >= 4096) {
+  if (I->memcheck >= 4096) {
     I->memcheck = 0;
     if ((size_t)(I->stack_base - &probe) + 2 * STACK_SCRUB < I->stack_reserved)
       scrub_stack();
@@ -169,6 +172,18 @@ static Value *mk_thunk(Interp *I, Expr *e, Env *env) {
    it now cannot fail or loop, so laziness is unchanged, and an accumulator
    such as `count (n - 1) (acc + 1)` stays a number instead of growing a
    chain of a million thunks that would then be forced recursively. */
+/* What e, an E_VAR, is bound to now, as lookup() finds it, or NULL
+   (a constructor, or a name not defined: lookup() reports that). */
+static Value *known_var(Expr *e, Env *env) {
+  Value *v = lookup_local(e, env);
+  if (v) return v;
+  Sym *s = e->u.var;
+  if (s->con_arity >= 0) return NULL;
+  if (e->pos.src && e->pos.src->prelude && s->prelude_value)
+    return s->prelude_value;
+  return s->global;
+}
+
 static int known_num(Interp *I, Expr *e, Env *env, double *out) {
   char probe; /* a chain of a million '+' is left to eval, which checks */
   if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
@@ -177,10 +192,21 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
     *out = e->u.num;
     return 1;
   case E_VAR: {
-    Value *v = lookup_local(e, env);
+    Value *v = known_var(e, env);
     if (!v || v->kind != V_NUM) return 0;
     *out = v->u.num;
     return 1;
+  }
+  case E_APP: { /* floor x, min a b, ...: built-ins defined on every Real */
+    if (e->u.app.fn->kind != E_VAR || e->u.app.n > 2) return 0;
+    Value *f = known_var(e->u.app.fn, env);
+    if (!f || f->kind != V_FUNC || f->u.fn.kind != F_BUILTIN ||
+        f->u.fn.arity != e->u.app.n)
+      return 0;
+    double x[2];
+    for (int i = 0; i < e->u.app.n; i++)
+      if (!known_num(I, e->u.app.args[i], env, &x[i])) return 0;
+    return builtin_num(f->u.fn.u.bi, e->u.app.n, x, out);
   }
   case E_NEG:
     if (!known_num(I, e->u.neg, env, out)) return 0;
@@ -203,13 +229,117 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
   }
 }
 
-Value *delay(Interp *I, Expr *e, Env *env) {
-  double x;
-  if ((e->kind == E_BINOP || e->kind == E_NEG) && known_num(I, e, env, &x))
-    return val_num(x);
+/* The value of a literal, one per place it is written. */
+static Value *lit_num(Expr *e) {
+  if (!e->lit) e->lit = val_num(e->u.num);
+  return e->lit;
+}
+static Value *lit_str(Expr *e) {
+  if (!e->lit) e->lit = val_str(e->u.str);
+  return e->lit;
+}
+
+/* A tuple of at most VEC_BLOCK_MAX Reals known the same way (literals,
+   variables bound to evaluated ones, and the tuple arithmetic of arith()
+   on them when the sizes agree): its size, with the Reals in out[], or 0.
+   The arithmetic is arith()'s own (num_op), so the values are the same. */
+#define VEC_BLOCK_MAX 4
+static double num_op(TokKind op, double x, double y);
+static Value *vec_block(int n, const double *x);
+
+static int known_vec(Interp *I, Expr *e, Env *env, double *out) {
+  char probe;
+  if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
   switch (e->kind) {
-  case E_NUM: return val_num(e->u.num);
-  case E_STR: return val_str(e->u.str);
+  case E_VAR: {
+    Value *v = known_var(e, env);
+    if (!v || v->kind != V_TUPLE || v->u.tup.n > VEC_BLOCK_MAX) return 0;
+    for (int i = 0; i < v->u.tup.n; i++) {
+      Value *x = v->u.tup.items[i];
+      if (x->kind != V_NUM) return 0;
+      out[i] = x->u.num;
+    }
+    return v->u.tup.n;
+  }
+  case E_TUPLE: {
+    int n = e->u.tuple.n;
+    if (n > VEC_BLOCK_MAX) return 0;
+    for (int i = 0; i < n; i++)
+      if (!known_num(I, e->u.tuple.items[i], env, &out[i])) return 0;
+    return n;
+  }
+  case E_NEG: { /* as eval's: (-1) * t */
+    int n = known_vec(I, e->u.neg, env, out);
+    for (int i = 0; i < n; i++) out[i] = num_op(T_STAR, -1, out[i]);
+    return n;
+  }
+  case E_BINOP: {
+    TokKind op = e->u.bin.op;
+    double a[VEC_BLOCK_MAX], b[VEC_BLOCK_MAX], s;
+    if (op == T_PLUS || op == T_MINUS) {
+      int n = known_vec(I, e->u.bin.a, env, a);
+      if (!n || known_vec(I, e->u.bin.b, env, b) != n) return 0;
+      for (int i = 0; i < n; i++) out[i] = num_op(op, a[i], b[i]);
+      return n;
+    }
+    if (op == T_STAR && e->u.bin.a->kind != E_TUPLE &&
+        known_num(I, e->u.bin.a, env, &s)) {
+      int n = known_vec(I, e->u.bin.b, env, b);
+      for (int i = 0; i < n; i++) out[i] = num_op(op, s, b[i]);
+      return n;
+    }
+    if (op == T_STAR || op == T_SLASH) {
+      int n = known_vec(I, e->u.bin.a, env, a);
+      if (!n || !known_num(I, e->u.bin.b, env, &s)) return 0;
+      for (int i = 0; i < n; i++) out[i] = num_op(op, a[i], s);
+      return n;
+    }
+    return 0;
+  }
+  default:
+    return 0;
+  }
+}
+
+/* A constructor applied to all its arguments, in the user's code, is
+   built at once: that cannot fail, and its arguments stay delayed. */
+static Value *known_con(Interp *I, Expr *e, Env *env) {
+  Expr *fe = e->u.app.fn;
+  if (fe->kind != E_VAR || !e->pos.src || e->pos.src->prelude) return NULL;
+  Sym *c = fe->u.var;
+  if (c->con_arity != e->u.app.n || c->con_arity <= 0) return NULL;
+  if (lookup_local(fe, env)) return NULL; /* a local of that name */
+  int n = e->u.app.n;
+  Value **args = val_array(n);
+  for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
+  Value *v = val_con(c, n, args);
+  v->u.con.pos = &e->pos;
+  return v;
+}
+
+Value *delay(Interp *I, Expr *e, Env *env) {
+  double x, t[VEC_BLOCK_MAX];
+  int n;
+  switch (e->kind) {
+  case E_BINOP: case E_NEG:
+    if (known_num(I, e, env, &x)) return val_num(x);
+    if ((n = known_vec(I, e, env, t)) > 0) return vec_block(n, t);
+    break;
+  case E_TUPLE:
+    if ((n = known_vec(I, e, env, t)) > 0) return vec_block(n, t);
+    break;
+  case E_APP: {
+    if (known_num(I, e, env, &x)) return val_num(x);
+    Value *c = known_con(I, e, env);
+    if (c) return c;
+    break;
+  }
+  default:
+    break;
+  }
+  switch (e->kind) {
+  case E_NUM: return lit_num(e);
+  case E_STR: return lit_str(e);
   case E_BOOL: return val_bool(I, e->u.b);
   case E_VAR: return lookup(I, e, env);
   default: return mk_thunk(I, e, env);
@@ -541,13 +671,24 @@ static void brief_args(Interp *I, int n, Value **args, char *buf, size_t size) {
    returns the body and its environment for the caller to evaluate. */
 static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
                            Pos pos, Env **out_env) {
+  Env *spare = NULL; /* the frame of a clause that did not match */
   for (int c = 0; c < d->nclauses; c++) {
     Clause *cl = d->clauses[c];
-    Env *frame = env_new(env, cl->npats + cl->nwhere + 1);
+    Env *frame;
+    if (spare && spare->cap >= cl->npats + cl->nwhere + 1) {
+      frame = spare; /* nothing made by a failed match refers to it */
+      frame->n = 0;
+      spare = NULL;
+    } else {
+      frame = env_new(env, cl->npats + cl->nwhere + 1);
+    }
     int ok = 1;
     for (int i = 0; i < cl->npats && ok; i++)
       ok = match(I, cl->pats[i], args[i], frame);
-    if (!ok) continue;
+    if (!ok) {
+      spare = frame;
+      continue;
+    }
     if (cl->nwhere) bind_defs(I, cl->nwhere, cl->where, frame);
     for (int b = 0; b < cl->nbodies; b++) {
       Expr *g = cl->guards[b];
@@ -605,7 +746,8 @@ static int after_minus(Pos pos) {
 /* Apply f to n arguments. Returns 1 with (*body, *benv) set when the result
    is a function body to evaluate in tail position, or 0 with *result. */
 static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
-                Value **result, Expr **body, Env **benv, int depth) {
+                const Pos *spos, Value **result, Expr **body, Env **benv,
+                int depth) {
   /* A function given more arguments than it takes applies its result to
      the rest: if that is no function, the message says so by name. */
   const char *over_name = NULL;
@@ -657,9 +799,13 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
       memcpy(cargs, args, sizeof(Value *) * (size_t)a);
       *result = val_con(c, a, cargs);
       if (pos.src) { /* scene errors found later point back here */
-        Pos *p = GC_MALLOC(sizeof *p);
-        *p = eval_user_pos(I, pos);
-        (*result)->u.con.pos = p;
+        if (spos && !pos.src->prelude) {
+          (*result)->u.con.pos = spos;  /* the call's own, in its Expr */
+        } else {
+          Pos *p = val_small(sizeof *p);
+          *p = eval_user_pos(I, pos);
+          (*result)->u.con.pos = p;
+        }
       }
       return 0;
     }
@@ -674,9 +820,13 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
          here (eval() puts the origin back when it returns) */
       if (pos.src && !pos.src->prelude && d->pos.src &&
           d->pos.src->prelude) {
-        Pos *o = GC_MALLOC(sizeof *o);
-        *o = pos;
-        I->origin = o;
+        if (spos) {
+          I->origin = spos;
+        } else {
+          Pos *o = val_small(sizeof *o);
+          *o = pos;
+          I->origin = o;
+        }
       }
       Env *env;
       Expr *b = select_clause(I, d, f->u.fn.env, args, pos, &env);
@@ -715,7 +865,7 @@ Value *apply(Interp *I, Value *f, int n, Value **args, Pos pos) {
   Expr *body;
   Env *env;
   int depth = I->ntrace;
-  if (call(I, f, n, args, pos, &r, &body, &env, depth)) r = eval(I, body, env);
+  if (call(I, f, n, args, pos, NULL, &r, &body, &env, depth)) r = eval(I, body, env);
   I->ntrace = depth;
   return r;
 }
@@ -726,11 +876,50 @@ static int values_equal(Interp *I, Value *a, Value *b, Pos pos);
 
 static Value *arith(Interp *I, TokKind op, Value *a, Value *b, Pos pos);
 
+/* A tuple of n Reals as one block: the tuple, its item array and the n
+   Reals (the items point into the block). One allocation instead of
+   n + 2, and one object for the collector to mark. */
+static Value *vec_block(int n, const double *x) {
+  Value *t = val_small(sizeof(Value) * (size_t)(n + 1) +
+                       sizeof(Value *) * (size_t)n);
+  Value *nums = t + 1;
+  Value **it = (Value **)(nums + n);
+  for (int i = 0; i < n; i++) {
+    nums[i].kind = V_NUM;
+    nums[i].u.num = x[i];
+    it[i] = &nums[i];
+  }
+  t->kind = V_TUPLE;
+  t->u.tup.n = n;
+  t->u.tup.items = it;
+  return t;
+}
+
+static double num_op(TokKind op, double x, double y) {
+  switch (op) {
+  case T_PLUS: return x + y;
+  case T_MINUS: return x - y;
+  case T_STAR: return x * y;
+  case T_SLASH: return x / y;
+  default: return pow(x, y); /* T_CARET */
+  }
+}
+
 static Value *vec_map2(Interp *I, TokKind op, Value *a, Value *b, Pos pos) {
   if (a->u.tup.n != b->u.tup.n)
     qcs_error(pos, "'%s' on tuples of different sizes (%d and %d)",
               op_text(op), a->u.tup.n, b->u.tup.n);
   int n = a->u.tup.n;
+  if (n <= VEC_BLOCK_MAX) { /* Reals on both sides: no cell per item */
+    double x[VEC_BLOCK_MAX];
+    int i = 0;
+    for (; i < n; i++) {
+      Value *p = force(I, a->u.tup.items[i]), *q = force(I, b->u.tup.items[i]);
+      if (p->kind != V_NUM || q->kind != V_NUM) break;
+      x[i] = num_op(op, p->u.num, q->u.num);
+    }
+    if (i == n) return vec_block(n, x);
+  }
   Value **it = val_array(n);
   for (int i = 0; i < n; i++)
     it[i] = arith(I, op, force(I, a->u.tup.items[i]),
@@ -741,6 +930,17 @@ static Value *vec_map2(Interp *I, TokKind op, Value *a, Value *b, Pos pos) {
 static Value *vec_scale(Interp *I, TokKind op, Value *t, Value *s, int s_first,
                         Pos pos) {
   int n = t->u.tup.n;
+  if (n <= VEC_BLOCK_MAX && s->kind == V_NUM) {
+    double x[VEC_BLOCK_MAX];
+    int i = 0;
+    for (; i < n; i++) {
+      Value *p = force(I, t->u.tup.items[i]);
+      if (p->kind != V_NUM) break;
+      x[i] = s_first ? num_op(op, s->u.num, p->u.num)
+                     : num_op(op, p->u.num, s->u.num);
+    }
+    if (i == n) return vec_block(n, x);
+  }
   Value **it = val_array(n);
   for (int i = 0; i < n; i++) {
     Value *x = force(I, t->u.tup.items[i]);
@@ -1022,10 +1222,10 @@ Value *eval(Interp *I, Expr *e, Env *env) {
     eval_check(I, e->pos);
     switch (e->kind) {
     case E_NUM:
-      result = val_num(e->u.num);
+      result = lit_num(e);
       goto done;
     case E_STR:
-      result = val_str(e->u.str);
+      result = lit_str(e);
       goto done;
     case E_BOOL:
       result = val_bool(I, e->u.b);
@@ -1042,7 +1242,8 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
       Expr *body;
       Env *benv;
-      if (call(I, f, n, args, e->pos, &result, &body, &benv, tslot)) {
+      if (call(I, f, n, args, e->pos, &e->pos, &result, &body, &benv,
+               tslot)) {
         tslot = depth + 1;
         e = body;
         env = benv;
@@ -1074,7 +1275,13 @@ Value *eval(Interp *I, Expr *e, Env *env) {
               : e->u.cond.f;
       continue;
     case E_TUPLE: {
-      int n = e->u.tuple.n;
+      double t[VEC_BLOCK_MAX];
+      int n = known_vec(I, e, env, t);
+      if (n > 0) {
+        result = vec_block(n, t);
+        goto done;
+      }
+      n = e->u.tuple.n;
       Value **items = val_array(n);
       for (int i = 0; i < n; i++) items[i] = delay(I, e->u.tuple.items[i], env);
       result = val_tuple(n, items);

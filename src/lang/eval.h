@@ -64,8 +64,17 @@ Value *eval_con_value(Interp *I, Sym *s);
 void eval_restore(Interp *I, int nforcing);
 
 /* Recursion-depth, step and interrupt checks (also used by builtins that
-   loop). */
-void eval_check(Interp *I, Pos pos);
+   loop). The common case (nothing to report, not the 4096th step) is
+   inline; eval_check_slow does the rest. */
+void eval_check_slow(Interp *I, Pos pos);
+static inline void eval_check(Interp *I, Pos pos) {
+  char probe;
+  ++I->steps;
+  if (atomic_load_explicit(&qcs_interrupted, memory_order_relaxed) ||
+      (size_t)(I->stack_base - &probe) > I->stack_limit ||
+      (I->steps > I->max_steps && I->max_steps) || ++I->memcheck >= 4096)
+    eval_check_slow(I, pos);
+}
 
 /* Before one large allocation (a String): bytes more would pass
    max-memory -> the limit's error. */

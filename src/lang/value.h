@@ -113,6 +113,11 @@ struct Value {
    must be allocated by one thread at a time, the interpreter's. */
 Value *val_cell(void);
 
+/* A zeroed block of the collected heap for an array, a frame or a
+   position: batched like val_cell below 256 bytes (and so for the
+   interpreter's thread only), GC_MALLOC above. */
+void *val_small(size_t bytes);
+
 /* A frame of local bindings; `up` is the enclosing scope. */
 struct Env {
   Env *up;

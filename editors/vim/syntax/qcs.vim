@@ -20,11 +20,11 @@ syn keyword qcsConstructor Uniform Union Up
 syn keyword qcsBuiltin Density Displacement Field Gradient InnerBounds LG
 syn keyword qcsBuiltin OuterBounds PointInObject Roots Trace TrueDensity abs
 syn keyword qcsBuiltin acos asin atan atan2 ceiling clock concatMap cos cross
-syn keyword qcsBuiltin dot error exp floor foldl frame isInfinite isNaN length
-syn keyword qcsBuiltin log max meshWith min mod norm not pi plotConvolution
-syn keyword qcsBuiltin plotDisplacement plotField plotRay plotSlice product
-syn keyword qcsBuiltin renderWith round seq show showReal sin sqrt sum tan
-syn keyword qcsBuiltin truncate
+syn keyword qcsBuiltin dot error exp floor foldl fract frame isInfinite isNaN
+syn keyword qcsBuiltin length log max meshWith min mod norm not pi
+syn keyword qcsBuiltin plotConvolution plotDisplacement plotField plotRay
+syn keyword qcsBuiltin plotSlice product renderWith round seq show showReal
+syn keyword qcsBuiltin sin sqrt sum tan truncate
 syn keyword qcsPrelude AffineMap AffinePlane AffinePoint Ball BallWith Box
 syn keyword qcsPrelude ChordSides Cone ConeWith Cylinder CylinderWith
 syn keyword qcsPrelude DefaultChord DistanceOfPointFromPlane Dodecahedron
@@ -39,13 +39,13 @@ syn keyword qcsPrelude Tetrahedron Transform Translate Tube TubeWith UnionAll
 syn keyword qcsPrelude UnitCube Wedge all any ballFaces concat const cosd
 syn keyword qcsPrelude cycle cyclic3 drop dropWhile elem facetSides
 syn keyword qcsPrelude fibonacciSphere filter finiteReal flip foldTree foldl1
-syn keyword qcsPrelude foldr foldr1 fract fst head id init iterate kitCount
-syn keyword qcsPrelude kitSides kitSize last lookup map maximum mesh minimum
-syn keyword qcsPrelude mmul noNegZero normalize null otherwise phi
-syn keyword qcsPrelude polygonPlanes polyhedronOf positiveReal productOf
-syn keyword qcsPrelude render repeat replicate reverse row4 signs3 sind snd
-syn keyword qcsPrelude tail take takeWhile transpose transposeRows unzip
-syn keyword qcsPrelude wholeNumber zip zip3 zipWith
+syn keyword qcsPrelude foldr foldr1 fst head id init iterate kitCount kitSides
+syn keyword qcsPrelude kitSize last lookup map maximum mesh minimum mmul
+syn keyword qcsPrelude noNegZero normalize null otherwise phi polygonPlanes
+syn keyword qcsPrelude polyhedronOf positiveReal productOf render repeat
+syn keyword qcsPrelude replicate reverse row4 signs3 sind snd tail take
+syn keyword qcsPrelude takeWhile transpose transposeRows unzip wholeNumber zip
+syn keyword qcsPrelude zip3 zipWith
 
 " a capitalised name that is none of the above: a type or a user's constructor
 syn match qcsType "\<\u[A-Za-z0-9_']*\>"
