@@ -410,6 +410,8 @@ enum { LEAF_PLANE, LEAF_SMOOTH, LEAF_FINE, LEAF_EXACT };
 typedef struct {
   uint32_t q[3];           /* its lowest corner, in units of its side */
   unsigned char level, kind;
+  unsigned char plain;     /* its faces are plain (cell, set by the first
+                              pass) */
   int pl0, npl;            /* LEAF_EXACT: its planes, pls[pl0 .. + npl) */
   double w, gmin;          /* LEAF_SMOOTH: the gradient bound */
 } Leaf;
@@ -552,7 +554,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     m->rep->full++;
     return 0;
   }
-  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0};
+  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0};
   int leaf = level == m->depth;
   if (c == T_ONE && clip_in && !m->uniform) {
     const ScNode *nd = &m->s->nodes[one];
@@ -1411,8 +1413,43 @@ static const int kuhn[6][4] = {
     {0, 1, 7, 5}, {0, 4, 7, 6}, {0, 2, 7, 3}, /* odd, last two swapped */
 };
 
+/* The faces of cell q (level l) are all plain (see face): no cell of the
+   level sharing a face or an edge with it is split. */
+static int plain_cell(const Mesher *m, int l, const int64_t q[3]) {
+  for (int dx = -1; dx <= 1; dx++)
+    for (int dy = -1; dy <= 1; dy++)
+      for (int dz = -1; dz <= 1; dz++) {
+        int nz = (dx != 0) + (dy != 0) + (dz != 0);
+        if ((nz == 1 || nz == 2) &&
+            is_split(m, l, q[0] + dx, q[1] + dy, q[2] + dz))
+          return 0;
+      }
+  return 1;
+}
+
+/* The corner points of a plain cell, made in the order face makes them
+   (so that the points' numbers do not depend on the shortcut). */
+static int plain_points(Mesher *m, int l, const int64_t q[3]) {
+  static const int cu[4] = {0, 1, 1, 0}, cw[4] = {0, 0, 1, 1};
+  for (int a = 0; a < 3; a++)
+    for (int s = 0; s < 2; s++) {
+      int b = (a + 1) % 3, e = (a + 2) % 3;
+      for (int r = 0; r < 4; r++) {
+        int k0 = s ? r : (4 - r) % 4;
+        int64_t p0[3];
+        p0[a] = q[a] + s;
+        p0[b] = q[b] + cu[k0];
+        p0[e] = q[e] + cw[k0];
+        uint32_t dc[3];
+        for (int i = 0; i < 3; i++) dc[i] = (uint32_t)(p0[i] << (m->depth - l + 1));
+        if (point(m, dc) < 0) return -1;
+      }
+    }
+  return 0;
+}
+
 static int cell(Mesher *m, size_t leaf, size_t *count) {
-  const Leaf *lf = &m->leaves[leaf];
+  Leaf *lf = &m->leaves[leaf];
   m->cur = lf;
   int l = lf->level, plain = 1;
   int64_t q[3] = {lf->q[0], lf->q[1], lf->q[2]};
@@ -1438,10 +1475,17 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
     mk = exact_tet;
   }
   m->nft = 0;
-  if (l < m->depth)
+  /* the first pass (count) finds whether the faces are plain: a plain
+     cell needs only its corners */
+  if (count) lf->plain = (unsigned char)(l == m->depth || plain_cell(m, l, q));
+  if (lf->plain) {
+    if (count && l < m->depth && plain_points(m, l, q) < 0) return -1;
+  } else {
     for (int a = 0; a < 3; a++)
       for (int s = 0; s < 2; s++)
         if (face(m, l, q, a, s, &plain) < 0) return -1;
+    if (plain) return (void)(m->err = MESH_EINTERNAL), -1;
+  }
   if (plain) {
     int c[8];
     for (int k = 0; k < 8; k++) {
@@ -1745,6 +1789,26 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_ELIMIT;
     goto done;
   }
+  /* the octree's maps are done with: free them before the check's
+     tables are made (the peak) */
+  hfree(&m.split);
+  hfree(&m.pt);
+  hfree(&m.vert);
+  hfree(&m.crease);
+  free(m.vert2.k);
+  free(m.vert2.v);
+  free(m.fpath.k);
+  free(m.fpath.v);
+  free(m.pc);
+  free(m.ps);
+  memset(&m.split, 0, sizeof m.split);
+  memset(&m.pt, 0, sizeof m.pt);
+  memset(&m.vert, 0, sizeof m.vert);
+  memset(&m.crease, 0, sizeof m.crease);
+  memset(&m.vert2, 0, sizeof m.vert2);
+  memset(&m.fpath, 0, sizeof m.fpath);
+  m.pc = NULL;
+  m.ps = NULL;
   Mesh *me = malloc(sizeof *me);
   if (!me) {
     rc = MESH_ENOMEM;
@@ -1753,8 +1817,11 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   me->nv = m.nv;
   me->nt = m.nt;
   me->rgb = NULL;
-  me->v = m.v;
-  me->t = m.t;
+  /* the arrays grew by doubling: give back what is not used */
+  double *v2 = m.nv ? realloc(m.v, 3 * m.nv * sizeof *m.v) : NULL;
+  int *t2 = m.nt ? realloc(m.t, 3 * m.nt * sizeof *m.t) : NULL;
+  me->v = v2 ? v2 : m.v;
+  me->t = t2 ? t2 : m.t;
   m.v = NULL;
   m.t = NULL;
   MeshCheck ck;
@@ -1826,121 +1893,107 @@ static int find(int *p, int x) {
   return x;
 }
 
+/* Each vertex's wedges (one per triangle corner at it: the next vertex,
+   the one after, the triangle) in one array, vertex by vertex; an edge
+   a -> b is found by scanning a's wedges, and its reverse b's (a few
+   each), so no hash table is needed (at 4 million triangles the hash
+   tables of directed and undirected edges took 600 MB). */
 int mesh_check(const Mesh *m, MeshCheck *c) {
   memset(c, 0, sizeof *c);
-  hmap de = {0};           /* directed edge -> count */
-  int *par = malloc((m->nt ? m->nt : 1) * sizeof *par);
-  int *deg = calloc(m->nv ? m->nv : 1, sizeof *deg);
-  int *nxt = NULL;
+  size_t nv = m->nv, nt = m->nt;
+  int *par = malloc((nt ? nt : 1) * sizeof *par);
+  size_t *start = malloc((nv + 1) * sizeof *start);
+  int *deg = calloc(nv ? nv : 1, sizeof *deg);
+  int *w = malloc(9 * (nt ? nt : 1) * sizeof *w);
   long edges = 0, used = 0;
   int rc = 0;
-  if (!par || !deg) goto nomem;
-  for (size_t i = 0; i < m->nt; i++) {
+  if (!par || !start || !deg || !w) {
+    rc = -2;
+    goto out;
+  }
+  for (size_t i = 0; i < nt; i++) {
     par[i] = (int)i;
     const int *t = m->t + 3 * i;
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) c->degenerate++;
+    for (int e = 0; e < 3; e++) deg[t[e]]++;
+  }
+  size_t tot = 0;
+  for (size_t v = 0; v < nv; v++) {
+    start[v] = tot;
+    tot += (size_t)deg[v];
+    used += deg[v] > 0;
+    deg[v] = 0; /* refilled below */
+  }
+  start[nv] = tot;
+  for (size_t i = 0; i < nt; i++) {
+    const int *t = m->t + 3 * i;
     for (int e = 0; e < 3; e++) {
-      uint64_t a = (uint64_t)t[e], b = (uint64_t)t[(e + 1) % 3];
-      uint64_t k = a << 32 | b;
-      int n = hget(&de, k);
-      if (hput(&de, k, n < 0 ? 1 : n + 1) < 0) goto nomem;
-      deg[t[e]]++;
+      int v = t[e];
+      size_t s = 3 * (start[v] + (size_t)deg[v]++);
+      w[s] = t[(e + 1) % 3];
+      w[s + 1] = t[(e + 2) % 3];
+      w[s + 2] = (int)i;
     }
   }
-  for (size_t i = 0; i < de.cap; i++) {
-    if (!de.k[i]) continue;
-    uint64_t k = de.k[i] - 1, r = (k & 0xffffffffu) << 32 | k >> 32;
-    if (de.v[i] > 1) c->nonmanifold_edges++;
-    if (hget(&de, r) != 1) c->boundary_edges++;
-    edges++;
+  for (size_t a = 0; a < nv; a++) {
+    const int *fa = w + 3 * start[a];
+    int na = deg[a];
+    for (int x = 0; x < na; x++) {
+      int b = fa[3 * x], first = 1, n = 0;
+      for (int y = 0; y < na; y++)
+        if (fa[3 * y] == b) {
+          first &= y >= x;
+          n++;
+          par[find(par, fa[3 * y + 2])] = find(par, fa[3 * x + 2]);
+        }
+      if (!first) continue; /* the directed edge a -> b counted once */
+      int r = 0;
+      const int *fb = w + 3 * start[b];
+      for (int y = 0; y < deg[b]; y++)
+        if (fb[3 * y] == (int)a) {
+          r++;
+          par[find(par, fb[3 * y + 2])] = find(par, fa[3 * x + 2]);
+        }
+      if (n > 1) c->nonmanifold_edges++;
+      if (r != 1) c->boundary_edges++;
+      edges++;
+    }
   }
   edges /= 2;
-  /* components: triangles joined through shared edges */
-  {
-    hmap first = {0}; /* undirected edge -> a triangle */
-    for (size_t i = 0; i < m->nt; i++) {
-      const int *t = m->t + 3 * i;
-      for (int e = 0; e < 3; e++) {
-        uint64_t a = (uint64_t)t[e], b = (uint64_t)t[(e + 1) % 3];
-        uint64_t k = a < b ? a << 32 | b : b << 32 | a;
-        int o = hget(&first, k);
-        if (o < 0) {
-          if (hput(&first, k, (int)i) < 0) {
-            hfree(&first);
-            goto nomem;
-          }
-        } else {
-          par[find(par, o)] = find(par, (int)i);
-        }
-      }
-    }
-    hfree(&first);
-    for (size_t i = 0; i < m->nt; i++) c->components += find(par, (int)i) == (int)i;
-  }
+  for (size_t i = 0; i < nt; i++) c->components += find(par, (int)i) == (int)i;
   /* vertex fans: around each vertex, the triangles' opposite edges must
      chain into one cycle (checked by following next-vertex links) */
-  {
-    size_t tot = 0;
-    int *start = malloc((m->nv + 1) * sizeof *start);
-    if (!start) goto nomem;
-    for (size_t v = 0; v < m->nv; v++) {
-      start[v] = (int)tot;
-      tot += (size_t)deg[v];
-      used += deg[v] > 0;
-    }
-    start[m->nv] = (int)tot;
-    nxt = malloc(2 * (tot ? tot : 1) * sizeof *nxt);
-    int *fill = calloc(m->nv ? m->nv : 1, sizeof *fill);
-    if (!nxt || !fill) {
-      free(start);
-      free(fill);
-      goto nomem;
-    }
-    for (size_t i = 0; i < m->nt; i++) {
-      const int *t = m->t + 3 * i;
-      for (int e = 0; e < 3; e++) {
-        int v = t[e], slot = start[v] + fill[v]++;
-        nxt[2 * slot] = t[(e + 1) % 3];
-        nxt[2 * slot + 1] = t[(e + 2) % 3];
-      }
-    }
-    for (size_t v = 0; v < m->nv; v++) {
-      int n = deg[v];
-      if (!n) continue;
-      const int *f = nxt + 2 * start[v];
-      /* follow b -> c links from the first wedge; one cycle of n wedges */
-      int cur = f[1], steps = 1, ok = 1;
-      while (cur != f[0] && ok) {
-        int found = -1;
-        for (int w = 0; w < n; w++)
-          if (f[2 * w] == cur) {
-            found = w;
-            break;
-          }
-        if (found < 0 || steps > n) ok = 0;
-        else {
-          cur = f[2 * found + 1];
-          steps++;
+  for (size_t v = 0; v < nv; v++) {
+    int n = deg[v];
+    if (!n) continue;
+    const int *f = w + 3 * start[v];
+    /* follow b -> c links from the first wedge; one cycle of n wedges */
+    int cur = f[1], steps = 1, ok = 1;
+    while (cur != f[0] && ok) {
+      int found = -1;
+      for (int q = 0; q < n; q++)
+        if (f[3 * q] == cur) {
+          found = q;
+          break;
         }
+      if (found < 0 || steps > n) ok = 0;
+      else {
+        cur = f[3 * found + 1];
+        steps++;
       }
-      if (!ok || steps != n) c->nonmanifold_verts++;
     }
-    free(start);
-    free(fill);
+    if (!ok || steps != n) c->nonmanifold_verts++;
   }
-  c->euler = used - edges + (long)m->nt;
+  c->euler = used - edges + (long)nt;
   rc = c->boundary_edges || c->nonmanifold_edges || c->nonmanifold_verts ||
                c->degenerate
            ? -1
            : 0;
-  goto out;
-nomem:
-  rc = -2;
 out:
-  hfree(&de);
   free(par);
+  free(start);
   free(deg);
-  free(nxt);
+  free(w);
   return rc;
 }
 
@@ -2264,6 +2317,9 @@ out:
 int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
   buf b = {0};
   if (!strcmp(ext_of(path), "stl")) {
+    /* its size is known: no doubling of a large buffer */
+    b.cap = 84 + 50 * m->nt;
+    if (!(b.p = malloc(b.cap))) b.bad = 1;
     char head[80] = "binary STL written by qcs";
     put(&b, head, 80);
     unsigned char q[4];
