@@ -394,7 +394,42 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   }
   double gmin = al > 0 ? al : (ah < 0 ? -ah : 0);
   if (!(gmin > 0) || !isfinite(w)) return -1;
+  /* the deviation from g0 along u = g0 / |g0| and across it */
+  double wu = 0, wp = 0;
+  for (int i = 0; i < r->n; i++) {
+    double k = vec3_dot(t->leaves[r->leaf[i]].n, g0) / len;
+    double hw = 0.5 * (r->ch[i] - r->cl[i]);
+    wu += hw * fabs(k);
+    wp += hw * sqrt(fmax(0, 1 - k * k));
+  }
+  /* chords of the surface are nearly across u: see tri_bound */
+  double we = wp * (1 + wu / (gmin * (1 - 1e-9)));
+  if (we < w) w = we;
   b->w = w * (1 + 1e-9) + 1e-300;
+  b->gmin = gmin * (1 - 1e-9);
+  return 0;
+}
+
+/* The gradient bound from per-axis intervals [gl, gh] of the gradient
+   over a box (a soft object's field, soft_grad_box): g0 the midpoint, w
+   the radii's length, gmin the lower bound of grad . g0 / |g0|. 0, or -1
+   when it is not positive. */
+static int grad_axes(const double gl[3], const double gh[3], GrBound *b) {
+  double g0[3], r2 = 0;
+  for (int j = 0; j < 3; j++) {
+    g0[j] = 0.5 * (gl[j] + gh[j]);
+    double r = 0.5 * (gh[j] - gl[j]);
+    r2 += r * r;
+  }
+  double len = sqrt(vec3_dot(g0, g0)), gmin = 0;
+  if (!(len > 0) || !isfinite(len) || !isfinite(r2)) return -1;
+  for (int j = 0; j < 3; j++) {
+    double u = g0[j] / len;
+    gmin += u > 0 ? u * gl[j] : u * gh[j];
+  }
+  if (!(gmin > 0)) return -1;
+  memset(b, 0, sizeof *b);
+  b->w = sqrt(r2) * (1 + 1e-9) + 1e-300;
   b->gmin = gmin * (1 - 1e-9);
   return 0;
 }
@@ -561,14 +596,20 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     if (nd->kind == SC_HALFSPACE) {
       lf.kind = LEAF_PLANE;
       leaf = 1;
-    } else if (nd->kind == SC_ROUNDED) {
-      double gl[3], gh[3];
+    } else if (nd->kind == SC_ROUNDED || nd->kind == SC_SOFT) {
+      double gl[3], gh[3], dl[3], dh[3];
       GrBound b;
       for (int a = 0; a < 3; a++) {
         gl[a] = lo[a] - m->tol;
         gh[a] = hi[a] + m->tol;
       }
-      if (grad_box(nd->tape, gl, gh, m->gst, &b) == 0) {
+      int ok;
+      if (nd->kind == SC_ROUNDED) ok = grad_box(nd->tape, gl, gh, m->gst, &b) == 0;
+      else {
+        soft_grad_box(nd->soft, gl, gh, dl, dh);
+        ok = grad_axes(dl, dh, &b) == 0;
+      }
+      if (ok) {
         double d = sqrt(3.0) * side;
         if (b.planar) {
           lf.kind = LEAF_PLANE;
