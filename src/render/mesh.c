@@ -2366,14 +2366,23 @@ int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
     unsigned char q[4];
     for (int i = 0; i < 4; i++) q[i] = (unsigned char)(m->nt >> (8 * i));
     put(&b, q, 4);
-    for (size_t i = 0; i < m->nt; i++) {
-      double n[3];
+    for (size_t i = 0; i < m->nt && !b.bad; i++) {
+      /* 50 bytes a triangle, straight into the buffer sized above */
+      double n[3], f[12];
       tri_normal(m, i, n);
       double l = sqrt(vec3_dot(n, n));
-      for (int k = 0; k < 3; k++) put_f32(&b, l > 0 ? n[k] / l : 0);
+      for (int k = 0; k < 3; k++) f[k] = l > 0 ? n[k] / l : 0;
       for (int k = 0; k < 3; k++)
-        for (int j = 0; j < 3; j++) put_f32(&b, m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)j]);
-      put(&b, "\0\0", 2);
+        for (int j = 0; j < 3; j++) f[3 + 3 * k + j] = m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)j];
+      unsigned char *o = (unsigned char *)b.p + b.n;
+      for (int k = 0; k < 12; k++) {
+        float x = (float)f[k];
+        uint32_t u;
+        memcpy(&u, &x, 4);
+        for (int r = 0; r < 4; r++) o[4 * k + r] = (unsigned char)(u >> (8 * r));
+      }
+      o[48] = o[49] = 0;
+      b.n += 50;
     }
   } else if (!strcmp(ext_of(path), "obj")) {
     double *vn = calloc(3 * (m->nv ? m->nv : 1), sizeof *vn);
