@@ -2053,61 +2053,42 @@ int mesh_is_mesh_path(const char *path) {
 
 /* ---- colours ------------------------------------------------------------ */
 
-/* The top-level union's parts with their inherited Colour (as the tracer
-   collects them). */
+/* The top-level union's parts with their inherited Colour
+   (scene_union_parts, the walk the tracer's collect_prims makes too). */
+typedef struct {
+  int *parts;
+  const double **cols;
+  int n, cap;
+} Parts;
+
+static int add_part(void *ctx, int part, const double *colour) {
+  Parts *p = ctx;
+  if (p->n == p->cap) {
+    int nc = p->cap ? 2 * p->cap : 16;
+    int *g = realloc(p->parts, (size_t)nc * sizeof *g);
+    if (g) p->parts = g;
+    const double **gc = realloc(p->cols, (size_t)nc * sizeof *gc);
+    if (gc) p->cols = gc;
+    if (!g || !gc) return -1;
+    p->cap = nc;
+  }
+  p->parts[p->n] = part;
+  p->cols[p->n++] = colour;
+  return 0;
+}
+
 static int collect_parts(const Scene *s, int root, int **parts,
                          const double ***cols, int *n) {
-  int cap = 16, sp = 0, capst = 16;
-  int *st = malloc((size_t)capst * sizeof *st);
-  const double **stc = malloc((size_t)capst * sizeof *stc);
-  *parts = malloc((size_t)cap * sizeof **parts);
-  *cols = malloc((size_t)cap * sizeof **cols);
-  *n = 0;
-  if (!st || !stc || !*parts || !*cols) goto nomem;
-  st[sp] = root;
-  stc[sp++] = NULL;
-  while (sp) {
-    sp--;
-    int nd = st[sp];
-    const ScNode *x = &s->nodes[nd];
-    const double *c = x->has_colour ? x->colour : stc[sp];
-    if (x->kind == SC_UNION) {
-      if (sp + 2 > capst) {
-        capst *= 2;
-        int *g = realloc(st, (size_t)capst * sizeof *st);
-        if (g) st = g;
-        const double **gc = realloc(stc, (size_t)capst * sizeof *stc);
-        if (gc) stc = gc;
-        if (!g || !gc) goto nomem;
-      }
-      st[sp] = x->b;
-      stc[sp++] = c;
-      st[sp] = x->a;
-      stc[sp++] = c;
-      continue;
-    }
-    if (*n == cap) {
-      cap *= 2;
-      int *g = realloc(*parts, (size_t)cap * sizeof **parts);
-      if (g) *parts = g;
-      const double **gc = realloc(*cols, (size_t)cap * sizeof **cols);
-      if (gc) *cols = gc;
-      if (!g || !gc) goto nomem;
-    }
-    (*parts)[*n] = nd;
-    (*cols)[(*n)++] = c;
+  Parts p = {NULL, NULL, 0, 0};
+  if (scene_union_parts(s, root, add_part, &p) < 0) {
+    free(p.parts);
+    free(p.cols);
+    return -1;
   }
-  free(st);
-  free(stc);
+  *parts = p.parts;
+  *cols = p.cols;
+  *n = p.n;
   return 0;
-nomem:
-  free(st);
-  free(stc);
-  free(*parts);
-  free(*cols);
-  *parts = NULL;
-  *cols = NULL;
-  return -1;
 }
 
 int mesh_colour(const Scene *s, int node, Mesh *m, const double def[3],
