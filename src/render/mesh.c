@@ -794,7 +794,11 @@ static double tri_bound(const Mesher *m, int a, int b, int c) {
   case LEAF_SMOOTH: {
     double d = fmax(dist3(pa, pb), fmax(dist3(pb, pc), dist3(pa, pc)));
     /* sum_i l_i |p - x_i| <= sum_i l_i (1 - l_i) D'' <= 2/3 D'', with
-       D'' <= d + 2 vtol the crossings' diameter (sum l_i^2 >= 1/3) */
+       D'' <= d + 2 vtol the crossings' diameter (sum l_i^2 >= 1/3); w is
+       grad_box's: the whole deviation, or w_perp (1 + w_par / gmin) where
+       smaller (each p - x_i a combination of chords c between crossings,
+       |c . u| gmin <= w_perp |c| since the density is equal at both ends,
+       so the deviation along u meets only w_perp / gmin of the length) */
     return m->vtol + m->cur->w * (2.0 / 3) * (d + 2 * m->vtol) / m->cur->gmin;
   }
   default: return m->vtol + cover_radius(pa, pb, pc);
