@@ -303,7 +303,36 @@ typedef struct {
   int planar;              /* one live leaf: the 0.5 level is a plane */
   double w;                /* |grad - g0| <= w over the box */
   double gmin;             /* grad . n0 >= gmin > 0 over the box */
+  double n0[3];            /* the unit direction of g0 */
+  double slope;            /* |grad - (grad . n0) n0| / gmin bound: a chord
+                              c between two points of the surface in the
+                              box has |c . n0| <= slope |c| */
 } GrBound;
+
+/* The longest vector c in [-1, 1]^3 (the difference of two points of a
+   unit cube) with |c . u| <= tau (u a unit vector): |c|^2 is convex, so
+   its largest value on that convex polytope is at a vertex, a cube
+   corner inside the slab or where the slab's planes cut a cube edge. */
+static double chord_max(const double u[3], double tau) {
+  double best = 0;
+  for (int c = 0; c < 8; c++) {
+    double v[3] = {c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1};
+    if (fabs(vec3_dot(v, u)) <= tau) best = fmax(best, vec3_dot(v, v));
+  }
+  for (int a = 0; a < 3; a++) { /* edges along axis a */
+    int b = (a + 1) % 3, e = (a + 2) % 3;
+    if (u[a] == 0) continue;
+    for (int c = 0; c < 4; c++)
+      for (int sgn = -1; sgn <= 1; sgn += 2) {
+        double v[3];
+        v[b] = c & 1 ? 1 : -1;
+        v[e] = c & 2 ? 1 : -1;
+        v[a] = (sgn * tau - u[b] * v[b] - u[e] * v[e]) / u[a];
+        if (fabs(v[a]) <= 1) best = fmax(best, vec3_dot(v, v));
+      }
+  }
+  return sqrt(best) * (1 + 1e-12);
+}
 
 /* The gradient bound of t over [lo, hi]: 0 when found (*b), -1 when the
    tape is not smooth there (a sharp leaf crosses it, too many live leaves,
@@ -405,6 +434,8 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   /* chords of the surface are nearly across u: see tri_bound */
   double we = wp * (1 + wu / (gmin * (1 - 1e-9)));
   if (we < w) w = we;
+  for (int q = 0; q < 3; q++) b->n0[q] = g0[q] / len;
+  b->slope = wp * (1 + 1e-9) / (gmin * (1 - 1e-9));
   b->w = w * (1 + 1e-9) + 1e-300;
   b->gmin = gmin * (1 - 1e-9);
   return 0;
@@ -431,6 +462,8 @@ static int grad_axes(const double gl[3], const double gh[3], GrBound *b) {
   memset(b, 0, sizeof *b);
   b->w = sqrt(r2) * (1 + 1e-9) + 1e-300;
   b->gmin = gmin * (1 - 1e-9);
+  for (int j = 0; j < 3; j++) b->n0[j] = g0[j] / len;
+  b->slope = b->w / b->gmin; /* |grad_perp| <= |grad - g0| */
   return 0;
 }
 
@@ -614,7 +647,14 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
         if (b.planar) {
           lf.kind = LEAF_PLANE;
           leaf = 1;
-        } else if (m->vtol + b.w * (2.0 / 3) * (d + 2 * m->vtol) / b.gmin <= m->tol) {
+        } else if (m->vtol + b.w * (2.0 / 3) *
+                                 fmin(d + 2 * m->vtol,
+                                      side * chord_max(b.n0, sqrt(3.0) * b.slope)) /
+                               b.gmin <= m->tol) {
+          /* the crossings' diameter: chords of the surface in the cell
+             are within slope of across n0, so at most the cell's longest
+             such chord (|c| <= sqrt 3 side gives |c . n0| <= sqrt 3 slope
+             side) */
           lf.kind = LEAF_SMOOTH;
           lf.w = b.w;
           lf.gmin = b.gmin;
