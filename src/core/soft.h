@@ -93,6 +93,16 @@ int soft_surface_bounds(const soft_obj *obj, double lo[3], double hi[3]);
 int soft_field_box(const soft_obj *obj, const double lo[3], const double hi[3],
                    double *flo, double *fhi);
 
+/* Bounds [gl[j], gh[j]] on each component of the field's gradient over
+ * the closed box [lo, hi]: per key, 2 w C'(s) A (x - x0), with C'(s)
+ * over the range of s on the box (C' rises on s < 1, where it reaches
+ * 0) and each component of A (x - x0) exactly (it is linear), their
+ * product by interval multiplication; summed, widened for rounding. The
+ * mesher's proof that the surface in a cell is smooth enough. Every key
+ * is visited (O(keys)). Returns 0. */
+int soft_grad_box(const soft_obj *obj, const double lo[3], const double hi[3],
+                  double gl[3], double gh[3]);
+
 /* eq. (1) summed over the keys: the field at p. */
 double soft_field(const soft_obj *obj, const double p[3]);
 
