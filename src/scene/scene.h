@@ -93,9 +93,9 @@ void scene_free(Scene *s);
    carries the Colour of its nearest coloured ancestor-or-self in the
    union (NULL: none). fn is called once per part in that order; a
    nonzero return stops the walk and is returned. -1 if memory runs out
-   (a union deeper than 32 levels needs a stack). The mesher's colouring
-   calls it; the tracer's collect_prims (render/render.c) still makes the
-   same walk itself, to be switched over when that file is free. */
+   (a union deeper than 32 levels needs a stack). The tracer's primitives
+   (render/render.c) and the mesher's colouring both come from it, so a
+   part is coloured the same in a picture and in a .ply or .3mf. */
 int scene_union_parts(const Scene *s, int node,
                       int (*fn)(void *ctx, int part, const double *colour),
                       void *ctx);
