@@ -1838,8 +1838,18 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     goto done;
   }
   if (count == 0) {
-    snprintf(err, errlen, "the object is empty: no inside point was found "
-             "in its box at this tolerance (%g)", e);
+    double thin = INFINITY; /* the box's least side: a hint, not a proof */
+    for (int i = 0; i < 3; i++) thin = fmin(thin, hi[i] - lo[i]);
+    if (rep->leaves > 0)
+      /* cells were left undecided, so the surface may pass through them
+         between their corners: a solid thinner than a cell */
+      snprintf(err, errlen, "no inside point was found at this tolerance "
+               "(%g): the object is empty, or thinner than a cell (side "
+               "%.3g) everywhere; its box is %.3g thin at the least: try "
+               "meshWith [Tolerance %.2g]", e, m.h, thin, thin / 10);
+    else
+      snprintf(err, errlen, "the object is empty: every cell of its box "
+               "is proven outside it");
     rc = MESH_EEMPTY;
     goto done;
   }
