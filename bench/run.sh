@@ -430,7 +430,9 @@ if [ $CALLGRIND -eq 1 ]; then
   bash bench/callgrind.sh && CG=1
 fi
 
-# bench/README.md: how to run, and this run's summary.
+# bench/README.md: how to run, this run's summary, then bench/NOTES.md.
+# The file is written whole each run: observations that must last go in
+# bench/NOTES.md, never into bench/README.md by hand.
 {
   cat <<EOF
 # bench: qcs against POV-Ray 3.7 (issue 7)
@@ -449,7 +451,12 @@ of whole-process wall time. The machines are shared and noisy: the
 - \`bench/results.csv\`: the table of the last run, one row per scene.
 - \`make bench-callgrind\` (\`bench/callgrind.sh\`): instruction counts per scene
   at 150x95, one thread, under \`valgrind --tool=callgrind\`, into
-  \`bench/callgrind.csv\`; these are repeatable, so regressions show.
+  \`bench/callgrind.csv\`; these are repeatable, so regressions show. Where
+  they go: each function's own count per scene in
+  \`bench/callgrind-functions.csv\`, and the run prints every scene's top
+  functions (\`CG_TOP\`, 8) against the previous file's, so a gain or a loss
+  names the functions it came from. \`bash bench/callgrind.sh SCENE ...\` runs
+  a few scenes and keeps the other rows.
 - \`bash bench/interp.sh [-n REPS]\` (run by \`make bench\`; \`INTERP_BENCH=0\` skips it):
   the interpreter against Hugs 98 on the programs of \`bench/hugs/\` (each
   written in qcs and in Haskell), paired runs, medians of wall time and of

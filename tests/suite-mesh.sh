@@ -43,6 +43,17 @@ for t in 0 "0/0" 1e-300; do
   elif grep -q "tolerance" "$tmp/err" && [ ! -e "$tmp/t.stl" ]; then echo "ok mesh: tolerance $t refused"
   else echo "FAIL mesh: tolerance $t: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 done
+# a rod thinner than the default tolerance's cells: not "empty" but said
+# to be thinner than a cell, with a tolerance to try, which then works
+printf 'mesh "rod.stl" (Scale (20, 0.1, 0.1) (Rounded 0.1 UnitCube))\n' > "$tmp/rod.qcs"
+if (cd "$tmp" && "$top/$QCS" rod.qcs > out 2> err); then echo "FAIL mesh: a rod thinner than a cell gave no error"
+elif grep -q "thinner than a cell" "$tmp/err" && [ ! -e "$tmp/rod.stl" ] &&
+     try=$(sed -n 's/.*try meshWith \[Tolerance \([0-9.e-]*\)\].*/\1/p' "$tmp/err") && [ -n "$try" ]; then
+  printf 'meshWith [Tolerance %s] "rod.stl" (Scale (20, 0.1, 0.1) (Rounded 0.1 UnitCube))\n' "$try" > "$tmp/rod2.qcs"
+  if (cd "$tmp" && "$top/$QCS" rod2.qcs > out 2> err2) && [ -s "$tmp/rod.stl" ]; then
+    echo "ok mesh: a rod thinner than a cell is said to be, and the tolerance suggested ($try) meshes it"
+  else echo "FAIL mesh: the suggested tolerance $try: $(head -c 300 "$tmp/err2" | tr '\n' ' ')"; fi
+else echo "FAIL mesh: thin rod: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 printf 'meshWith [MaxTriangles 1000] "big.stl" (Rounded 0.2 UnitCube)\n' > "$tmp/big.qcs"
 if (cd "$tmp" && "$top/$QCS" big.qcs > out 2> err); then echo "FAIL mesh: MaxTriangles ignored"
 elif grep -q "max-triangles" "$tmp/err" && [ ! -e "$tmp/big.stl" ]; then echo "ok mesh: MaxTriangles refuses, no file"

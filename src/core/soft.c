@@ -10,6 +10,7 @@
 
 #include "core/bvh.h"
 #include "core/heap.h"
+#include "core/interval.h"
 #include "core/vec.h"
 
 /* eq. (1) as a cubic in s = r^2/R^2: C = 1 + A1 s + A2 s^2 + A3 s^3. */
@@ -310,36 +311,108 @@ static void box_dist2(const double lo[3], const double hi[3], double *dmin2,
   *dmax2 = b;
 }
 
+/* The range [*smin, *smax] of key k's s over the box whose offsets from
+ * its centre are [ol, oh], widened for rounding: |p|^2 times A's
+ * eigenvalue bounds (Gershgorin's discs for a quadric), and for a quadric
+ * also the centred form s(c + e) = s(c) + 2 (A c) . e + e'Ae with
+ * 0 <= e'Ae <= lmax |e|^2, which is tight for a small box far from the
+ * centre (where the eigenvalue spread would give a wide range). */
+static void key_s_range(const nkey *k, const double ol[3], const double oh[3],
+                        double *smin, double *smax) {
+  double dmin2, dmax2, lmin, lmax;
+  box_dist2(ol, oh, &dmin2, &dmax2);
+  if (k->sphere) {
+    lmin = lmax = k->a[0];
+  } else { /* Gershgorin's discs bound A's eigenvalues */
+    double r0 = fabs(k->a[3]) + fabs(k->a[4]);
+    double r1 = fabs(k->a[3]) + fabs(k->a[5]);
+    double r2 = fabs(k->a[4]) + fabs(k->a[5]);
+    lmin = fmin(k->a[0] - r0, fmin(k->a[1] - r1, k->a[2] - r2));
+    lmax = fmax(k->a[0] + r0, fmax(k->a[1] + r1, k->a[2] + r2));
+    if (lmin < 0) lmin = 0;
+  }
+  double l = lmin * dmin2 + k->k, h = lmax * dmax2 + k->k;
+  if (!k->sphere) {
+    double c[3], e[3], ac[3], e2 = 0, lin = 0;
+    for (int j = 0; j < 3; j++) {
+      c[j] = 0.5 * (ol[j] + oh[j]);
+      e[j] = 0.5 * (oh[j] - ol[j]);
+      e2 += e[j] * e[j];
+    }
+    ac[0] = k->a[0] * c[0] + k->a[3] * c[1] + k->a[4] * c[2];
+    ac[1] = k->a[3] * c[0] + k->a[1] * c[1] + k->a[5] * c[2];
+    ac[2] = k->a[4] * c[0] + k->a[5] * c[1] + k->a[2] * c[2];
+    for (int j = 0; j < 3; j++) lin += 2 * fabs(ac[j]) * e[j];
+    double sc = vec3_dot(c, ac) + k->k;
+    /* rounding of the centred form: a relative 1e-12 of its terms */
+    double err = 1e-12 * (fabs(sc) + lin + lmax * e2 + fabs(k->k) + 1);
+    l = fmax(l, sc - lin - err);
+    h = fmin(h, sc + lin + lmax * e2 + err);
+  }
+  *smin = l - 1e-12 * (fabs(l) + 1);
+  *smax = h + 1e-12 * (fabs(h) + 1);
+}
+
+/* The keys whose bounds may meet the box [lo, hi], in index order: a
+ * left-first walk of the key BVH that skips the subtrees whose box misses
+ * it (leaves hold consecutive keys, so the walk meets them in increasing
+ * order, as a scan of all keys would). The caller still tests each key:
+ * this only leaves out keys a scan would skip, so sums over the keys come
+ * out bit for bit as a scan's, in O(log n + met) instead of O(n) a box,
+ * which the mesher asks for every cell. */
+typedef struct {
+  const soft_obj *o;
+  const double *lo, *hi;
+  int st[BVH_STACK], sp;
+  int j, jend;
+} key_walk;
+
+static void key_walk_start(key_walk *w, const soft_obj *o, const double lo[3],
+                           const double hi[3]) {
+  w->o = o;
+  w->lo = lo;
+  w->hi = hi;
+  w->sp = 0;
+  w->j = w->jend = 0;
+  if (o->nkeys > 0) w->st[w->sp++] = 0;
+}
+
+static const nkey *key_walk_next(key_walk *w) {
+  for (;;) {
+    if (w->j < w->jend) return &w->o->keys[w->j++];
+    if (!w->sp) return NULL;
+    const bvh_node *nd = &w->o->tree.nodes[w->st[--w->sp]];
+    int apart = 0;
+    for (int a = 0; a < 3; a++)
+      if (w->hi[a] < nd->lo[a] || w->lo[a] > nd->hi[a]) apart = 1;
+    if (apart) continue;
+    if (nd->count) {
+      w->j = nd->first;
+      w->jend = nd->first + nd->count;
+    } else {
+      w->st[w->sp++] = nd->first + 1;  /* the right child after the left */
+      w->st[w->sp++] = nd->first;
+    }
+  }
+}
+
 int soft_field_box(const soft_obj *obj, const double lo[3], const double hi[3],
                    double *flo, double *fhi) {
   double fl = 0, fh = 0, mag = 0;
-  for (size_t i = 0; i < obj->nkeys; i++) {
-    const nkey *k = &obj->keys[i];
+  key_walk kw;
+  key_walk_start(&kw, obj, lo, hi);
+  for (const nkey *k; (k = key_walk_next(&kw));) {
     if (k->empty) continue;
     int apart = 0;
     for (int j = 0; j < 3; j++)
       if (hi[j] < k->lo[j] || lo[j] > k->hi[j]) apart = 1;
     if (apart) continue; /* s >= 1 over the box: no contribution */
-    double ol[3], oh[3], dmin2, dmax2, lmin, lmax;
+    double ol[3], oh[3], smin, smax;
     for (int j = 0; j < 3; j++) {
       ol[j] = lo[j] - k->x0[j];
       oh[j] = hi[j] - k->x0[j];
     }
-    box_dist2(ol, oh, &dmin2, &dmax2);
-    if (k->sphere) {
-      lmin = lmax = k->a[0];
-    } else { /* Gershgorin's discs bound A's eigenvalues */
-      double r0 = fabs(k->a[3]) + fabs(k->a[4]);
-      double r1 = fabs(k->a[3]) + fabs(k->a[5]);
-      double r2 = fabs(k->a[4]) + fabs(k->a[5]);
-      lmin = fmin(k->a[0] - r0, fmin(k->a[1] - r1, k->a[2] - r2));
-      lmax = fmax(k->a[0] + r0, fmax(k->a[1] + r1, k->a[2] + r2));
-      if (lmin < 0) lmin = 0;
-    }
-    /* s over the box lies in [smin, smax], widened for rounding */
-    double smin = lmin * dmin2 + k->k, smax = lmax * dmax2 + k->k;
-    smin -= 1e-12 * (fabs(smin) + 1);
-    smax += 1e-12 * (fabs(smax) + 1);
+    key_s_range(k, ol, oh, &smin, &smax);
     double cl = cfield(smax), ch = cfield(smin); /* C falls for s < 1 */
     if (ch > k->cmax) ch = k->cmax;
     if (k->w >= 0) {
@@ -353,6 +426,51 @@ int soft_field_box(const soft_obj *obj, const double lo[3], const double hi[3],
   }
   *flo = fl - 1e-12 * mag;
   *fhi = fh + 1e-12 * mag;
+  return 0;
+}
+
+int soft_grad_box(const soft_obj *obj, const double lo[3], const double hi[3],
+                  double gl[3], double gh[3]) {
+  double mag = 0;
+  for (int j = 0; j < 3; j++) gl[j] = gh[j] = 0;
+  key_walk kw;
+  key_walk_start(&kw, obj, lo, hi);
+  for (const nkey *k; (k = key_walk_next(&kw));) {
+    if (k->empty) continue;
+    int apart = 0;
+    for (int j = 0; j < 3; j++)
+      if (hi[j] < k->lo[j] || lo[j] > k->hi[j]) apart = 1;
+    if (apart) continue; /* s >= 1 over the box: no contribution */
+    double ol[3], oh[3], smin, smax;
+    for (int j = 0; j < 3; j++) {
+      ol[j] = lo[j] - k->x0[j];
+      oh[j] = hi[j] - k->x0[j];
+    }
+    key_s_range(k, ol, oh, &smin, &smax);
+    if (smin >= 1) continue;
+    /* dC/ds rises on s < 17/12 (its vertex) and is 0 at s = 1 */
+    double cl = cslope(smin), ch = smax >= 1 ? 0 : cslope(smax);
+    iv_mul(2 * k->w, 2 * k->w, cl, ch, &cl, &ch);
+    /* grad s = 2 A p: each row of A p is linear in p, exact over the box */
+    static const int row[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    for (int j = 0; j < 3; j++) {
+      double al = 0, ah = 0;
+      for (int q = 0; q < 3; q++) {
+        double a = k->sphere ? (q == j ? k->a[0] : 0) : k->a[row[j][q]];
+        al += a * (a > 0 ? ol[q] : oh[q]);
+        ah += a * (a > 0 ? oh[q] : ol[q]);
+      }
+      double l, h;
+      iv_mul(cl, ch, al, ah, &l, &h);
+      gl[j] += l;
+      gh[j] += h;
+      mag += fmax(fabs(l), fabs(h));
+    }
+  }
+  for (int j = 0; j < 3; j++) {
+    gl[j] -= 1e-12 * mag + 1e-300;
+    gh[j] += 1e-12 * mag + 1e-300;
+  }
   return 0;
 }
 

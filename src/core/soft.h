@@ -88,10 +88,21 @@ int soft_surface_bounds(const soft_obj *obj, double lo[3], double hi[3]);
 
 /* Bounds [*flo, *fhi] on the field over the closed box [lo, hi] (interval
  * arithmetic per key, widened for rounding): the mesher's proof that a
- * cell is wholly inside or outside. Every key is visited (O(keys)).
- * Returns 0. */
+ * cell is wholly inside or outside. Only the keys whose bounds meet the
+ * box are visited, found through the key BVH in index order (the sum is
+ * the same, bit for bit, as over all keys). Returns 0. */
 int soft_field_box(const soft_obj *obj, const double lo[3], const double hi[3],
                    double *flo, double *fhi);
+
+/* Bounds [gl[j], gh[j]] on each component of the field's gradient over
+ * the closed box [lo, hi]: per key, 2 w C'(s) A (x - x0), with C'(s)
+ * over the range of s on the box (C' rises on s < 1, where it reaches
+ * 0) and each component of A (x - x0) exactly (it is linear), their
+ * product by interval multiplication; summed, widened for rounding. The
+ * mesher's proof that the surface in a cell is smooth enough. The keys
+ * are visited as by soft_field_box. Returns 0. */
+int soft_grad_box(const soft_obj *obj, const double lo[3], const double hi[3],
+                  double gl[3], double gh[3]);
 
 /* eq. (1) summed over the keys: the field at p. */
 double soft_field(const soft_obj *obj, const double p[3]);

@@ -303,7 +303,36 @@ typedef struct {
   int planar;              /* one live leaf: the 0.5 level is a plane */
   double w;                /* |grad - g0| <= w over the box */
   double gmin;             /* grad . n0 >= gmin > 0 over the box */
+  double n0[3];            /* the unit direction of g0 */
+  double slope;            /* |grad - (grad . n0) n0| / gmin bound: a chord
+                              c between two points of the surface in the
+                              box has |c . n0| <= slope |c| */
 } GrBound;
+
+/* The longest vector c in [-1, 1]^3 (the difference of two points of a
+   unit cube) with |c . u| <= tau (u a unit vector): |c|^2 is convex, so
+   its largest value on that convex polytope is at a vertex, a cube
+   corner inside the slab or where the slab's planes cut a cube edge. */
+static double chord_max(const double u[3], double tau) {
+  double best = 0;
+  for (int c = 0; c < 8; c++) {
+    double v[3] = {c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1};
+    if (fabs(vec3_dot(v, u)) <= tau) best = fmax(best, vec3_dot(v, v));
+  }
+  for (int a = 0; a < 3; a++) { /* edges along axis a */
+    int b = (a + 1) % 3, e = (a + 2) % 3;
+    if (u[a] == 0) continue;
+    for (int c = 0; c < 4; c++)
+      for (int sgn = -1; sgn <= 1; sgn += 2) {
+        double v[3];
+        v[b] = c & 1 ? 1 : -1;
+        v[e] = c & 2 ? 1 : -1;
+        v[a] = (sgn * tau - u[b] * v[b] - u[e] * v[e]) / u[a];
+        if (fabs(v[a]) <= 1) best = fmax(best, vec3_dot(v, v));
+      }
+  }
+  return sqrt(best) * (1 + 1e-12);
+}
 
 /* The gradient bound of t over [lo, hi]: 0 when found (*b), -1 when the
    tape is not smooth there (a sharp leaf crosses it, too many live leaves,
@@ -394,8 +423,47 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   }
   double gmin = al > 0 ? al : (ah < 0 ? -ah : 0);
   if (!(gmin > 0) || !isfinite(w)) return -1;
+  /* the deviation from g0 along u = g0 / |g0| and across it */
+  double wu = 0, wp = 0;
+  for (int i = 0; i < r->n; i++) {
+    double k = vec3_dot(t->leaves[r->leaf[i]].n, g0) / len;
+    double hw = 0.5 * (r->ch[i] - r->cl[i]);
+    wu += hw * fabs(k);
+    wp += hw * sqrt(fmax(0, 1 - k * k));
+  }
+  /* chords of the surface are nearly across u: see tri_bound */
+  double we = wp * (1 + wu / (gmin * (1 - 1e-9)));
+  if (we < w) w = we;
+  for (int q = 0; q < 3; q++) b->n0[q] = g0[q] / len;
+  b->slope = wp * (1 + 1e-9) / (gmin * (1 - 1e-9));
   b->w = w * (1 + 1e-9) + 1e-300;
   b->gmin = gmin * (1 - 1e-9);
+  return 0;
+}
+
+/* The gradient bound from per-axis intervals [gl, gh] of the gradient
+   over a box (a soft object's field, soft_grad_box): g0 the midpoint, w
+   the radii's length, gmin the lower bound of grad . g0 / |g0|. 0, or -1
+   when it is not positive. */
+static int grad_axes(const double gl[3], const double gh[3], GrBound *b) {
+  double g0[3], r2 = 0;
+  for (int j = 0; j < 3; j++) {
+    g0[j] = 0.5 * (gl[j] + gh[j]);
+    double r = 0.5 * (gh[j] - gl[j]);
+    r2 += r * r;
+  }
+  double len = sqrt(vec3_dot(g0, g0)), gmin = 0;
+  if (!(len > 0) || !isfinite(len) || !isfinite(r2)) return -1;
+  for (int j = 0; j < 3; j++) {
+    double u = g0[j] / len;
+    gmin += u > 0 ? u * gl[j] : u * gh[j];
+  }
+  if (!(gmin > 0)) return -1;
+  memset(b, 0, sizeof *b);
+  b->w = sqrt(r2) * (1 + 1e-9) + 1e-300;
+  b->gmin = gmin * (1 - 1e-9);
+  for (int j = 0; j < 3; j++) b->n0[j] = g0[j] / len;
+  b->slope = b->w / b->gmin; /* |grad_perp| <= |grad - g0| */
   return 0;
 }
 
@@ -410,6 +478,8 @@ enum { LEAF_PLANE, LEAF_SMOOTH, LEAF_FINE, LEAF_EXACT };
 typedef struct {
   uint32_t q[3];           /* its lowest corner, in units of its side */
   unsigned char level, kind;
+  unsigned char plain;     /* its faces are plain (cell, set by the first
+                              pass) */
   int pl0, npl;            /* LEAF_EXACT: its planes, pls[pl0 .. + npl) */
   double w, gmin;          /* LEAF_SMOOTH: the gradient bound */
 } Leaf;
@@ -552,26 +622,39 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     m->rep->full++;
     return 0;
   }
-  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0};
+  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0};
   int leaf = level == m->depth;
   if (c == T_ONE && clip_in && !m->uniform) {
     const ScNode *nd = &m->s->nodes[one];
     if (nd->kind == SC_HALFSPACE) {
       lf.kind = LEAF_PLANE;
       leaf = 1;
-    } else if (nd->kind == SC_ROUNDED) {
-      double gl[3], gh[3];
+    } else if (nd->kind == SC_ROUNDED || nd->kind == SC_SOFT) {
+      double gl[3], gh[3], dl[3], dh[3];
       GrBound b;
       for (int a = 0; a < 3; a++) {
         gl[a] = lo[a] - m->tol;
         gh[a] = hi[a] + m->tol;
       }
-      if (grad_box(nd->tape, gl, gh, m->gst, &b) == 0) {
+      int ok;
+      if (nd->kind == SC_ROUNDED) ok = grad_box(nd->tape, gl, gh, m->gst, &b) == 0;
+      else {
+        soft_grad_box(nd->soft, gl, gh, dl, dh);
+        ok = grad_axes(dl, dh, &b) == 0;
+      }
+      if (ok) {
         double d = sqrt(3.0) * side;
         if (b.planar) {
           lf.kind = LEAF_PLANE;
           leaf = 1;
-        } else if (m->vtol + b.w * (2.0 / 3) * (d + 2 * m->vtol) / b.gmin <= m->tol) {
+        } else if (m->vtol + b.w * (2.0 / 3) *
+                                 fmin(d + 2 * m->vtol,
+                                      side * chord_max(b.n0, sqrt(3.0) * b.slope)) /
+                               b.gmin <= m->tol) {
+          /* the crossings' diameter: chords of the surface in the cell
+             are within slope of across n0, so at most the cell's longest
+             such chord (|c| <= sqrt 3 side gives |c . n0| <= sqrt 3 slope
+             side) */
           lf.kind = LEAF_SMOOTH;
           lf.w = b.w;
           lf.gmin = b.gmin;
@@ -751,7 +834,11 @@ static double tri_bound(const Mesher *m, int a, int b, int c) {
   case LEAF_SMOOTH: {
     double d = fmax(dist3(pa, pb), fmax(dist3(pb, pc), dist3(pa, pc)));
     /* sum_i l_i |p - x_i| <= sum_i l_i (1 - l_i) D'' <= 2/3 D'', with
-       D'' <= d + 2 vtol the crossings' diameter (sum l_i^2 >= 1/3) */
+       D'' <= d + 2 vtol the crossings' diameter (sum l_i^2 >= 1/3); w is
+       grad_box's: the whole deviation, or w_perp (1 + w_par / gmin) where
+       smaller (each p - x_i a combination of chords c between crossings,
+       |c . u| gmin <= w_perp |c| since the density is equal at both ends,
+       so the deviation along u meets only w_perp / gmin of the length) */
     return m->vtol + m->cur->w * (2.0 / 3) * (d + 2 * m->vtol) / m->cur->gmin;
   }
   default: return m->vtol + cover_radius(pa, pb, pc);
@@ -1411,8 +1498,43 @@ static const int kuhn[6][4] = {
     {0, 1, 7, 5}, {0, 4, 7, 6}, {0, 2, 7, 3}, /* odd, last two swapped */
 };
 
+/* The faces of cell q (level l) are all plain (see face): no cell of the
+   level sharing a face or an edge with it is split. */
+static int plain_cell(const Mesher *m, int l, const int64_t q[3]) {
+  for (int dx = -1; dx <= 1; dx++)
+    for (int dy = -1; dy <= 1; dy++)
+      for (int dz = -1; dz <= 1; dz++) {
+        int nz = (dx != 0) + (dy != 0) + (dz != 0);
+        if ((nz == 1 || nz == 2) &&
+            is_split(m, l, q[0] + dx, q[1] + dy, q[2] + dz))
+          return 0;
+      }
+  return 1;
+}
+
+/* The corner points of a plain cell, made in the order face makes them
+   (so that the points' numbers do not depend on the shortcut). */
+static int plain_points(Mesher *m, int l, const int64_t q[3]) {
+  static const int cu[4] = {0, 1, 1, 0}, cw[4] = {0, 0, 1, 1};
+  for (int a = 0; a < 3; a++)
+    for (int s = 0; s < 2; s++) {
+      int b = (a + 1) % 3, e = (a + 2) % 3;
+      for (int r = 0; r < 4; r++) {
+        int k0 = s ? r : (4 - r) % 4;
+        int64_t p0[3];
+        p0[a] = q[a] + s;
+        p0[b] = q[b] + cu[k0];
+        p0[e] = q[e] + cw[k0];
+        uint32_t dc[3];
+        for (int i = 0; i < 3; i++) dc[i] = (uint32_t)(p0[i] << (m->depth - l + 1));
+        if (point(m, dc) < 0) return -1;
+      }
+    }
+  return 0;
+}
+
 static int cell(Mesher *m, size_t leaf, size_t *count) {
-  const Leaf *lf = &m->leaves[leaf];
+  Leaf *lf = &m->leaves[leaf];
   m->cur = lf;
   int l = lf->level, plain = 1;
   int64_t q[3] = {lf->q[0], lf->q[1], lf->q[2]};
@@ -1438,10 +1560,17 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
     mk = exact_tet;
   }
   m->nft = 0;
-  if (l < m->depth)
+  /* the first pass (count) finds whether the faces are plain: a plain
+     cell needs only its corners */
+  if (count) lf->plain = (unsigned char)(l == m->depth || plain_cell(m, l, q));
+  if (lf->plain) {
+    if (count && l < m->depth && plain_points(m, l, q) < 0) return -1;
+  } else {
     for (int a = 0; a < 3; a++)
       for (int s = 0; s < 2; s++)
         if (face(m, l, q, a, s, &plain) < 0) return -1;
+    if (plain) return (void)(m->err = MESH_EINTERNAL), -1;
+  }
   if (plain) {
     int c[8];
     for (int k = 0; k < 8; k++) {
@@ -1709,8 +1838,18 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     goto done;
   }
   if (count == 0) {
-    snprintf(err, errlen, "the object is empty: no inside point was found "
-             "in its box at this tolerance (%g)", e);
+    double thin = INFINITY; /* the box's least side: a hint, not a proof */
+    for (int i = 0; i < 3; i++) thin = fmin(thin, hi[i] - lo[i]);
+    if (rep->leaves > 0)
+      /* cells were left undecided, so the surface may pass through them
+         between their corners: a solid thinner than a cell */
+      snprintf(err, errlen, "no inside point was found at this tolerance "
+               "(%g): the object is empty, or thinner than a cell (side "
+               "%.3g) everywhere; its box is %.3g thin at the least: try "
+               "meshWith [Tolerance %.2g]", e, m.h, thin, thin / 10);
+    else
+      snprintf(err, errlen, "the object is empty: every cell of its box "
+               "is proven outside it");
     rc = MESH_EEMPTY;
     goto done;
   }
@@ -1745,6 +1884,26 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_ELIMIT;
     goto done;
   }
+  /* the octree's maps are done with: free them before the check's
+     tables are made (the peak) */
+  hfree(&m.split);
+  hfree(&m.pt);
+  hfree(&m.vert);
+  hfree(&m.crease);
+  free(m.vert2.k);
+  free(m.vert2.v);
+  free(m.fpath.k);
+  free(m.fpath.v);
+  free(m.pc);
+  free(m.ps);
+  memset(&m.split, 0, sizeof m.split);
+  memset(&m.pt, 0, sizeof m.pt);
+  memset(&m.vert, 0, sizeof m.vert);
+  memset(&m.crease, 0, sizeof m.crease);
+  memset(&m.vert2, 0, sizeof m.vert2);
+  memset(&m.fpath, 0, sizeof m.fpath);
+  m.pc = NULL;
+  m.ps = NULL;
   Mesh *me = malloc(sizeof *me);
   if (!me) {
     rc = MESH_ENOMEM;
@@ -1753,8 +1912,11 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   me->nv = m.nv;
   me->nt = m.nt;
   me->rgb = NULL;
-  me->v = m.v;
-  me->t = m.t;
+  /* the arrays grew by doubling: give back what is not used */
+  double *v2 = m.nv ? realloc(m.v, 3 * m.nv * sizeof *m.v) : NULL;
+  int *t2 = m.nt ? realloc(m.t, 3 * m.nt * sizeof *m.t) : NULL;
+  me->v = v2 ? v2 : m.v;
+  me->t = t2 ? t2 : m.t;
   m.v = NULL;
   m.t = NULL;
   MeshCheck ck;
@@ -1826,121 +1988,107 @@ static int find(int *p, int x) {
   return x;
 }
 
+/* Each vertex's wedges (one per triangle corner at it: the next vertex,
+   the one after, the triangle) in one array, vertex by vertex; an edge
+   a -> b is found by scanning a's wedges, and its reverse b's (a few
+   each), so no hash table is needed (at 4 million triangles the hash
+   tables of directed and undirected edges took 600 MB). */
 int mesh_check(const Mesh *m, MeshCheck *c) {
   memset(c, 0, sizeof *c);
-  hmap de = {0};           /* directed edge -> count */
-  int *par = malloc((m->nt ? m->nt : 1) * sizeof *par);
-  int *deg = calloc(m->nv ? m->nv : 1, sizeof *deg);
-  int *nxt = NULL;
+  size_t nv = m->nv, nt = m->nt;
+  int *par = malloc((nt ? nt : 1) * sizeof *par);
+  size_t *start = malloc((nv + 1) * sizeof *start);
+  int *deg = calloc(nv ? nv : 1, sizeof *deg);
+  int *w = malloc(9 * (nt ? nt : 1) * sizeof *w);
   long edges = 0, used = 0;
   int rc = 0;
-  if (!par || !deg) goto nomem;
-  for (size_t i = 0; i < m->nt; i++) {
+  if (!par || !start || !deg || !w) {
+    rc = -2;
+    goto out;
+  }
+  for (size_t i = 0; i < nt; i++) {
     par[i] = (int)i;
     const int *t = m->t + 3 * i;
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) c->degenerate++;
+    for (int e = 0; e < 3; e++) deg[t[e]]++;
+  }
+  size_t tot = 0;
+  for (size_t v = 0; v < nv; v++) {
+    start[v] = tot;
+    tot += (size_t)deg[v];
+    used += deg[v] > 0;
+    deg[v] = 0; /* refilled below */
+  }
+  start[nv] = tot;
+  for (size_t i = 0; i < nt; i++) {
+    const int *t = m->t + 3 * i;
     for (int e = 0; e < 3; e++) {
-      uint64_t a = (uint64_t)t[e], b = (uint64_t)t[(e + 1) % 3];
-      uint64_t k = a << 32 | b;
-      int n = hget(&de, k);
-      if (hput(&de, k, n < 0 ? 1 : n + 1) < 0) goto nomem;
-      deg[t[e]]++;
+      int v = t[e];
+      size_t s = 3 * (start[v] + (size_t)deg[v]++);
+      w[s] = t[(e + 1) % 3];
+      w[s + 1] = t[(e + 2) % 3];
+      w[s + 2] = (int)i;
     }
   }
-  for (size_t i = 0; i < de.cap; i++) {
-    if (!de.k[i]) continue;
-    uint64_t k = de.k[i] - 1, r = (k & 0xffffffffu) << 32 | k >> 32;
-    if (de.v[i] > 1) c->nonmanifold_edges++;
-    if (hget(&de, r) != 1) c->boundary_edges++;
-    edges++;
+  for (size_t a = 0; a < nv; a++) {
+    const int *fa = w + 3 * start[a];
+    int na = deg[a];
+    for (int x = 0; x < na; x++) {
+      int b = fa[3 * x], first = 1, n = 0;
+      for (int y = 0; y < na; y++)
+        if (fa[3 * y] == b) {
+          first &= y >= x;
+          n++;
+          par[find(par, fa[3 * y + 2])] = find(par, fa[3 * x + 2]);
+        }
+      if (!first) continue; /* the directed edge a -> b counted once */
+      int r = 0;
+      const int *fb = w + 3 * start[b];
+      for (int y = 0; y < deg[b]; y++)
+        if (fb[3 * y] == (int)a) {
+          r++;
+          par[find(par, fb[3 * y + 2])] = find(par, fa[3 * x + 2]);
+        }
+      if (n > 1) c->nonmanifold_edges++;
+      if (r != 1) c->boundary_edges++;
+      edges++;
+    }
   }
   edges /= 2;
-  /* components: triangles joined through shared edges */
-  {
-    hmap first = {0}; /* undirected edge -> a triangle */
-    for (size_t i = 0; i < m->nt; i++) {
-      const int *t = m->t + 3 * i;
-      for (int e = 0; e < 3; e++) {
-        uint64_t a = (uint64_t)t[e], b = (uint64_t)t[(e + 1) % 3];
-        uint64_t k = a < b ? a << 32 | b : b << 32 | a;
-        int o = hget(&first, k);
-        if (o < 0) {
-          if (hput(&first, k, (int)i) < 0) {
-            hfree(&first);
-            goto nomem;
-          }
-        } else {
-          par[find(par, o)] = find(par, (int)i);
-        }
-      }
-    }
-    hfree(&first);
-    for (size_t i = 0; i < m->nt; i++) c->components += find(par, (int)i) == (int)i;
-  }
+  for (size_t i = 0; i < nt; i++) c->components += find(par, (int)i) == (int)i;
   /* vertex fans: around each vertex, the triangles' opposite edges must
      chain into one cycle (checked by following next-vertex links) */
-  {
-    size_t tot = 0;
-    int *start = malloc((m->nv + 1) * sizeof *start);
-    if (!start) goto nomem;
-    for (size_t v = 0; v < m->nv; v++) {
-      start[v] = (int)tot;
-      tot += (size_t)deg[v];
-      used += deg[v] > 0;
-    }
-    start[m->nv] = (int)tot;
-    nxt = malloc(2 * (tot ? tot : 1) * sizeof *nxt);
-    int *fill = calloc(m->nv ? m->nv : 1, sizeof *fill);
-    if (!nxt || !fill) {
-      free(start);
-      free(fill);
-      goto nomem;
-    }
-    for (size_t i = 0; i < m->nt; i++) {
-      const int *t = m->t + 3 * i;
-      for (int e = 0; e < 3; e++) {
-        int v = t[e], slot = start[v] + fill[v]++;
-        nxt[2 * slot] = t[(e + 1) % 3];
-        nxt[2 * slot + 1] = t[(e + 2) % 3];
-      }
-    }
-    for (size_t v = 0; v < m->nv; v++) {
-      int n = deg[v];
-      if (!n) continue;
-      const int *f = nxt + 2 * start[v];
-      /* follow b -> c links from the first wedge; one cycle of n wedges */
-      int cur = f[1], steps = 1, ok = 1;
-      while (cur != f[0] && ok) {
-        int found = -1;
-        for (int w = 0; w < n; w++)
-          if (f[2 * w] == cur) {
-            found = w;
-            break;
-          }
-        if (found < 0 || steps > n) ok = 0;
-        else {
-          cur = f[2 * found + 1];
-          steps++;
+  for (size_t v = 0; v < nv; v++) {
+    int n = deg[v];
+    if (!n) continue;
+    const int *f = w + 3 * start[v];
+    /* follow b -> c links from the first wedge; one cycle of n wedges */
+    int cur = f[1], steps = 1, ok = 1;
+    while (cur != f[0] && ok) {
+      int found = -1;
+      for (int q = 0; q < n; q++)
+        if (f[3 * q] == cur) {
+          found = q;
+          break;
         }
+      if (found < 0 || steps > n) ok = 0;
+      else {
+        cur = f[3 * found + 1];
+        steps++;
       }
-      if (!ok || steps != n) c->nonmanifold_verts++;
     }
-    free(start);
-    free(fill);
+    if (!ok || steps != n) c->nonmanifold_verts++;
   }
-  c->euler = used - edges + (long)m->nt;
+  c->euler = used - edges + (long)nt;
   rc = c->boundary_edges || c->nonmanifold_edges || c->nonmanifold_verts ||
                c->degenerate
            ? -1
            : 0;
-  goto out;
-nomem:
-  rc = -2;
 out:
-  hfree(&de);
   free(par);
+  free(start);
   free(deg);
-  free(nxt);
+  free(w);
   return rc;
 }
 
@@ -1959,61 +2107,42 @@ int mesh_is_mesh_path(const char *path) {
 
 /* ---- colours ------------------------------------------------------------ */
 
-/* The top-level union's parts with their inherited Colour (as the tracer
-   collects them). */
+/* The top-level union's parts with their inherited Colour
+   (scene_union_parts, the walk the tracer's collect_prims makes too). */
+typedef struct {
+  int *parts;
+  const double **cols;
+  int n, cap;
+} Parts;
+
+static int add_part(void *ctx, int part, const double *colour) {
+  Parts *p = ctx;
+  if (p->n == p->cap) {
+    int nc = p->cap ? 2 * p->cap : 16;
+    int *g = realloc(p->parts, (size_t)nc * sizeof *g);
+    if (g) p->parts = g;
+    const double **gc = realloc(p->cols, (size_t)nc * sizeof *gc);
+    if (gc) p->cols = gc;
+    if (!g || !gc) return -1;
+    p->cap = nc;
+  }
+  p->parts[p->n] = part;
+  p->cols[p->n++] = colour;
+  return 0;
+}
+
 static int collect_parts(const Scene *s, int root, int **parts,
                          const double ***cols, int *n) {
-  int cap = 16, sp = 0, capst = 16;
-  int *st = malloc((size_t)capst * sizeof *st);
-  const double **stc = malloc((size_t)capst * sizeof *stc);
-  *parts = malloc((size_t)cap * sizeof **parts);
-  *cols = malloc((size_t)cap * sizeof **cols);
-  *n = 0;
-  if (!st || !stc || !*parts || !*cols) goto nomem;
-  st[sp] = root;
-  stc[sp++] = NULL;
-  while (sp) {
-    sp--;
-    int nd = st[sp];
-    const ScNode *x = &s->nodes[nd];
-    const double *c = x->has_colour ? x->colour : stc[sp];
-    if (x->kind == SC_UNION) {
-      if (sp + 2 > capst) {
-        capst *= 2;
-        int *g = realloc(st, (size_t)capst * sizeof *st);
-        if (g) st = g;
-        const double **gc = realloc(stc, (size_t)capst * sizeof *stc);
-        if (gc) stc = gc;
-        if (!g || !gc) goto nomem;
-      }
-      st[sp] = x->b;
-      stc[sp++] = c;
-      st[sp] = x->a;
-      stc[sp++] = c;
-      continue;
-    }
-    if (*n == cap) {
-      cap *= 2;
-      int *g = realloc(*parts, (size_t)cap * sizeof **parts);
-      if (g) *parts = g;
-      const double **gc = realloc(*cols, (size_t)cap * sizeof **cols);
-      if (gc) *cols = gc;
-      if (!g || !gc) goto nomem;
-    }
-    (*parts)[*n] = nd;
-    (*cols)[(*n)++] = c;
+  Parts p = {NULL, NULL, 0, 0};
+  if (scene_union_parts(s, root, add_part, &p) < 0) {
+    free(p.parts);
+    free(p.cols);
+    return -1;
   }
-  free(st);
-  free(stc);
+  *parts = p.parts;
+  *cols = p.cols;
+  *n = p.n;
   return 0;
-nomem:
-  free(st);
-  free(stc);
-  free(*parts);
-  free(*cols);
-  *parts = NULL;
-  *cols = NULL;
-  return -1;
 }
 
 int mesh_colour(const Scene *s, int node, Mesh *m, const double def[3],
@@ -2264,19 +2393,31 @@ out:
 int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
   buf b = {0};
   if (!strcmp(ext_of(path), "stl")) {
+    /* its size is known: no doubling of a large buffer */
+    b.cap = 84 + 50 * m->nt;
+    if (!(b.p = malloc(b.cap))) b.bad = 1;
     char head[80] = "binary STL written by qcs";
     put(&b, head, 80);
     unsigned char q[4];
     for (int i = 0; i < 4; i++) q[i] = (unsigned char)(m->nt >> (8 * i));
     put(&b, q, 4);
-    for (size_t i = 0; i < m->nt; i++) {
-      double n[3];
+    for (size_t i = 0; i < m->nt && !b.bad; i++) {
+      /* 50 bytes a triangle, straight into the buffer sized above */
+      double n[3], f[12];
       tri_normal(m, i, n);
       double l = sqrt(vec3_dot(n, n));
-      for (int k = 0; k < 3; k++) put_f32(&b, l > 0 ? n[k] / l : 0);
+      for (int k = 0; k < 3; k++) f[k] = l > 0 ? n[k] / l : 0;
       for (int k = 0; k < 3; k++)
-        for (int j = 0; j < 3; j++) put_f32(&b, m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)j]);
-      put(&b, "\0\0", 2);
+        for (int j = 0; j < 3; j++) f[3 + 3 * k + j] = m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)j];
+      unsigned char *o = (unsigned char *)b.p + b.n;
+      for (int k = 0; k < 12; k++) {
+        float x = (float)f[k];
+        uint32_t u;
+        memcpy(&u, &x, 4);
+        for (int r = 0; r < 4; r++) o[4 * k + r] = (unsigned char)(u >> (8 * r));
+      }
+      o[48] = o[49] = 0;
+      b.n += 50;
     }
   } else if (!strcmp(ext_of(path), "obj")) {
     double *vn = calloc(3 * (m->nv ? m->nv : 1), sizeof *vn);

@@ -11,9 +11,9 @@
  * sharp halfspaces alone. A cell proven inside or outside is dropped. An
  * undecided cell becomes a surface leaf, at any size, when its error is
  * proven within the tolerance: one plane (a halfspace, or a rounded tree
- * with one live leaf), a rounded node whose gradient bound over the cell
- * grown by the tolerance bounds its triangles' distance (mesh.c,
- * grad_box), or a CSG of at most 8 planes (a sharp cell, meshed exactly);
+ * with one live leaf), a rounded node or a soft object whose gradient
+ * bound over the cell grown by the tolerance bounds its triangles'
+ * distance (mesh.c, grad_box; core/soft.h, soft_grad_box), or a CSG of at most 8 planes (a sharp cell, meshed exactly);
  * else it is split, down to the finest level whose side the tolerance
  * fixes.
  *

@@ -373,29 +373,12 @@ static int add_prim(Tracer *T, int node, const double *colour) {
 /* The top-level union, flattened into primitives, a before b; colours
    are inherited. An explicit stack: a scene may be a union a million deep.
    0, or -1 when memory runs out. */
+static int add_part(void *ctx, int part, const double *colour) {
+  return add_prim((Tracer *)ctx, part, colour) ? -1 : 0;
+}
+
 static int collect_prims(Tracer *T, int root) {
-  typedef struct { int node; const double *colour; } Item;
-  Item local[32], *st = local;
-  int cap = 32, n = 0, r = 0;
-  st[n++] = (Item){root, NULL};
-  while (n) {
-    Item it = st[--n];
-    const ScNode *nd = &T->s->nodes[it.node];
-    const double *colour = nd->has_colour ? nd->colour : it.colour;
-    if (nd->kind == SC_UNION) {
-      if (grow_stack((void **)&st, &cap, n + 2, sizeof *st, local)) {
-        r = -1;
-        break;
-      }
-      st[n++] = (Item){nd->b, colour};
-      st[n++] = (Item){nd->a, colour};
-    } else if (nd->kind != SC_EMPTY && add_prim(T, it.node, colour)) {
-      r = -1;
-      break;
-    }
-  }
-  if (st != local) free(st);
-  return r;
+  return scene_union_parts(T->s, root, add_part, T) ? -1 : 0;
 }
 
 /* The BVH over the bounded prims: median split on the widest spread of

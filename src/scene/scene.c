@@ -75,6 +75,40 @@ static int leaf_inside(const ScNode *n, const double p[3]) {
   }
 }
 
+int scene_union_parts(const Scene *s, int node,
+                      int (*fn)(void *ctx, int part, const double *colour),
+                      void *ctx) {
+  typedef struct { int node; const double *colour; } Item;
+  Item local[32], *st = local;
+  size_t cap = 32, n = 0;
+  int r = 0;
+  st[n++] = (Item){node, NULL};
+  while (n && !r) {
+    Item it = st[--n];
+    const ScNode *nd = &s->nodes[it.node];
+    const double *colour = nd->has_colour ? nd->colour : it.colour;
+    if (nd->kind == SC_UNION) {
+      if (n + 2 > cap) {
+        Item *g = st == local ? malloc(2 * cap * sizeof *g)
+                              : realloc(st, 2 * cap * sizeof *g);
+        if (!g) {
+          r = -1;
+          break;
+        }
+        if (st == local) memcpy(g, local, sizeof local);
+        st = g;
+        cap *= 2;
+      }
+      st[n++] = (Item){nd->b, colour};
+      st[n++] = (Item){nd->a, colour};
+    } else if (nd->kind != SC_EMPTY) {
+      r = fn(ctx, it.node, colour);
+    }
+  }
+  if (st != local) free(st);
+  return r;
+}
+
 int scene_inside(const Scene *s, int node, const double p[3]) {
   const ScNode *nd = &s->nodes[node];
   if (nd->first == node) return leaf_inside(nd, p);

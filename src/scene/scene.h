@@ -87,6 +87,19 @@ int scene_add_op(Scene *s, ScKind k, int a, int b, int tag);
 /* Free the scene and every tape and soft object it owns. NULL is fine. */
 void scene_free(Scene *s);
 
+/* The parts of node's top-level union, as the tracer and the mesher's
+   colouring see them: the union is flattened (any depth, a before b),
+   each other node is a part (SC_EMPTY parts are skipped), and each part
+   carries the Colour of its nearest coloured ancestor-or-self in the
+   union (NULL: none). fn is called once per part in that order; a
+   nonzero return stops the walk and is returned. -1 if memory runs out
+   (a union deeper than 32 levels needs a stack). The tracer's primitives
+   (render/render.c) and the mesher's colouring both come from it, so a
+   part is coloured the same in a picture and in a .ply or .3mf. */
+int scene_union_parts(const Scene *s, int node,
+                      int (*fn)(void *ctx, int part, const double *colour),
+                      void *ctx);
+
 /* Figure 4, PointInObject: 1 if p is inside node, 0 if not, -1 if memory
    runs out (a subtree of more than 256 nodes needs a byte per node).
    Iterative: the subtree's nodes are visited once each, children first. */

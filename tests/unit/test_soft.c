@@ -430,6 +430,96 @@ static void test_field(void)
   soft_free(o);
 }
 
+/* The gradient in long double from the definition: sum of w dC/ds grad s
+ * with C(s) = 1 - 22/9 s + 17/9 s^2 - 4/9 s^3, s = |x - c|^2 / R^2 (grad s
+ * = 2 (x - c) / R^2) or u'Mu / R^2 (grad s = 2 (M u)_xyz / R^2, M
+ * symmetric as built). */
+static void ld_grad(const tkey *tk, int n, const double p[3], long double g[3])
+{
+  g[0] = g[1] = g[2] = 0;
+  for (int j = 0; j < n; j++) {
+    const soft_key *k = &tk[j].k;
+    long double s = 0, gs[3], R2 = (long double)k->R * k->R;
+    if (k->kind == SOFT_SPHERE) {
+      for (int i = 0; i < 3; i++) {
+        long double d = (long double)p[i] - k->c[i];
+        s += d * d;
+        gs[i] = 2 * d / R2;
+      }
+      s /= R2;
+    } else {
+      long double uu[4] = {p[0], p[1], p[2], 1}, mu[4] = {0, 0, 0, 0};
+      for (int a = 0; a < 4; a++)
+        for (int b = 0; b < 4; b++) mu[a] += (long double)k->m[a][b] * uu[b];
+      for (int a = 0; a < 4; a++) s += uu[a] * mu[a];
+      s /= R2;
+      for (int i = 0; i < 3; i++) gs[i] = 2 * mu[i] / R2;
+    }
+    if (s >= 1) continue;
+    long double dc = -22.0L / 9 + 34.0L / 9 * s - 12.0L / 9 * s * s;
+    for (int i = 0; i < 3; i++) g[i] += k->w * dc * gs[i];
+  }
+}
+
+/* soft_field_box and soft_grad_box (the mesher's cell proofs) hold the
+ * field (MPFR) and the gradient (long double, from the definition) at
+ * the corners and random points of 600 random boxes of sides 1e-3 to 1
+ * over a cloud of spheres, ellipsoids and negative keys. */
+static void test_box_bounds(void)
+{
+  tkey tk[40];
+  double off[3] = {0, 0, 0};
+  make_cloud(tk, 40, off, 1, 1);
+  soft_obj *o = build(tk, 40, 0.5);
+  CHECK("box bounds: the cloud builds", o != NULL);
+  if (!o) return;
+  mpfr_t f;
+  mpfr_init2(f, 256);
+  int fbad = 0, gbad = 0, pts = 0;
+  double width = 0;
+  for (int b = 0; b < 600; b++) {
+    double side = pow(10, -3 * rnd()), lo[3], hi[3], fl, fh, gl[3], gh[3];
+    for (int a = 0; a < 3; a++) {
+      lo[a] = (rnd() - 0.5) * 3.2;
+      hi[a] = lo[a] + side * (0.5 + rnd());
+    }
+    soft_field_box(o, lo, hi, &fl, &fh);
+    soft_grad_box(o, lo, hi, gl, gh);
+    for (int a = 0; a < 3; a++) width = fmax(width, (gh[a] - gl[a]) / side);
+    for (int q = 0; q < 24; q++, pts++) {
+      double p[3];
+      for (int a = 0; a < 3; a++)
+        p[a] = q < 8 ? (q >> a & 1 ? hi[a] : lo[a]) : lo[a] + rnd() * (hi[a] - lo[a]);
+      mp_field(f, tk, 40, p);
+      double v = mpfr_get_d(f, MPFR_RNDN);
+      if (v < fl || v > fh) fbad++;
+      long double g[3];
+      ld_grad(tk, 40, p, g);
+      for (int a = 0; a < 3; a++)
+        if (g[a] < gl[a] || g[a] > gh[a]) gbad++;
+    }
+  }
+  mpfr_clear(f);
+  char name[200];
+  snprintf(name, sizeof name, "soft_field_box holds the field (MPFR) at %d points of 600 boxes", pts);
+  CHECK(name, fbad == 0);
+  snprintf(name, sizeof name, "soft_grad_box holds the gradient (long double) at %d points of 600 boxes", pts);
+  CHECK(name, gbad == 0);
+  /* not vacuous: a small box's gradient range is narrow */
+  double lo[3] = {0.1, 0.2, 0.3}, hi[3] = {0.101, 0.201, 0.301}, gl[3], gh[3];
+  soft_grad_box(o, lo, hi, gl, gh);
+  long double g[3];
+  ld_grad(tk, 40, lo, g);
+  double gw = 0, gn = 0;
+  for (int a = 0; a < 3; a++) {
+    gw = fmax(gw, gh[a] - gl[a]);
+    gn += (double)(g[a] * g[a]);
+  }
+  snprintf(name, sizeof name, "soft_grad_box over a 0.001 box: width %.3g against |grad| %.3g", gw, sqrt(gn));
+  CHECK(name, gw < 0.05 * sqrt(gn));
+  soft_free(o);
+}
+
 /* soft_surface_bounds is conservative: no point with field >= magic lies
  * outside it, over clouds of mixed keys (spheres, ellipsoids, negative
  * weights), dense and sparse, and magic from 0.05 to 2. */
@@ -773,6 +863,7 @@ int main(void)
   test_build();
   test_field();
   test_surface_bounds();
+  test_box_bounds();
   test_clouds();
   test_helix();
   test_magic_extremes();
