@@ -5,6 +5,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -562,17 +563,23 @@ void soft_scratch_free(soft_scratch *s) {
 typedef struct {
   double o[3], d[3], inv[3];  /* origin, unit direction, 1/direction */
   double ta, tb;              /* the search range, in units of length */
+  size_t near[3], far[3];     /* per axis: the offsets in a bvh_node of the
+                                 box side the ray meets first and last */
 } soft_ray;
 
-/* Slab test; returns entry in *tn or 0 if the box is missed in [ta, tb]. */
-static int hit_box(const soft_ray *r, const double lo[3], const double hi[3],
-                   double *tn) {
+/* The slab test of node nd; returns entry in *tn or 0 if the box is
+ * missed in [ta, tb]. Per axis the nearer side's t, (lo - o) / d where d
+ * > 0, is the smaller of the two whatever the rounding (it is monotone),
+ * so taking the sides by the direction's signs gives what ordering the
+ * two t's would, bit for bit, without the compare and swap. */
+static inline int hit_box(const soft_ray *r, const bvh_node *nd, double *tn) {
+  const char *b = (const char *)nd;
   double t0 = r->ta, t1 = r->tb;
   for (int i = 0; i < 3; i++) {
-    double a = (lo[i] - r->o[i]) * r->inv[i], b = (hi[i] - r->o[i]) * r->inv[i];
-    if (a > b) { double t = a; a = b; b = t; }
+    double a = (*(const double *)(b + r->near[i]) - r->o[i]) * r->inv[i];
+    double c = (*(const double *)(b + r->far[i]) - r->o[i]) * r->inv[i];
     if (a > t0) t0 = a;
-    if (b < t1) t1 = b;
+    if (c < t1) t1 = c;
   }
   *tn = t0;
   return t0 <= t1;
@@ -697,6 +704,10 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
     r.d[i] = d[i] / len;
     double di = fabs(r.d[i]) < 1e-300 ? copysign(1e-300, r.d[i]) : r.d[i];
     r.inv[i] = 1 / di;
+    size_t lo = offsetof(bvh_node, lo) + (size_t)i * sizeof(double);
+    size_t hi = offsetof(bvh_node, hi) + (size_t)i * sizeof(double);
+    r.near[i] = r.inv[i] < 0 ? hi : lo;
+    r.far[i] = r.inv[i] < 0 ? lo : hi;
   }
   r.ta = t0 * len;
   r.tb = t1 * len;
@@ -706,7 +717,7 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
   int nn = 0, nk = 0, na = 0, nout = 0;
   double tn;
   const bvh_node *root = &obj->tree.nodes[0];
-  if (hit_box(&r, root->lo, root->hi, &tn))
+  if (hit_box(&r, root, &tn))
     nheap_push(nheap, &nn, (node_ent){tn, 0});
 
   double cur = r.ta;
@@ -727,15 +738,15 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
       if (nd->count == 0) {
         for (int c = 0; c < 2; c++) {
           const bvh_node *ch = &obj->tree.nodes[nd->first + c];
-          if (hit_box(&r, ch->lo, ch->hi, &tn))
-            nheap_push(nheap, &nn, (node_ent){fmax(tn, cur), nd->first + c});
+          if (hit_box(&r, ch, &tn))  /* fmax(tn, cur), no call: */
+            nheap_push(nheap, &nn, (node_ent){tn > cur ? tn : cur, nd->first + c});
         }
       } else {
         for (int j = nd->first; j < nd->first + nd->count; j++) {
           key_event ev;
           if (!hit_key(&r, &obj->keys[j], &ev.te, &ev.tx) || ev.tx <= cur) continue;
           stats->keys++;
-          ev.te = fmax(ev.te, cur);
+          ev.te = ev.te > cur ? ev.te : cur;  /* fmax: te is not NaN */
           ev.i = j;
           kheap_push(kheap, &nk, ev);
         }
