@@ -478,7 +478,7 @@ int soft_grad_box(const soft_obj *obj, const double lo[3], const double hi[3],
 /* ---- field and gradient ---------------------------------------------- */
 
 /* ap = A p for the key's matrix A. */
-static void apply_a(const nkey *k, const double p[3], double ap[3]) {
+static inline void apply_a(const nkey *k, const double p[3], double ap[3]) {
   if (k->sphere) {
     for (int i = 0; i < 3; i++) ap[i] = k->a[0] * p[i];
   } else {
@@ -490,7 +490,7 @@ static void apply_a(const nkey *k, const double p[3], double ap[3]) {
 
 /* s of eq. (1) (r^2/R^2, or u'Mu/R^2 for a quadric, eq. 5) for key k at the
  * point whose offset from the centre is p, with A p into ap. */
-static double key_s(const nkey *k, const double p[3], double ap[3]) {
+static inline double key_s(const nkey *k, const double p[3], double ap[3]) {
   apply_a(k, p, ap);
   return vec3_dot(p, ap) + k->k;
 }
