@@ -575,12 +575,17 @@ typedef struct {
 static inline int hit_box(const soft_ray *r, const bvh_node *nd, double *tn) {
   const char *b = (const char *)nd;
   double t0 = r->ta, t1 = r->tb;
-  for (int i = 0; i < 3; i++) {
-    double a = (*(const double *)(b + r->near[i]) - r->o[i]) * r->inv[i];
-    double c = (*(const double *)(b + r->far[i]) - r->o[i]) * r->inv[i];
-    if (a > t0) t0 = a;
-    if (c < t1) t1 = c;
-  }
+#define SIDE(s, i) ((*(const double *)(b + r->s[i]) - r->o[i]) * r->inv[i])
+  double a0 = SIDE(near, 0), c0 = SIDE(far, 0);
+  double a1 = SIDE(near, 1), c1 = SIDE(far, 1);
+  double a2 = SIDE(near, 2), c2 = SIDE(far, 2);
+#undef SIDE
+  if (a0 > t0) t0 = a0;
+  if (c0 < t1) t1 = c0;
+  if (a1 > t0) t0 = a1;
+  if (c1 < t1) t1 = c1;
+  if (a2 > t0) t0 = a2;
+  if (c2 < t1) t1 = c2;
   *tn = t0;
   return t0 <= t1;
 }
