@@ -502,13 +502,14 @@ static double field_at(const soft_obj *o, const double x[3], double g[3]) {
   if (g) g[0] = g[1] = g[2] = 0;
   if (o->nkeys == 0) return 0;
   int stack[BVH_STACK], sp = 0;  /* enough for any tree (bvh.h) */
-  stack[sp++] = 0;
+  /* only nodes holding x are stacked: those the walk descends into, in
+     the same order (the right child first), so the sum's order is kept */
+  if (bvh_node_has(&o->tree.nodes[0], x)) stack[sp++] = 0;
   while (sp > 0) {
     const bvh_node *nd = &o->tree.nodes[stack[--sp]];
-    if (!bvh_node_has(nd, x)) continue;
     if (nd->count == 0) {
-      stack[sp++] = nd->first;
-      stack[sp++] = nd->first + 1;
+      if (bvh_node_has(&o->tree.nodes[nd->first], x)) stack[sp++] = nd->first;
+      if (bvh_node_has(&o->tree.nodes[nd->first + 1], x)) stack[sp++] = nd->first + 1;
       continue;
     }
     for (int j = nd->first; j < nd->first + nd->count; j++) {
