@@ -733,20 +733,22 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
   long iv = 0;
   double amin = INFINITY;  /* earliest exit among the active keys */
   for (;;) {
-    double tfront = nn ? nheap[0].t : INFINITY;
     double tnext = r.tb;
     if (nk && kheap[0].te < tnext) tnext = kheap[0].te;
     if (amin < tnext) tnext = amin;
-    if (tfront < tnext) {  /* a key may still enter before tnext: discover */
+    /* Discover while a key may still enter before tnext; a key found
+     * lowers tnext as it would the top of the key heap. */
+    while (nn && nheap[0].t < tnext) {
       node_ent e = nheap_pop(nheap, &nn);
       const bvh_node *nd = &obj->tree.nodes[e.i];
       stats->nodes++;
       if (nd->count == 0) {
-        for (int c = 0; c < 2; c++) {
-          const bvh_node *ch = &obj->tree.nodes[nd->first + c];
-          if (hit_box(&r, ch, &tn))  /* fmax(tn, cur), no call: */
-            nheap_push(nheap, &nn, (node_ent){tn > cur ? tn : cur, nd->first + c});
-        }
+        int f = nd->first;
+        const bvh_node *ch = &obj->tree.nodes[f];
+        if (hit_box(&r, ch, &tn))  /* fmax(tn, cur), no call: */
+          nheap_push(nheap, &nn, (node_ent){tn > cur ? tn : cur, f});
+        if (hit_box(&r, ch + 1, &tn))
+          nheap_push(nheap, &nn, (node_ent){tn > cur ? tn : cur, f + 1});
       } else {
         for (int j = nd->first; j < nd->first + nd->count; j++) {
           key_event ev;
@@ -755,9 +757,9 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
           ev.te = ev.te > cur ? ev.te : cur;  /* fmax: te is not NaN */
           ev.i = j;
           kheap_push(kheap, &nk, ev);
+          if (ev.te < tnext) tnext = ev.te;
         }
       }
-      continue;
     }
     if (!isfinite(tnext)) {  /* nothing active, nothing left to find */
       if (state == 1 && na == 0 && iv > 0 && nout < maxout) out[nout++] = cur / len;
