@@ -635,6 +635,49 @@ static void test_clouds(void)
   soft_free(o);
 }
 
+/* Rays parallel to an axis, their other direction components +0 or -0
+ * (the key BVH's slab test takes a box's near and far sides by the
+ * direction's signs, -0 included), through a lattice of equal keys whose
+ * bounds, and so the BVH's boxes, share face planes; some rays run in
+ * those planes (a key's bound's face, a lattice plane). Checked against
+ * the dense long-double reference. */
+static void test_axis_rays(void)
+{
+  tkey tk[64];
+  int n = 0;
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++)
+      for (int k = 0; k < 4; k++)
+        tk[n++] = sphere_key(0.5 * i - 0.75, 0.5 * j - 0.75, 0.5 * k - 0.75,
+                             0.5, (i + j + k) % 3 ? 0.6 : 0.9);
+  soft_obj *o = build(tk, n, 0.5);
+  soft_scratch *s = soft_scratch_new((size_t)n);
+  tally ty;
+  memset(&ty, 0, sizeof ty);
+  int faces = 0;
+  for (int axis = 0; axis < 3; axis++)
+    for (int sg = -1; sg <= 1; sg += 2)
+      for (int zs = 0; zs < 2; zs++)
+        for (int r = 0; r < 8; r++) {
+          double d[3], org[3], tg[3];
+          for (int i = 0; i < 3; i++) {
+            d[i] = zs ? -0.0 : 0.0;
+            /* r < 4: in lattice planes or on bound faces (0.25 + 0.5 m,
+               -0.75 + 0.5 m); else anywhere in the lattice's box */
+            tg[i] = r < 4 ? -0.75 + 0.25 * (double)((r + 3 * i) % 7)
+                          : (rnd() - 0.5) * 2.2;
+          }
+          d[axis] = sg;
+          faces += r < 4;
+          for (int i = 0; i < 3; i++) org[i] = tg[i] - 4 * d[i];
+          compare_ray(tk, n, o, 0.5, org, d, 0, INFINITY, 2e-3, s, NULL, &ty);
+        }
+  report("axis-parallel rays (other components +0 and -0) through a lattice", &ty);
+  CHECK("axis-parallel rays: some run in the bounds' face planes", faces == 48);
+  soft_scratch_free(s);
+  soft_free(o);
+}
+
 static void test_helix(void)
 {
   tkey tk[50];
@@ -865,6 +908,7 @@ int main(void)
   test_surface_bounds();
   test_box_bounds();
   test_clouds();
+  test_axis_rays();
   test_helix();
   test_magic_extremes();
   test_boundary_root();
