@@ -184,6 +184,46 @@ static Value *known_var(Expr *e, Env *env) {
   return s->global;
 }
 
+static int known_num(Interp *I, Expr *e, Env *env, double *out);
+
+/* How many calls of defined functions known_num looks into, nested: a
+   function whose body calls itself is not unfolded without end. */
+#define KNOWN_CALL_DEPTH 4
+static _Thread_local int known_calls;
+
+/* known_num of f applied to the arguments of e (an E_APP), when f is a
+   defined function (a lambda, say) of one clause taking exactly those
+   arguments with variable patterns, no guard and no where: its body, in a
+   frame binding those variables to the arguments' present values as
+   select_clause would, is arithmetic on known Reals. The frame lives on
+   the C stack only while known_num reads it: nothing is made, so a body
+   that is not such arithmetic costs no more than the look. */
+static Value *lit_num(Expr *e);
+static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out) {
+  Def *d = f->u.fn.u.def;
+  int n = e->u.app.n;
+  if (d->arity != n || d->nclauses != 1 || d->pat || n > 4 ||
+      known_calls >= KNOWN_CALL_DEPTH)
+    return 0;
+  Clause *c = d->clauses[0];
+  if (c->nbodies != 1 || c->guards[0] || c->nwhere) return 0;
+  Sym *names[4];
+  Value *vals[4];
+  for (int i = 0; i < n; i++) {
+    Pat *p = c->pats[i];
+    Expr *a = e->u.app.args[i];
+    if (p->kind != P_VAR) return 0;
+    names[i] = p->u.var;
+    if (a->kind == E_NUM) vals[i] = lit_num(a);
+    else if (a->kind != E_VAR || !(vals[i] = known_var(a, env))) return 0;
+  }
+  Env frame = {f->u.fn.env, n, n, names, vals};
+  known_calls++;
+  int ok = known_num(I, c->bodies[0], &frame, out);
+  known_calls--;
+  return ok;
+}
+
 static int known_num(Interp *I, Expr *e, Env *env, double *out) {
   char probe; /* a chain of a million '+' is left to eval, which checks */
   if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
@@ -197,10 +237,13 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
     *out = v->u.num;
     return 1;
   }
-  case E_APP: { /* floor x, min a b, ...: built-ins defined on every Real */
-    if (e->u.app.fn->kind != E_VAR || e->u.app.n > 2) return 0;
+  case E_APP: { /* floor x, min a b, ...: built-ins defined on every Real;
+                   (\x -> x * 3) y: see known_call */
+    if (e->u.app.fn->kind != E_VAR) return 0;
     Value *f = known_var(e->u.app.fn, env);
-    if (!f || f->kind != V_FUNC || f->u.fn.kind != F_BUILTIN ||
+    if (f && f->kind == V_FUNC && f->u.fn.kind == F_DEF)
+      return known_call(I, e, env, f, out);
+    if (e->u.app.n > 2 || !f || f->kind != V_FUNC || f->u.fn.kind != F_BUILTIN ||
         f->u.fn.arity != e->u.app.n)
       return 0;
     double x[2];
@@ -301,6 +344,8 @@ static int known_vec(Interp *I, Expr *e, Env *env, double *out) {
   }
 }
 
+static Value *mk_fn(Def *d, Env *env);
+
 /* A constructor applied to all its arguments, in the user's code, is
    built at once: that cannot fail, and its arguments stay delayed. */
 static Value *known_con(Interp *I, Expr *e, Env *env) {
@@ -342,6 +387,7 @@ Value *delay(Interp *I, Expr *e, Env *env) {
   case E_STR: return lit_str(e);
   case E_BOOL: return val_bool(I, e->u.b);
   case E_VAR: return lookup(I, e, env);
+  case E_LAMBDA: return mk_fn(e->u.lambda, env); /* as eval makes it */
   default: return mk_thunk(I, e, env);
   }
 }
