@@ -96,6 +96,10 @@ typedef struct Clause {
   Expr **bodies;
   int nwhere;
   Def **where;
+  /* eval.c's select_clause: 0 not yet looked at; else 1 + the number of
+     variables its patterns bind, if every pattern is a variable, _, [] or
+     [h : t] with h and t variables or _; -1 if not */
+  int simple;
 } Clause;
 
 /* A definition: a named function or value with one or more clauses, or a

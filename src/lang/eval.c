@@ -713,6 +713,60 @@ static void brief_args(Interp *I, int n, Value **args, char *buf, size_t size) {
   }
 }
 
+/* Clause.simple (ast.h) of cl, found on first use. */
+static int pat_is_var(const Pat *p) { return p->kind == P_VAR || p->kind == P_WILD; }
+static int clause_simple(Clause *cl) {
+  if (cl->simple) return cl->simple;
+  int vars = 0;
+  for (int i = 0; i < cl->npats; i++) {
+    Pat *p = cl->pats[i];
+    if (p->kind == P_VAR) {
+      vars++;
+    } else if (p->kind == P_CONS && pat_is_var(p->u.cons.head) &&
+               pat_is_var(p->u.cons.tail)) {
+      vars += (p->u.cons.head->kind == P_VAR) + (p->u.cons.tail->kind == P_VAR);
+    } else if (p->kind != P_WILD && p->kind != P_NIL) {
+      return cl->simple = -1;
+    }
+  }
+  return cl->simple = vars + 1;
+}
+
+/* match() of a simple clause's patterns (clause_simple), in two passes:
+   the list arguments are forced and their kinds checked left to right,
+   stopping at the first that does not match, as match() does; only a
+   clause that matches gets a frame, sized for its variables and where
+   bindings, filled in match()'s order. Returns the frame or NULL. */
+static Env *match_simple(Interp *I, Clause *cl, int simple, Env *env,
+                         Value **args) {
+  for (int i = 0; i < cl->npats; i++) {
+    int k = cl->pats[i]->kind;
+    if (k == P_NIL && force(I, args[i])->kind != V_NIL) return NULL;
+    if (k == P_CONS && force(I, args[i])->kind != V_CONS) return NULL;
+  }
+  Env *frame = env_new(env, simple + cl->nwhere);
+  int n = 0;
+  for (int i = 0; i < cl->npats; i++) {
+    Pat *p = cl->pats[i];
+    if (p->kind == P_VAR) {
+      frame->names[n] = p->u.var;
+      frame->vals[n++] = args[i];
+    } else if (p->kind == P_CONS) {
+      Value *v = args[i]; /* forced above, in place */
+      if (p->u.cons.head->kind == P_VAR) {
+        frame->names[n] = p->u.cons.head->u.var;
+        frame->vals[n++] = v->u.cons.head;
+      }
+      if (p->u.cons.tail->kind == P_VAR) {
+        frame->names[n] = p->u.cons.tail->u.var;
+        frame->vals[n++] = v->u.cons.tail;
+      }
+    }
+  }
+  frame->n = n;
+  return frame;
+}
+
 /* Choose the clause of d that matches args and the body whose guard holds;
    returns the body and its environment for the caller to evaluate. */
 static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
@@ -721,19 +775,25 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
   for (int c = 0; c < d->nclauses; c++) {
     Clause *cl = d->clauses[c];
     Env *frame;
-    if (spare && spare->cap >= cl->npats + cl->nwhere + 1) {
-      frame = spare; /* nothing made by a failed match refers to it */
-      frame->n = 0;
-      spare = NULL;
+    int simple = args ? clause_simple(cl) : -1;
+    if (simple > 0) {
+      frame = match_simple(I, cl, simple, env, args);
+      if (!frame) continue;
     } else {
-      frame = env_new(env, cl->npats + cl->nwhere + 1);
-    }
-    int ok = 1;
-    for (int i = 0; i < cl->npats && ok; i++)
-      ok = match(I, cl->pats[i], args[i], frame);
-    if (!ok) {
-      spare = frame;
-      continue;
+      if (spare && spare->cap >= cl->npats + cl->nwhere + 1) {
+        frame = spare; /* nothing made by a failed match refers to it */
+        frame->n = 0;
+        spare = NULL;
+      } else {
+        frame = env_new(env, cl->npats + cl->nwhere + 1);
+      }
+      int ok = 1;
+      for (int i = 0; i < cl->npats && ok; i++)
+        ok = match(I, cl->pats[i], args[i], frame);
+      if (!ok) {
+        spare = frame;
+        continue;
+      }
     }
     if (cl->nwhere) bind_defs(I, cl->nwhere, cl->where, frame);
     for (int b = 0; b < cl->nbodies; b++) {
