@@ -122,6 +122,10 @@ struct Def {
      that an animation re-evaluates only what depends on frame and clock. */
   int nuses;
   Sym **uses;
+  /* resolve.c: 1 if no variable in its clauses is bound outside them (it
+     captures nothing: eval.c's closures of it keep no frame), 2 if one
+     is, 0 not resolved yet (taken as 2) */
+  int closed;
 };
 
 /* Type declarations: constructors with their arities. */

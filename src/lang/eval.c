@@ -27,6 +27,39 @@ static __attribute__((noinline)) void scrub_stack(void) {
   __asm__ volatile("" : : "r"(pad) : "memory");
 }
 
+/* Zeroes SCRUB_NEAR bytes below the caller's frame, where the next call's
+   frames will lie (see eval's E_APP). */
+#define SCRUB_NEAR 1024
+static __attribute__((noinline)) void scrub_near(void) {
+  volatile char pad[SCRUB_NEAR];
+  memset((char *)pad, 0, sizeof pad);
+  __asm__ volatile("" : : "r"(pad) : "memory");
+}
+
+/* Zeroes the registers a callee saves (and so keeps, in its frame or
+   unchanged, through the whole call): whatever the caller held there
+   that it no longer needs (env, in eval's E_APP) would otherwise stay
+   visible to the collector, which scans registers as it does the stack.
+   The compiler saves around it what is still live. x86-64 and AArch64;
+   elsewhere nothing (a possible leak, not an error). */
+#if defined(__x86_64__) && defined(__GNUC__)
+#define CLEAR_CALLEE_SAVED()                                                 \
+  __asm__ volatile("xor %%ebx, %%ebx\n\txor %%r12d, %%r12d\n\t"             \
+                   "xor %%r13d, %%r13d\n\txor %%r14d, %%r14d\n\t"            \
+                   "xor %%r15d, %%r15d"                                     \
+                   : : : "rbx", "r12", "r13", "r14", "r15")
+#elif defined(__aarch64__) && defined(__GNUC__)
+#define CLEAR_CALLEE_SAVED()                                                 \
+  __asm__ volatile("mov x19, xzr\n\tmov x20, xzr\n\tmov x21, xzr\n\t"      \
+                   "mov x22, xzr\n\tmov x23, xzr\n\tmov x24, xzr\n\t"      \
+                   "mov x25, xzr\n\tmov x26, xzr\n\tmov x27, xzr\n\t"      \
+                   "mov x28, xzr"                                           \
+                   : : : "x19", "x20", "x21", "x22", "x23", "x24", "x25",   \
+                     "x26", "x27", "x28")
+#else
+#define CLEAR_CALLEE_SAVED() ((void)0)
+#endif
+
 /* eval_check (eval.h) found something to do: I->steps is counted and,
    unless a check before failed, I->memcheck too. No system calls, no
    allocation. */
@@ -629,7 +662,11 @@ static void pat_bind_vars(Pat *p, Value *whole, Env *frame, Pat *top) {
   }
 }
 
+/* A function that captures nothing (Def.closed) keeps no frame: a lambda
+   given to map inside `let xs = [1 .. 10^6] in ...` would otherwise keep
+   the let's frame, and so all of xs, alive while map walks it. */
 static Value *mk_fn(Def *d, Env *env) {
+  if (d->closed == 1) env = NULL;
   Value *v = val_cell();
   v->kind = V_FUNC;
   v->u.fn.kind = F_DEF;
@@ -1346,8 +1383,19 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       int n = e->u.app.n;
       Value **args = val_array(n);
       for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
+      /* A built-in that walks a list (sum, length, foldl) runs long in
+         frames laid over the stack that eval, delay and lookup have just
+         used: slots of those frames that it never writes keep what they
+         held, often env, and the collector, which scans the stack
+         conservatively, then keeps env's frame and, through it, a list
+         bound there and being consumed (`let xs = [1 .. 10^6] in sum xs`
+         held 131 MB for its 10^6 cells, 23 MB now). */
+      if (f->kind == V_FUNC && f->u.fn.kind == F_BUILTIN) {
+        scrub_near();
+        CLEAR_CALLEE_SAVED();
+      }
       Expr *body;
-      Env *benv;
+      Env *benv = NULL; /* its slot would still hold the last tail call's */
       if (call(I, f, n, args, e->pos, &e->pos, &result, &body, &benv,
                tslot)) {
         tslot = depth + 1;
