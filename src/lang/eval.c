@@ -777,7 +777,7 @@ static int clause_simple(Clause *cl) {
 static Env *match_simple(Interp *I, Clause *cl, int simple, Env *env,
                          Value **args) {
   for (int i = 0; i < cl->npats; i++) {
-    int k = cl->pats[i]->kind;
+    PatKind k = cl->pats[i]->kind;
     if (k == P_NIL && force(I, args[i])->kind != V_NIL) return NULL;
     if (k == P_CONS && force(I, args[i])->kind != V_CONS) return NULL;
   }
