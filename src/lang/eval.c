@@ -1389,8 +1389,11 @@ Value *eval(Interp *I, Expr *e, Env *env) {
          held, often env, and the collector, which scans the stack
          conservatively, then keeps env's frame and, through it, a list
          bound there and being consumed (`let xs = [1 .. 10^6] in sum xs`
-         held 131 MB for its 10^6 cells, 23 MB now). */
-      if (f->kind == V_FUNC && f->u.fn.kind == F_BUILTIN) {
+         held 131 MB for its 10^6 cells, 23 MB now). The same goes for the
+         registers it saves. Only for those built-ins: for mod or sqrt the
+         scrub would cost more than the call. */
+      if (f->kind == V_FUNC && f->u.fn.kind == F_BUILTIN &&
+          builtin_walks_list(f->u.fn.u.bi)) {
         scrub_near();
         CLEAR_CALLEE_SAVED();
       }
