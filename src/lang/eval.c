@@ -1379,7 +1379,11 @@ Value *eval(Interp *I, Expr *e, Env *env) {
     case E_WILD:
       qcs_error(e->pos, "'_' stands only in patterns");
     case E_APP: {
-      Value *f = eval(I, e->u.app.fn, env);
+      /* a named function (the common case) without a nested eval: what
+         eval's E_VAR does, less its step check, made here for the call */
+      Value *f = e->u.app.fn->kind == E_VAR
+                     ? force(I, lookup(I, e->u.app.fn, env))
+                     : eval(I, e->u.app.fn, env);
       int n = e->u.app.n;
       Value **args = val_array(n);
       for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
