@@ -232,7 +232,11 @@ static _Thread_local int known_calls;
    the C stack only while known_num reads it: nothing is made, so a body
    that is not such arithmetic costs no more than the look. */
 static Value *lit_num(Expr *e);
-static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out) {
+static int known_bool(Interp *I, Expr *e, Env *env, int *out);
+/* With bout non-NULL, the body must be a known comparison (known_bool),
+   its value put there, and out is not used. */
+static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out,
+                      int *bout) {
   Def *d = f->u.fn.u.def;
   int n = e->u.app.n;
   if (d->arity != n || d->nclauses != 1 || d->pat || n > 4 ||
@@ -252,7 +256,8 @@ static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out) {
   }
   Env frame = {f->u.fn.env, n, n, names, vals};
   known_calls++;
-  int ok = known_num(I, c->bodies[0], &frame, out);
+  int ok = bout ? known_bool(I, c->bodies[0], &frame, bout)
+                : known_num(I, c->bodies[0], &frame, out);
   known_calls--;
   return ok;
 }
@@ -275,7 +280,7 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
     if (e->u.app.fn->kind != E_VAR) return 0;
     Value *f = known_var(e->u.app.fn, env);
     if (f && f->kind == V_FUNC && f->u.fn.kind == F_DEF)
-      return known_call(I, e, env, f, out);
+      return known_call(I, e, env, f, out, NULL);
     if (e->u.app.n > 2 || !f || f->kind != V_FUNC || f->u.fn.kind != F_BUILTIN ||
         f->u.fn.arity != e->u.app.n)
       return 0;
@@ -303,6 +308,36 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
   default:
     return 0;
   }
+}
+
+/* A comparison of Reals already known (x > 10), or a call as known_call
+   takes whose body is one (p x with p = \x -> x > 10): its truth in
+   *out, as binop and values_equal would find it; 0 if e is not such. For
+   guards and conditions, which are forced at once anyway: this spares the
+   call's frame and the Bool's cell. */
+static int known_bool(Interp *I, Expr *e, Env *env, int *out) {
+  if (e->kind == E_APP) {
+    if (e->u.app.fn->kind != E_VAR) return 0;
+    Value *f = known_var(e->u.app.fn, env);
+    if (!f || f->kind != V_FUNC || f->u.fn.kind != F_DEF) return 0;
+    return known_call(I, e, env, f, NULL, out);
+  }
+  if (e->kind != E_BINOP) return 0;
+  TokKind op = e->u.bin.op;
+  double a, b;
+  if (op != T_LT && op != T_LE && op != T_GT && op != T_GE && op != T_EQ &&
+      op != T_NE)
+    return 0;
+  /* only a name or a literal on each side: a look deeper (mod x 3 == 1)
+     fails as often as not and then costs more than it spares */
+  Expr *l = e->u.bin.a, *r = e->u.bin.b;
+  if ((l->kind != E_VAR && l->kind != E_NUM) || (r->kind != E_VAR && r->kind != E_NUM))
+    return 0;
+  if (!known_num(I, e->u.bin.a, env, &a) || !known_num(I, e->u.bin.b, env, &b))
+    return 0;
+  *out = op == T_LT ? a < b : op == T_LE ? a <= b : op == T_GT ? a > b
+       : op == T_GE ? a >= b : op == T_EQ ? a == b : a != b;
+  return 1;
 }
 
 /* The value of a literal, one per place it is written. */
@@ -835,7 +870,10 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
     if (cl->nwhere) bind_defs(I, cl->nwhere, cl->where, frame);
     for (int b = 0; b < cl->nbodies; b++) {
       Expr *g = cl->guards[b];
-      if (!g || force_bool(I, eval(I, g, frame), g->pos, "a guard")) {
+      int kb;
+      if (!g || (known_bool(I, g, frame, &kb)
+                     ? kb
+                     : force_bool(I, eval(I, g, frame), g->pos, "a guard"))) {
         *out_env = frame;
         return cl->bodies[b];
       }
@@ -1429,12 +1467,14 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       e = body;
       continue;
     }
-    case E_IF:
-      e = force_bool(I, eval(I, e->u.cond.c, env), e->u.cond.c->pos,
-                     "the condition of if")
-              ? e->u.cond.t
-              : e->u.cond.f;
+    case E_IF: {
+      int kb;
+      if (!known_bool(I, e->u.cond.c, env, &kb))
+        kb = force_bool(I, eval(I, e->u.cond.c, env), e->u.cond.c->pos,
+                        "the condition of if");
+      e = kb ? e->u.cond.t : e->u.cond.f;
       continue;
+    }
     case E_TUPLE: {
       double t[VEC_BLOCK_MAX];
       int n = known_vec(I, e, env, t);
