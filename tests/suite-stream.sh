@@ -41,7 +41,8 @@ N=3000000
 # skipped, not failed.
 if grep -q __asan_init "$QCS" 2>/dev/null; then
   for t in length foldl sum-comprehension map-filter append tail-recursion \
-           script-item script-function control-shared-list; do
+           script-item script-function let-bound lambda-bound let-map \
+           let-pipeline control-shared-list; do
     echo "skip stream-$t: the sanitizer build keeps the list alive (see the comment above)"
   done
   SKIP_MEMORY=1
@@ -69,6 +70,21 @@ printf 'length [1 .. %s]\n' "$N" > "$tmp/bare.qcs"
 expect stream-script-item "$N" $M "$tmp/bare.qcs"
 printf 'f n = length [1 .. n];\nf %s\n' "$N" > "$tmp/fn.qcs"
 expect stream-script-function "$N" $M "$tmp/fn.qcs"
+# a list bound by let or by a lambda's parameter and consumed by a
+# built-in, directly or through map with a lambda made inside the let (the
+# let's frame was kept by the lambda's closure, by a stale register and by
+# stale stack slots: 131 MB and more for 10^6 elements)
+expect stream-let-bound "$(awk -v n=$N 'BEGIN { printf "%.0f", n * (n + 1) / 2 }')" \
+  $M -e "let xs = [1 .. $N] in sum xs"
+expect stream-lambda-bound "$N" $M -e "(\\xs -> length xs) [1 .. $N]"
+expect stream-let-map "$(awk -v n=$N 'BEGIN { printf "%.0f", 3 * n * (n + 1) / 2 }')" \
+  $M -e "let xs = [1 .. $N] in sum (map (\\x -> x * 3) xs)"
+# two consumers of one let-bound list walking it in step (bench/hugs's
+# pipeline, with b - a): the i-th pair is (3i, 10 + i), m = N - 9 pairs,
+# so the sum is 10m - m(m + 1)
+expect stream-let-pipeline \
+  "$(awk -v n=$N 'BEGIN { m = n - 9; printf "%.0f", 10 * m - m * (m + 1) }')" \
+  $M -e "let xs = [1 .. $N] in sum (zipWith (\\a b -> b - a) (map (\\x -> x * 3) xs) (filter (\\x -> x > 10) (map (\\x -> x + 1) xs)))"
 # the control: xs is used twice, so all of it must be kept between the two
 expect_error stream-control-shared-list 'more than 32M' \
   $M -e "let xs = [1 .. $N] in length xs + length xs"

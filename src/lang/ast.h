@@ -96,6 +96,10 @@ typedef struct Clause {
   Expr **bodies;
   int nwhere;
   Def **where;
+  /* eval.c's select_clause: 0 not yet looked at; else 1 + the number of
+     variables its patterns bind, if every pattern is a variable, _, [] or
+     [h : t] with h and t variables or _; -1 if not */
+  int simple;
 } Clause;
 
 /* A definition: a named function or value with one or more clauses, or a
@@ -118,6 +122,10 @@ struct Def {
      that an animation re-evaluates only what depends on frame and clock. */
   int nuses;
   Sym **uses;
+  /* resolve.c: 1 if no variable in its clauses is bound outside them (it
+     captures nothing: eval.c's closures of it keep no frame), 2 if one
+     is, 0 not resolved yet (taken as 2) */
+  int closed;
 };
 
 /* Type declarations: constructors with their arities. */

@@ -255,6 +255,11 @@ static Value *bi_foldl(Interp *I, Value **args, Pos pos) {
   return force(I, acc);
 }
 
+int builtin_walks_list(const Builtin *b) {
+  return b->fn == bi_length || b->fn == bi_sum || b->fn == bi_product ||
+         b->fn == bi_foldl;
+}
+
 static Value *bi_concatMap(Interp *I, Value **args, Pos pos);
 static const Builtin concatmap_builtin = {"concatMap", 2, bi_concatMap, NULL};
 static Value *bi_append(Interp *I, Value **args, Pos pos);

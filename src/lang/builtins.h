@@ -79,6 +79,10 @@ void builtins_install(Interp *I);
    min, ...: no error, no loop for any Real), sets *out to its value at x
    and returns 1; else returns 0. */
 int builtin_num(const Builtin *b, int n, const double *x, double *out);
+/* Is b one of the built-ins that walk a whole list in one call (length,
+   sum, product, foldl)? eval.c clears the stack and registers it runs
+   over, so that a list it consumes is not kept by a stale pointer. */
+int builtin_walks_list(const Builtin *b);
 /* Install one built-in as a global (the layers above use it for theirs).
    Its doc reads "NAME ARGS: what it does; e.g. EXAMPLE": :doc and :info
    show both parts, and the suite runs the example. */

@@ -11,6 +11,7 @@ typedef struct Scope {
   struct Scope *up;
   int n, cap;
   Sym **names;
+  Def *owner;    /* the definition of a clause's frame, or NULL */
 } Scope;
 
 typedef struct Resolver {
@@ -202,6 +203,9 @@ static void resolve_var(Resolver *R, Expr *e, Scope *sc) {
     for (int i = x->n - 1; i >= 0; i--)
       if (x->names[i] == s) {
         set_var(e, depth, i + 1);
+        /* the definitions whose frames were crossed capture it */
+        for (Scope *y = sc; y != x; y = y->up)
+          if (y->owner) y->owner->closed = 2;
         return;
       }
   /* an import's own name that another import took: its qualified one */
@@ -257,9 +261,10 @@ static void resolve_block(Resolver *R, int *n, Def ***defs, Scope *s) {
 }
 
 static void resolve_def(Resolver *R, Def *d, Scope *sc) {
+  if (!d->closed) d->closed = 1;
   for (int c = 0; c < d->nclauses; c++) {
     Clause *cl = d->clauses[c];
-    Scope s = {sc, 0, 0, NULL};
+    Scope s = {sc, 0, 0, NULL, d};
     for (int i = 0; i < cl->npats; i++) pat_scope(cl->pats[i], &s);
     if (cl->nwhere) resolve_block(R, &cl->nwhere, &cl->where, &s);
     for (int b = 0; b < cl->nbodies; b++) {
@@ -292,7 +297,7 @@ static void resolve_body(Resolver *R, Expr *e, Scope *sc) {
     break;
   case E_LAMBDA: resolve_def(R, e->u.lambda, sc); break;
   case E_LET: {
-    Scope s = {sc, 0, 0, NULL};
+    Scope s = {sc, 0, 0, NULL, NULL};
     resolve_block(R, &e->u.let.n, &e->u.let.defs, &s);
     resolve(R, e->u.let.body, &s);
     break;
