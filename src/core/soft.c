@@ -397,23 +397,35 @@ static const nkey *key_walk_next(key_walk *w) {
   }
 }
 
+/* The next key of the walk whose bounds meet the box, with the box's
+ * corners relative to the key's centre (ol, oh) and the range [*smin,
+ * *smax] of its s over the box (keys apart from the box have s >= 1
+ * there and add nothing); NULL at the end. */
+static const nkey *key_walk_range(key_walk *w, double ol[3], double oh[3],
+                                  double *smin, double *smax) {
+  for (const nkey *k; (k = key_walk_next(w));) {
+    if (k->empty) continue;
+    int apart = 0;
+    for (int j = 0; j < 3; j++)
+      if (w->hi[j] < k->lo[j] || w->lo[j] > k->hi[j]) apart = 1;
+    if (apart) continue;
+    for (int j = 0; j < 3; j++) {
+      ol[j] = w->lo[j] - k->x0[j];
+      oh[j] = w->hi[j] - k->x0[j];
+    }
+    key_s_range(k, ol, oh, smin, smax);
+    return k;
+  }
+  return NULL;
+}
+
 int soft_field_box(const soft_obj *obj, const double lo[3], const double hi[3],
                    double *flo, double *fhi) {
   double fl = 0, fh = 0, mag = 0;
   key_walk kw;
   key_walk_start(&kw, obj, lo, hi);
-  for (const nkey *k; (k = key_walk_next(&kw));) {
-    if (k->empty) continue;
-    int apart = 0;
-    for (int j = 0; j < 3; j++)
-      if (hi[j] < k->lo[j] || lo[j] > k->hi[j]) apart = 1;
-    if (apart) continue; /* s >= 1 over the box: no contribution */
-    double ol[3], oh[3], smin, smax;
-    for (int j = 0; j < 3; j++) {
-      ol[j] = lo[j] - k->x0[j];
-      oh[j] = hi[j] - k->x0[j];
-    }
-    key_s_range(k, ol, oh, &smin, &smax);
+  double ol[3], oh[3], smin, smax;
+  for (const nkey *k; (k = key_walk_range(&kw, ol, oh, &smin, &smax));) {
     double cl = cfield(smax), ch = cfield(smin); /* C falls for s < 1 */
     if (ch > k->cmax) ch = k->cmax;
     if (k->w >= 0) {
@@ -436,18 +448,8 @@ int soft_grad_box(const soft_obj *obj, const double lo[3], const double hi[3],
   for (int j = 0; j < 3; j++) gl[j] = gh[j] = 0;
   key_walk kw;
   key_walk_start(&kw, obj, lo, hi);
-  for (const nkey *k; (k = key_walk_next(&kw));) {
-    if (k->empty) continue;
-    int apart = 0;
-    for (int j = 0; j < 3; j++)
-      if (hi[j] < k->lo[j] || lo[j] > k->hi[j]) apart = 1;
-    if (apart) continue; /* s >= 1 over the box: no contribution */
-    double ol[3], oh[3], smin, smax;
-    for (int j = 0; j < 3; j++) {
-      ol[j] = lo[j] - k->x0[j];
-      oh[j] = hi[j] - k->x0[j];
-    }
-    key_s_range(k, ol, oh, &smin, &smax);
+  double ol[3], oh[3], smin, smax;
+  for (const nkey *k; (k = key_walk_range(&kw, ol, oh, &smin, &smax));) {
     if (smin >= 1) continue;
     /* dC/ds rises on s < 17/12 (its vertex) and is 0 at s = 1 */
     double cl = cslope(smin), ch = smax >= 1 ? 0 : cslope(smax);
