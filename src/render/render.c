@@ -1191,6 +1191,24 @@ static inline void put_pixel(const Tracer *T, int x, int y, const double sum[3],
   if (im->cost) im->cost[k] = (float)cost;
 }
 
+/* One sample of a pixel into its sums: the ray's work (for the largest),
+   its colour (unless it missed and the picture has alpha), whether it hit,
+   and the depth and normal AOVs from the central sample. The tiled and
+   the untiled paths both use it, so they fill pixels alike. */
+static inline void add_sample(Worker *W, long work, const double rgb[3],
+                              double z, const double nrm[3], int central,
+                              double sum[3], int *hits, double *zmin,
+                              double nrm0[3]) {
+  if (work > W->max_work) W->max_work = work;
+  if (z < INFINITY) (*hits)++;
+  if (z < INFINITY || !W->T->rs->alpha)
+    for (int i = 0; i < 3; i++) sum[i] += rgb[i];
+  if (central) {
+    *zmin = z;
+    memcpy(nrm0, nrm, 3 * sizeof *nrm0);
+  }
+}
+
 /* A block's pixels [x0, x1) x [y0, y1) in two passes: every primary ray
    (culled and pruned to the block's frustum), then the shading, whose
    shadow rays are culled to the hull of their origins and each light.
@@ -1249,14 +1267,8 @@ static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
           shade_hit(W, T->cam.eye, sp->d, sp->found, &sp->h, rgb, &z, nrm, sh);
           long w = ray_work(W->c) - w0 + sp->work;
           cost += w;
-          if (w > W->max_work) W->max_work = w;
-          if (z < INFINITY) hits++;
-          if (z < INFINITY || !rs->alpha)
-            for (int i = 0; i < 3; i++) sum[i] += rgb[i];
-          if (sx == g / 2 && sy == g / 2) { /* AOVs from the central sample */
-            zmin = z;
-            memcpy(nrm0, nrm, sizeof nrm0);
-          }
+          add_sample(W, w, rgb, z, nrm, sx == g / 2 && sy == g / 2, sum,
+                     &hits, &zmin, nrm0);
         }
       put_pixel(T, x, y, sum, hits, zmin, nrm0, cost);
     }
@@ -1264,7 +1276,6 @@ static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
 
 static void render_tile(Worker *W, int tile) {
   Tracer *T = W->T;
-  const RenderSettings *rs = T->rs;
   Image *im = T->im;
   /* tiles cover the crop (im); pixel coordinates are the full picture's */
   int tx = tile % T->tiles_x, ty = tile / T->tiles_x;
@@ -1293,15 +1304,8 @@ static void render_tile(Worker *W, int tile) {
           Hit h;
           int found = primary_hit(W, T->cam.eye, d, &h, NULL);
           shade_hit(W, T->cam.eye, d, found, &h, rgb, &z, nrm, NULL);
-          long w = ray_work(W->c) - w0;
-          if (w > W->max_work) W->max_work = w;
-          if (z < INFINITY) hits++;
-          if (z < INFINITY || !rs->alpha)
-            for (int i = 0; i < 3; i++) sum[i] += rgb[i];
-          if (sx == g / 2 && sy == g / 2) { /* AOVs from the central sample */
-            zmin = z;
-            memcpy(nrm0, nrm, sizeof nrm0);
-          }
+          add_sample(W, ray_work(W->c) - w0, rgb, z, nrm,
+                     sx == g / 2 && sy == g / 2, sum, &hits, &zmin, nrm0);
         }
       put_pixel(T, x, y, sum, hits, zmin, nrm0, ray_work(W->c) - work0);
     }
