@@ -228,7 +228,7 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
     fputs(v->u.b ? "True" : "False", out);
     break;
   case V_STR:
-    print_str(out, v->u.str);
+    print_str(out, eval_str_chars(I, v, pos_none));
     break;
   case V_TUPLE: {
     double scale = zero_scale(I, v);
@@ -343,9 +343,14 @@ void print_brief(FILE *out, Value *v, int depth) {
   case V_BOOL:
     fputs(v->u.b ? "True" : "False", out);
     break;
-  case V_STR:
-    print_str(out, v->u.str);
+  case V_STR: {
+    /* nothing to check the memory against here: a rope too big to
+       flatten shows as "..." */
+    const char *s = val_str_chars(v);
+    if (s) print_str(out, s);
+    else fputs("\"...\"", out);
     break;
+  }
   case V_TUPLE:
     fputc('(', out);
     for (int i = 0; i < v->u.tup.n; i++) {
