@@ -28,6 +28,23 @@ void format_real_digits(char *buf, double x, int digits) {
     strcpy(buf, signbit(x) ? "-0" : "0");
     return;
   }
+  /* A whole number below 2^53 reads back from its own digits and from no
+     fewer (rounded to fewer, it is another whole number, held exactly),
+     and prints without an exponent: written out directly, it is what the
+     search below would find, without its snprintf and strtod calls. */
+  if (digits <= 0 && fabs(x) < 9007199254740992.0 && x == floor(x)) {
+    char rev[20];
+    int k = 0;
+    unsigned long long u = (unsigned long long)fabs(x);
+    do {
+      rev[k++] = (char)('0' + u % 10);
+      u /= 10;
+    } while (u);
+    if (x < 0) *buf++ = '-';
+    while (k) *buf++ = rev[--k];
+    *buf = 0;
+    return;
+  }
   /* The fewest significant digits that read back as x (or, with digits
      set, x rounded to that many: a value within rounding of a round
      number shows as that number) ... */
