@@ -42,7 +42,9 @@ N=3000000
 if grep -q __asan_init "$QCS" 2>/dev/null; then
   for t in length foldl sum-comprehension map-filter append tail-recursion \
            script-item script-function let-bound lambda-bound let-map \
-           let-pipeline control-shared-list; do
+           let-pipeline control-shared-list strings-appended \
+           strings-prepended strings-prefixes-shared \
+           strings-control-prefixes-flat; do
     echo "skip stream-$t: the sanitizer build keeps the list alive (see the comment above)"
   done
   SKIP_MEMORY=1
@@ -88,6 +90,23 @@ expect stream-let-pipeline \
 # the control: xs is used twice, so all of it must be kept between the two
 expect_error stream-control-shared-list 'more than 32M' \
   $M -e "let xs = [1 .. $N] in length xs + length xs"
+
+# Strings built by ++ from 10^5 pieces: appended (s ++ piece) and prepended
+# (piece ++ s), checked against the printer's show of the list. ++ links
+# its sides (a rope) instead of copying them, so the 10^5 prefixes of a
+# String, all kept, share their bytes: about 20 MB, where flat copies
+# would take 35 GB; the control needs every prefix's bytes, so it must hit
+# the limit.
+S=100000
+expect strings-appended True $M -e \
+  "\"[\" ++ foldl (\\s x -> s ++ show x ++ \", \") \"\" [1 .. $((S - 1))] ++ \"$S]\" == show [1 .. $S]"
+expect strings-prepended True $M -e \
+  "\"[\" ++ foldl (\\s x -> show x ++ \", \" ++ s) \"$S]\" [$((S - 1)), $((S - 2)) .. 1] == show [1 .. $S]"
+PS="let ps = take $S (iterate (\\(k, s) -> (k + 1, s ++ show k ++ \", \")) (1, \"[\"))"
+expect strings-prefixes-shared True --max-memory 64M -e \
+  "$PS in foldl (\\ok (k, s) -> ok && s <> \"\") True ps && snd (last ps) ++ \"$S]\" == show [1 .. $S]"
+expect_error strings-control-prefixes-flat 'more than 64M' --max-memory 64M -e \
+  "$PS in foldl (\\ok (k, s) -> ok && s > \"\") True ps && snd (last ps) ++ \"$S]\" == show [1 .. $S]"
 fi
 
 # ranges across chunk boundaries, against seq (whole steps) and awk (Reals:

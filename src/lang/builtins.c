@@ -127,7 +127,13 @@ static Value *bi_not(Interp *I, Value **args, Pos pos) {
 /* show v is v as it prints: a String comes back quoted, as in Haskell, so
    that show (1, "a") and show "a" agree. */
 static Value *bi_show(Interp *I, Value **args, Pos pos) {
-  return val_str(show_value(I, force(I, args[0])));
+  Value *v = force(I, args[0]);
+  if (v->kind == V_NUM) { /* as print_value writes it, without its stream */
+    char buf[32];
+    format_real_digits(buf, v->u.num, I->digits);
+    return val_str(GC_STRDUP(buf));
+  }
+  return val_str(show_value(I, v));
 }
 /* showReal digits x: x rounded to digits significant digits (1..17), as
    :set digits prints it; digits 0 is the shortest form that reads back. */

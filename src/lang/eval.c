@@ -4,6 +4,7 @@
 #include <gc.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -594,10 +595,19 @@ int force_bool(Interp *I, Value *v, Pos pos, const char *what) {
   return v->u.b;
 }
 
+const char *eval_str_chars(Interp *I, Value *v, Pos pos) {
+  if (v->u.str.s) return v->u.str.s;
+  eval_alloc_check(I, pos, v->u.str.len + 1);
+  const char *s = val_str_chars(v);
+  if (!s) qcs_error(pos, "out of memory for a string of %zu bytes",
+                    v->u.str.len + 1);
+  return s;
+}
+
 const char *force_str(Interp *I, Value *v, Pos pos, const char *what) {
   v = force(I, v);
   if (v->kind != V_STR) type_error(I, v, pos, "a String", what);
-  return v->u.str;
+  return eval_str_chars(I, v, pos);
 }
 
 void force_vec3(Interp *I, Value *v, Pos pos, const char *what, double out[3]) {
@@ -622,7 +632,7 @@ static int match(Interp *I, Pat *p, Value *v, Env *frame) {
     return v->kind == V_NUM && v->u.num == p->u.num;
   case P_STR:
     v = force(I, v);
-    return v->kind == V_STR && !strcmp(v->u.str, p->u.str);
+    return v->kind == V_STR && !strcmp(eval_str_chars(I, v, p->pos), p->u.str);
   case P_BOOL:
     v = force(I, v);
     return v->kind == V_BOOL && v->u.b == p->u.b;
@@ -1177,7 +1187,10 @@ static int values_equal(Interp *I, Value *a, Value *b, Pos pos) {
   switch (a->kind) {
   case V_NUM: return a->u.num == b->u.num;
   case V_BOOL: return a->u.b == b->u.b;
-  case V_STR: return !strcmp(a->u.str, b->u.str);
+  case V_STR:
+    return a->u.str.len == b->u.str.len &&
+           !memcmp(eval_str_chars(I, a, pos), eval_str_chars(I, b, pos),
+                   a->u.str.len);
   case V_TUPLE:
     if (a->u.tup.n != b->u.tup.n) return 0;
     for (int i = 0; i < a->u.tup.n; i++)
@@ -1199,7 +1212,8 @@ static int compare(Interp *I, Value *a, Value *b, Pos pos, TokKind op) {
   b = force(I, b);
   if (a->kind == V_NUM && b->kind == V_NUM)
     return a->u.num < b->u.num ? -1 : a->u.num > b->u.num ? 1 : 0;
-  if (a->kind == V_STR && b->kind == V_STR) return strcmp(a->u.str, b->u.str);
+  if (a->kind == V_STR && b->kind == V_STR)
+    return strcmp(eval_str_chars(I, a, pos), eval_str_chars(I, b, pos));
   char ba[120], bb[120];
   val_brief(a, ba, sizeof ba);
   val_brief(b, bb, sizeof bb);
@@ -1219,15 +1233,21 @@ static Value *append_fn;
 static Value *append(Interp *I, Value *a, Value *b, Pos pos) {
   a = force(I, a);
   if (a->kind == V_STR) {
-    const char *y = force_str(I, b, pos, "the right side of ++ on strings");
-    size_t la = strlen(a->u.str), lb = strlen(y);
-    eval_alloc_check(I, pos, la + lb + 1);
-    char *s = GC_MALLOC_ATOMIC(la + lb + 1);
-    if (!s) qcs_error(pos, "out of memory for a string of %zu bytes",
-                      la + lb + 1);
-    memcpy(s, a->u.str, la);
-    memcpy(s + la, y, lb + 1);
-    return val_str(s);
+    /* A rope node, not a copy: building a String by ++ on either side is
+       linear. max-memory is checked as it was for a copy, with both sides
+       and the joined String flat (as they are when the result is
+       flattened while its parts are still in use), so no String can
+       outgrow the limit. */
+    Value *r = force(I, b);
+    if (r->kind != V_STR)
+      type_error(I, r, pos, "a String", "the right side of ++ on strings");
+    size_t la = a->u.str.len, lb = r->u.str.len;
+    if (lb >= SIZE_MAX / 4 - la)
+      qcs_error(pos, "out of memory for a string of %zu + %zu bytes", la, lb);
+    eval_alloc_check(I, pos, la + (r == a ? 0 : lb) + la + lb + 1);
+    if (lb == 0) return a;
+    if (la == 0) return r;
+    return val_str_concat(a, r);
   }
   if (a->kind == V_NIL) {
     Value *r = force(I, b);

@@ -50,6 +50,9 @@ Value *delay_apply(Value *f, int n, Value **args);
 double force_num(Interp *I, Value *v, Pos pos, const char *what);
 int force_bool(Interp *I, Value *v, Pos pos, const char *what);
 const char *force_str(Interp *I, Value *v, Pos pos, const char *what);
+/* The bytes of the String v (already forced), NUL-terminated: a rope made
+   by ++ is flattened here, once, within max-memory (its error at pos). */
+const char *eval_str_chars(Interp *I, Value *v, Pos pos);
 /* A 3-tuple of Reals. */
 void force_vec3(Interp *I, Value *v, Pos pos, const char *what, double out[3]);
 

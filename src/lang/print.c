@@ -28,6 +28,23 @@ void format_real_digits(char *buf, double x, int digits) {
     strcpy(buf, signbit(x) ? "-0" : "0");
     return;
   }
+  /* A whole number below 2^53 reads back from its own digits and from no
+     fewer (rounded to fewer, it is another whole number, held exactly),
+     and prints without an exponent: written out directly, it is what the
+     search below would find, without its snprintf and strtod calls. */
+  if (digits <= 0 && fabs(x) < 9007199254740992.0 && x == floor(x)) {
+    char rev[20];
+    int k = 0;
+    unsigned long long u = (unsigned long long)fabs(x);
+    do {
+      rev[k++] = (char)('0' + u % 10);
+      u /= 10;
+    } while (u);
+    if (x < 0) *buf++ = '-';
+    while (k) *buf++ = rev[--k];
+    *buf = 0;
+    return;
+  }
   /* The fewest significant digits that read back as x (or, with digits
      set, x rounded to that many: a value within rounding of a round
      number shows as that number) ... */
@@ -228,7 +245,7 @@ static void print_rec(Interp *I, FILE *out, Value *v, int parens) {
     fputs(v->u.b ? "True" : "False", out);
     break;
   case V_STR:
-    print_str(out, v->u.str);
+    print_str(out, eval_str_chars(I, v, pos_none));
     break;
   case V_TUPLE: {
     double scale = zero_scale(I, v);
@@ -343,9 +360,14 @@ void print_brief(FILE *out, Value *v, int depth) {
   case V_BOOL:
     fputs(v->u.b ? "True" : "False", out);
     break;
-  case V_STR:
-    print_str(out, v->u.str);
+  case V_STR: {
+    /* nothing to check the memory against here: a rope too big to
+       flatten shows as "..." */
+    const char *s = val_str_chars(v);
+    if (s) print_str(out, s);
+    else fputs("\"...\"", out);
     break;
+  }
   case V_TUPLE:
     fputc('(', out);
     for (int i = 0; i < v->u.tup.n; i++) {

@@ -2,6 +2,7 @@
 #include "lang/value.h"
 
 #include <gc.h>
+#include <stdlib.h>
 #include <string.h>
 
 atomic_int qcs_interrupted;
@@ -93,8 +94,70 @@ Value *val_bool(Interp *I, int b) { return b ? I->v_true : I->v_false; }
 
 Value *val_str(const char *s) {
   Value *v = alloc(V_STR);
-  v->u.str = s;
+  v->u.str.s = s;
+  v->u.str.len = strlen(s);
   return v;
+}
+
+/* Sides this short and flat are copied rather than linked: the copy is
+   bounded, so ++ stays O(1), and a rope gets fewer, longer pieces. */
+#define STR_COPY_MAX 32
+
+Value *val_str_concat(Value *a, Value *b) {
+  size_t la = a->u.str.len, lb = b->u.str.len;
+  Value *v = alloc(V_STR);
+  v->u.str.len = la + lb;
+  if (la + lb <= STR_COPY_MAX && a->u.str.s && b->u.str.s) {
+    char *s = GC_MALLOC_ATOMIC(la + lb + 1);
+    if (s) {
+      memcpy(s, a->u.str.s, la);
+      memcpy(s + la, b->u.str.s, lb + 1);
+      v->u.str.s = s;
+      return v;
+    }
+  }
+  v->u.str.left = a;
+  v->u.str.right = b;
+  return v;
+}
+
+/* Left to right through the tree, with the right sides still to copy on
+   a stack of our own (a rope built by s ++ piece is as deep as it has
+   pieces). Every piece has a byte, so the walk is O(len) even when parts
+   are shared (s ++ s). */
+const char *val_str_chars(Value *v) {
+  if (v->u.str.s) return v->u.str.s;
+  size_t len = v->u.str.len;
+  char *buf = GC_MALLOC_ATOMIC(len + 1);
+  if (!buf) return NULL;
+  Value *local[64], **stack = local;
+  size_t n = 0, cap = sizeof local / sizeof *local, at = 0;
+  for (Value *x = v;;) {
+    while (!x->u.str.s) {
+      if (n == cap) {
+        Value **grown = malloc(2 * cap * sizeof *grown);
+        if (!grown) {
+          if (stack != local) free(stack);
+          return NULL;
+        }
+        memcpy(grown, stack, n * sizeof *grown);
+        if (stack != local) free(stack);
+        stack = grown;
+        cap *= 2;
+      }
+      stack[n++] = x->u.str.right;
+      x = x->u.str.left;
+    }
+    memcpy(buf + at, x->u.str.s, x->u.str.len);
+    at += x->u.str.len;
+    if (n == 0) break;
+    x = stack[--n];
+  }
+  if (stack != local) free(stack);
+  buf[len] = 0;
+  v->u.str.s = buf;
+  v->u.str.left = v->u.str.right = NULL;
+  return buf;
 }
 
 Value **val_array(int n) {

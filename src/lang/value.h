@@ -90,7 +90,11 @@ struct Value {
   union {
     double num;
     int b;
-    const char *str;
+    /* V_STR: len bytes, no NUL among them. Flat: s holds them (with a
+       NUL after). A rope (s == NULL): the bytes of left then right, two
+       V_STRs of at least one byte each; ++ on Strings makes one in O(1)
+       and val_str_chars flattens it, once, when the bytes are wanted. */
+    struct { const char *s; Value *left, *right; size_t len; } str;
     struct { int n; Value **items; } tup;
     struct { Value *head, *tail; } cons;
     struct { Sym *con; int n; Value **args; const Pos *pos; } con; /* pos: where it was built, or NULL */
@@ -227,6 +231,15 @@ Sym *sym_intern(Interp *I, const char *name, int len);
 Value *val_num(double x);
 Value *val_bool(Interp *I, int b);
 Value *val_str(const char *s);
+/* The rope of two Strings, each at least one byte long (a String of
+   la + lb bytes; the caller checks that the sum neither overflows nor
+   passes the memory limit). Short flat sides are copied into a flat
+   String instead. */
+Value *val_str_concat(Value *a, Value *b);
+/* The bytes of the String v, NUL-terminated: a rope is flattened (once:
+   v becomes flat and lets go of its parts), iteratively, so a rope of any
+   depth needs no C stack. NULL when the memory for it runs out. */
+const char *val_str_chars(Value *v);
 Value *val_tuple(int n, Value **items);
 Value *val_tuple3(double x, double y, double z);
 Value *val_cons(Value *head, Value *tail);

@@ -224,6 +224,31 @@ static void test_print(void) {
   }
   CHECK("print: 200000 random doubles read back exactly", bad == 0);
   CHECK("print: with the fewest significant digits", longer == 0);
+  /* Whole numbers below 2^53 (printed directly, not by the search):
+     glibc's exact %.0f as the reference, and the shortest form by the
+     search above (no fewer digits read back). */
+  int wrong = 0, shorter = 0;
+  for (int i = 0; i < 100000; i++) {
+    s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+    double x = (double)(s >> (11 + s % 53)); /* 0 .. 2^53 - 1, all sizes */
+    if (i & 1) x = -x;
+    if (i % 1000 == 0) x = (i & 2 ? 1 : -1) * (9007199254740992.0 - (double)(s % 7 + 1));
+    char buf[32], ref[40];
+    format_real(buf, x);
+    snprintf(ref, sizeof ref, "%.0f", x);
+    if (x == 0) strcpy(ref, signbit(x) ? "-0" : "0");
+    if (strcmp(buf, ref)) wrong++;
+    int p;
+    for (p = 1; p <= 17; p++) {
+      snprintf(ref, sizeof ref, "%.*e", p - 1, x);
+      if (strtod(ref, NULL) == x) break;
+    }
+    size_t sig = strlen(buf) - (x < 0);
+    while (sig > 1 && buf[(x < 0) + sig - 1] == '0') sig--;
+    if ((int)sig != p) shorter++;
+  }
+  CHECK("print: 100000 whole numbers below 2^53 as %.0f writes them", wrong == 0);
+  CHECK("print: whole numbers with the fewest significant digits", shorter == 0);
   char buf[32];
   format_real(buf, 0.1);
   CHECK("print: 0.1", !strcmp(buf, "0.1"));
