@@ -100,6 +100,13 @@ typedef struct Clause {
      variables its patterns bind, if every pattern is a variable, _, [] or
      [h : t] with h and t variables or _; -1 if not */
   int simple;
+  /* eval.c's select_clause, set with simple: the first pattern that can
+     fail, if it is a constructor's with only variables and _ before it,
+     is argument quick_col - 1 and its constructor quick_con (0 if not):
+     an argument already seen to be another constructor skips the clause
+     before anything is bound */
+  int quick_col;
+  Sym *quick_con;
 } Clause;
 
 /* A definition: a named function or value with one or more clauses, or a
