@@ -962,22 +962,34 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
     Clause *cl = d->clauses[c];
     Env *frame;
     int simple = args ? clause_simple(cl) : -1;
+    /* Its first pattern that can fail is a constructor's, after variables:
+       the argument is forced here as matching would force it next, and
+       another constructor (or none) rules the clause out before anything
+       is bound, and with it every clause after it whose first such
+       pattern looks there for another constructor still (Shift's fifteen
+       clauses on its second argument). A pattern of the wrong arity is
+       left to matching and its error. */
+    if (cl->quick_col &&
+        cl->quick_con->con_arity == cl->pats[cl->quick_col - 1]->u.con.n) {
+      int col = cl->quick_col;
+      Value *v = force(I, args[col - 1]);
+      Sym *con = v->kind == V_CON ? v->u.con.con : NULL;
+      if (con != cl->quick_con) {
+        while (c + 1 < d->nclauses) {
+          Clause *next = d->clauses[c + 1];
+          clause_simple(next);
+          if (next->quick_col != col || next->quick_con == con ||
+              next->quick_con->con_arity != next->pats[col - 1]->u.con.n)
+            break;
+          c++;
+        }
+        continue;
+      }
+    }
     if (simple > 0) {
       frame = match_simple(I, cl, simple, env, args);
       if (!frame) continue;
     } else {
-      /* Its first pattern that can fail is a constructor's, after
-         variables: the argument is forced here as match() would force it
-         next, and another constructor (or no constructor) rules the clause
-         out before anything is bound. A pattern of the wrong arity is left
-         to match() and its error. */
-      if (cl->quick_col) {
-        Pat *qp = cl->pats[cl->quick_col - 1];
-        if (cl->quick_con->con_arity == qp->u.con.n) {
-          Value *v = force(I, args[cl->quick_col - 1]);
-          if (v->kind != V_CON || v->u.con.con != cl->quick_con) continue;
-        }
-      }
       Env scratch = {env, 0, MATCH_SCRATCH, snames, svals};
       int ok = 1;
       for (int i = 0; i < cl->npats && ok; i++)
