@@ -107,6 +107,9 @@ typedef struct Clause {
      before anything is bound */
   int quick_col;
   Sym *quick_con;
+  /* eval.c's match_simple: for a simple clause without where bindings,
+     the names its frame binds, in order, shared by all its frames */
+  Sym **frame_names;
 } Clause;
 
 /* A definition: a named function or value with one or more clauses, or a

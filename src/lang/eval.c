@@ -200,6 +200,13 @@ static inline Value *lookup(Interp *I, Expr *e, Env *env) {
     for (int d = e->u.vdepth; d > 0 && f; d--) f = f->up;
     if (f && slot <= f->n && f->names[slot - 1] == e->u.var)
       return f->vals[slot - 1];
+  } else if (slot == RES_GLOBAL && e->u.var->con_arity < 0) {
+    /* a global: as lookup_global finds it, when it is defined */
+    Sym *s = e->u.var;
+    Value *v = e->pos.src && e->pos.src->prelude && s->prelude_value
+                   ? s->prelude_value
+                   : s->global;
+    if (v) return v;
   }
   return lookup_global(I, e, env);
 }
@@ -448,7 +455,10 @@ static Value *known_con(Interp *I, Expr *e, Env *env) {
   return v;
 }
 
-Value *delay(Interp *I, Expr *e, Env *env) {
+/* delay() of anything but a variable: out of line, so that delay() of a
+   variable (most arguments) is a lookup without a frame. */
+static __attribute__((noinline)) Value *delay_slow(Interp *I, Expr *e,
+                                                   Env *env) {
   double x, t[VEC_BLOCK_MAX];
   int n;
   switch (e->kind) {
@@ -476,6 +486,11 @@ Value *delay(Interp *I, Expr *e, Env *env) {
   case E_LAMBDA: return mk_fn(e->u.lambda, env); /* as eval makes it */
   default: return mk_thunk(I, e, env);
   }
+}
+
+Value *delay(Interp *I, Expr *e, Env *env) {
+  if (e->kind == E_VAR) return lookup(I, e, env);
+  return delay_slow(I, e, env);
 }
 
 Value *eval_builtin_value(const Builtin *b) {
@@ -866,7 +881,52 @@ static int clause_simple(Clause *cl) {
     }
     if (!ok) return cl->simple = -1;
   }
+  if (cl->nwhere == 0 && vars > 0) { /* match_simple's order */
+    Sym **names = GC_MALLOC(sizeof(Sym *) * (size_t)vars);
+    int k = 0;
+    for (int i = 0; i < cl->npats; i++) {
+      Pat *p = cl->pats[i], **ps = &p;
+      int n = 1;
+      if (p->kind == P_CONS) ps = &p->u.cons.head, n = 2;
+      else if (p->kind == P_CON) ps = p->u.con.args, n = p->u.con.n;
+      else if (p->kind == P_TUPLE) ps = p->u.tuple.items, n = p->u.tuple.n;
+      for (int j = 0; j < n; j++) {
+        Pat *q = p->kind == P_CONS ? (j ? p->u.cons.tail : p->u.cons.head) : ps[j];
+        if (q->kind == P_VAR) names[k++] = q->u.var;
+      }
+    }
+    cl->frame_names = names;
+  }
   return cl->simple = vars + 1;
+}
+
+/* The values a simple clause's patterns bind (match_simple's second
+   pass), in vals, in match()'s order; args are forced where looked into. */
+static inline void simple_vals(Clause *cl, Value **args, Value **vals) {
+  int k = 0;
+  for (int i = 0; i < cl->npats; i++) {
+    Pat *p = cl->pats[i];
+    Value *v = args[i];
+    switch (p->kind) {
+    case P_VAR:
+      vals[k++] = v;
+      break;
+    case P_CONS:
+      if (p->u.cons.head->kind == P_VAR) vals[k++] = v->u.cons.head;
+      if (p->u.cons.tail->kind == P_VAR) vals[k++] = v->u.cons.tail;
+      break;
+    case P_CON:
+      for (int j = 0; j < p->u.con.n; j++)
+        if (p->u.con.args[j]->kind == P_VAR) vals[k++] = v->u.con.args[j];
+      break;
+    case P_TUPLE:
+      for (int j = 0; j < p->u.tuple.n; j++)
+        if (p->u.tuple.items[j]->kind == P_VAR) vals[k++] = v->u.tup.items[j];
+      break;
+    default:
+      break;
+    }
+  }
 }
 
 /* The variables of ps (variables or _) bound to vals, in frame. */
@@ -919,6 +979,18 @@ static Env *match_simple(Interp *I, Clause *cl, int simple, Env *env,
     default:
       break;
     }
+  }
+  if (cl->frame_names) {
+    /* no where bindings: the frame is never added to, so its names can
+       be the clause's own, and its values follow it in one block */
+    int n = simple - 1;
+    Env *frame = val_small(sizeof(Env) + sizeof(Value *) * (size_t)n);
+    frame->up = env;
+    frame->n = frame->cap = n;
+    frame->names = cl->frame_names;
+    frame->vals = (Value **)(frame + 1);
+    simple_vals(cl, args, frame->vals);
+    return frame;
   }
   Env *frame = env_new(env, simple + cl->nwhere);
   for (int i = 0; i < cl->npats; i++) {
@@ -995,12 +1067,29 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
       for (int i = 0; i < cl->npats && ok; i++)
         ok = match(I, cl->pats[i], args[i], &scratch);
       if (!ok) continue;
-      frame = env_new(env, scratch.n + cl->nwhere);
-      for (int i = 0; i < scratch.n; i++) {
-        frame->names[i] = scratch.names[i];
-        frame->vals[i] = scratch.vals[i];
+      int n = scratch.n;
+      if (cl->nwhere == 0 && n > 0) {
+        /* as match_simple's: a match that succeeds binds the same names
+           in the same order every time, kept once in the clause */
+        if (!cl->frame_names) {
+          Sym **names = GC_MALLOC(sizeof(Sym *) * (size_t)n);
+          memcpy(names, scratch.names, sizeof(Sym *) * (size_t)n);
+          cl->frame_names = names;
+        }
+        frame = val_small(sizeof(Env) + sizeof(Value *) * (size_t)n);
+        frame->up = env;
+        frame->n = frame->cap = n;
+        frame->names = cl->frame_names;
+        frame->vals = (Value **)(frame + 1);
+        for (int i = 0; i < n; i++) frame->vals[i] = scratch.vals[i];
+      } else {
+        frame = env_new(env, n + cl->nwhere);
+        for (int i = 0; i < n; i++) {
+          frame->names[i] = scratch.names[i];
+          frame->vals[i] = scratch.vals[i];
+        }
+        frame->n = n;
       }
-      frame->n = scratch.n;
     }
     if (cl->nwhere) bind_defs(I, cl->nwhere, cl->where, frame);
     for (int b = 0; b < cl->nbodies; b++) {
