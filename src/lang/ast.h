@@ -97,9 +97,22 @@ typedef struct Clause {
   int nwhere;
   Def **where;
   /* eval.c's select_clause: 0 not yet looked at; else 1 + the number of
-     variables its patterns bind, if every pattern is a variable, _, [] or
-     [h : t] with h and t variables or _; -1 if not */
+     variables its patterns bind, if every pattern is a variable, _, a
+     Real or Bool literal, [], or a [h : t], constructor or tuple pattern
+     whose parts are variables or _; -1 if not */
   int simple;
+  /* eval.c's select_clause, set with simple: the first pattern that can
+     fail, if it is a constructor's with only variables and _ before it,
+     is argument quick_col - 1 and its constructor quick_con (0 if not):
+     an argument already seen to be another constructor skips the clause
+     before anything is bound */
+  int quick_col;
+  Sym *quick_con;
+  /* eval.c's select_clause: for a clause without where bindings whose
+     patterns bind variables, the names its frame binds, in order (a match
+     that succeeds binds the same every time), shared by all its frames;
+     such a frame is made full (cap == n), so env_bind never writes here */
+  Sym **frame_names;
 } Clause;
 
 /* A definition: a named function or value with one or more clauses, or a

@@ -174,10 +174,15 @@ static inline Value *lookup_local(Expr *e, Env *env) {
   return NULL;
 }
 
-static Value *lookup(Interp *I, Expr *e, Env *env) {
-  Value *v = lookup_local(e, env);
-  if (v) return v;
+/* lookup() of a global, a constructor or a name not found: out of line,
+   as the error path makes a frame that a local's lookup need not pay. */
+static __attribute__((noinline)) Value *lookup_global(Interp *I, Expr *e,
+                                                      Env *env) {
   Sym *s = e->u.var;
+  if (e->u.vslot != RES_GLOBAL) /* not resolved, or not in its slot */
+    for (Env *f = env; f; f = f->up)
+      for (int i = f->n - 1; i >= 0; i--)
+        if (f->names[i] == s) return f->vals[i];
   if (s->con_arity >= 0) return eval_con_value(I, s);
   /* The prelude's code sees the prelude's definitions, so a user's own
      `floor` (the scenes' name for the ground plane) cannot break fract. */
@@ -185,6 +190,26 @@ static Value *lookup(Interp *I, Expr *e, Env *env) {
     return s->prelude_value;
   if (s->global) return s->global;
   unknown_name(I, s, env, e->pos);
+}
+
+/* The value e (an E_VAR) names in env: a local from its resolved frame
+   and slot (the name there checked) without a call, else lookup_global. */
+static inline Value *lookup(Interp *I, Expr *e, Env *env) {
+  int slot = e->u.vslot;
+  if (slot > 0) {
+    Env *f = env;
+    for (int d = e->u.vdepth; d > 0 && f; d--) f = f->up;
+    if (f && slot <= f->n && f->names[slot - 1] == e->u.var)
+      return f->vals[slot - 1];
+  } else if (slot == RES_GLOBAL && e->u.var->con_arity < 0) {
+    /* a global: as lookup_global finds it, when it is defined */
+    Sym *s = e->u.var;
+    Value *v = e->pos.src && e->pos.src->prelude && s->prelude_value
+                   ? s->prelude_value
+                   : s->global;
+    if (v) return v;
+  }
+  return lookup_global(I, e, env);
 }
 
 /* ---- thunks ---- */
@@ -431,7 +456,10 @@ static Value *known_con(Interp *I, Expr *e, Env *env) {
   return v;
 }
 
-Value *delay(Interp *I, Expr *e, Env *env) {
+/* delay() of anything but a variable: out of line, so that delay() of a
+   variable (most arguments) is a lookup without a frame. */
+static __attribute__((noinline)) Value *delay_slow(Interp *I, Expr *e,
+                                                   Env *env) {
   double x, t[VEC_BLOCK_MAX];
   int n;
   switch (e->kind) {
@@ -459,6 +487,11 @@ Value *delay(Interp *I, Expr *e, Env *env) {
   case E_LAMBDA: return mk_fn(e->u.lambda, env); /* as eval makes it */
   default: return mk_thunk(I, e, env);
   }
+}
+
+Value *delay(Interp *I, Expr *e, Env *env) {
+  if (e->kind == E_VAR) return lookup(I, e, env);
+  return delay_slow(I, e, env);
 }
 
 Value *eval_builtin_value(const Builtin *b) {
@@ -540,7 +573,9 @@ static _Noreturn void cycle_error(Interp *I, Value *v) {
   qcs_error(pos, "this value depends on itself (an infinite loop)");
 }
 
-Value *force(Interp *I, Value *v) {
+/* force() of a thunk or a blackhole: out of line, so that force() of a
+   value already evaluated (most calls) costs a compare and no frame. */
+static __attribute__((noinline)) Value *force_slow(Interp *I, Value *v) {
   switch (v->kind) {
   case V_THUNK:
   case V_APTHUNK:
@@ -572,6 +607,11 @@ Value *force(Interp *I, Value *v) {
   default:
     return v;
   }
+}
+
+Value *force(Interp *I, Value *v) {
+  if (v->kind >= V_THUNK && v->kind <= V_BLACKHOLE) return force_slow(I, v);
+  return v;
 }
 
 /* ---- checked forcing ---- */
@@ -620,10 +660,31 @@ void force_vec3(Interp *I, Value *v, Pos pos, const char *what, double out[3]) {
 
 /* ---- pattern matching ---- */
 
+/* env_bind, without the call while the frame has room. */
+static inline void bind_var(Env *frame, Sym *name, Value *v) {
+  if (frame->n < frame->cap) {
+    frame->names[frame->n] = name;
+    frame->vals[frame->n++] = v;
+  } else {
+    env_bind(frame, name, v);
+  }
+}
+
+/* match() of each of ps against vals, left to right; a variable or _
+   without the call. */
+static int match_parts(Interp *I, int n, Pat **ps, Value **vals, Env *frame) {
+  for (int i = 0; i < n; i++) {
+    Pat *q = ps[i];
+    if (q->kind == P_VAR) bind_var(frame, q->u.var, vals[i]);
+    else if (q->kind != P_WILD && !match(I, q, vals[i], frame)) return 0;
+  }
+  return 1;
+}
+
 static int match(Interp *I, Pat *p, Value *v, Env *frame) {
   switch (p->kind) {
   case P_VAR:
-    env_bind(frame, p->u.var, v);
+    bind_var(frame, p->u.var, v);
     return 1;
   case P_WILD:
     return 1;
@@ -646,16 +707,13 @@ static int match(Interp *I, Pat *p, Value *v, Env *frame) {
                 c->con_arity == 1 ? "" : "s", p->u.con.n);
     v = force(I, v);
     if (v->kind != V_CON || v->u.con.con != c) return 0;
-    for (int i = 0; i < p->u.con.n; i++)
-      if (!match(I, p->u.con.args[i], v->u.con.args[i], frame)) return 0;
-    return 1;
+    return match_parts(I, p->u.con.n, p->u.con.args, v->u.con.args, frame);
   }
   case P_TUPLE:
     v = force(I, v);
     if (v->kind != V_TUPLE || v->u.tup.n != p->u.tuple.n) return 0;
-    for (int i = 0; i < p->u.tuple.n; i++)
-      if (!match(I, p->u.tuple.items[i], v->u.tup.items[i], frame)) return 0;
-    return 1;
+    return match_parts(I, p->u.tuple.n, p->u.tuple.items, v->u.tup.items,
+                       frame);
   case P_NIL:
     v = force(I, v);
     return v->kind == V_NIL;
@@ -763,7 +821,7 @@ static void force_some(Interp *I, Value *v, int depth) {
   ErrInfo saved = *err_info();
   ErrFrame f;
   if (ERR_TRY(f)) {
-    v = force(I, v);
+    force(I, v); /* in place: v is not assigned after the setjmp */
     err_pop(&f);
   } else {
     err_pop(&f);
@@ -795,86 +853,252 @@ static void brief_args(Interp *I, int n, Value **args, char *buf, size_t size) {
   }
 }
 
-/* Clause.simple (ast.h) of cl, found on first use. */
+/* Clause.simple and Clause.quick_col, quick_con (ast.h) of cl, found on
+   first use. A simple clause's patterns are variables, _, Real or Bool
+   literals, [], or a [h : t], constructor or tuple pattern whose parts
+   are all variables or _. */
 static int pat_is_var(const Pat *p) { return p->kind == P_VAR || p->kind == P_WILD; }
+static int pats_vars(int n, Pat **ps, int *vars) {
+  for (int i = 0; i < n; i++) {
+    if (!pat_is_var(ps[i])) return 0;
+    *vars += ps[i]->kind == P_VAR;
+  }
+  return 1;
+}
 static int clause_simple(Clause *cl) {
   if (cl->simple) return cl->simple;
+  for (int i = 0; i < cl->npats; i++) {
+    Pat *p = cl->pats[i];
+    if (pat_is_var(p)) continue;
+    if (p->kind == P_CON) {
+      cl->quick_col = i + 1;
+      cl->quick_con = p->u.con.con;
+    }
+    break;
+  }
   int vars = 0;
   for (int i = 0; i < cl->npats; i++) {
     Pat *p = cl->pats[i];
-    if (p->kind == P_VAR) {
-      vars++;
-    } else if (p->kind == P_CONS && pat_is_var(p->u.cons.head) &&
-               pat_is_var(p->u.cons.tail)) {
-      vars += (p->u.cons.head->kind == P_VAR) + (p->u.cons.tail->kind == P_VAR);
-    } else if (p->kind != P_WILD && p->kind != P_NIL) {
-      return cl->simple = -1;
+    int ok;
+    switch (p->kind) {
+    case P_VAR: vars++; ok = 1; break;
+    case P_WILD: case P_NIL: case P_NUM: case P_BOOL: ok = 1; break;
+    case P_CONS: ok = pats_vars(1, &p->u.cons.head, &vars) &&
+                      pats_vars(1, &p->u.cons.tail, &vars); break;
+    case P_CON: ok = pats_vars(p->u.con.n, p->u.con.args, &vars); break;
+    case P_TUPLE: ok = pats_vars(p->u.tuple.n, p->u.tuple.items, &vars); break;
+    default: ok = 0; break;
     }
+    if (!ok) return cl->simple = -1;
+  }
+  if (cl->nwhere == 0 && vars > 0) { /* match_simple's order */
+    Sym **names = GC_MALLOC(sizeof(Sym *) * (size_t)vars);
+    int k = 0;
+    for (int i = 0; i < cl->npats; i++) {
+      Pat *p = cl->pats[i], **ps = &p;
+      int n = 1;
+      if (p->kind == P_CONS) ps = &p->u.cons.head, n = 2;
+      else if (p->kind == P_CON) ps = p->u.con.args, n = p->u.con.n;
+      else if (p->kind == P_TUPLE) ps = p->u.tuple.items, n = p->u.tuple.n;
+      for (int j = 0; j < n; j++) {
+        Pat *q = p->kind == P_CONS ? (j ? p->u.cons.tail : p->u.cons.head) : ps[j];
+        if (q->kind == P_VAR) names[k++] = q->u.var;
+      }
+    }
+    cl->frame_names = names;
   }
   return cl->simple = vars + 1;
 }
 
+/* The values a simple clause's patterns bind (match_simple's second
+   pass), in vals, in match()'s order; args are forced where looked into. */
+static inline void simple_vals(Clause *cl, Value **args, Value **vals) {
+  int k = 0;
+  for (int i = 0; i < cl->npats; i++) {
+    Pat *p = cl->pats[i];
+    Value *v = args[i];
+    switch (p->kind) {
+    case P_VAR:
+      vals[k++] = v;
+      break;
+    case P_CONS:
+      if (p->u.cons.head->kind == P_VAR) vals[k++] = v->u.cons.head;
+      if (p->u.cons.tail->kind == P_VAR) vals[k++] = v->u.cons.tail;
+      break;
+    case P_CON:
+      for (int j = 0; j < p->u.con.n; j++)
+        if (p->u.con.args[j]->kind == P_VAR) vals[k++] = v->u.con.args[j];
+      break;
+    case P_TUPLE:
+      for (int j = 0; j < p->u.tuple.n; j++)
+        if (p->u.tuple.items[j]->kind == P_VAR) vals[k++] = v->u.tup.items[j];
+      break;
+    default:
+      break;
+    }
+  }
+}
+
+/* The variables of ps (variables or _) bound to vals, in frame. */
+static inline void bind_parts(Env *frame, int n, Pat **ps, Value **vals) {
+  for (int i = 0; i < n; i++)
+    if (ps[i]->kind == P_VAR) {
+      frame->names[frame->n] = ps[i]->u.var;
+      frame->vals[frame->n++] = vals[i];
+    }
+}
+
 /* match() of a simple clause's patterns (clause_simple), in two passes:
-   the list arguments are forced and their kinds checked left to right,
-   stopping at the first that does not match, as match() does; only a
+   the arguments its patterns look into are forced and checked left to
+   right, stopping at the first that does not match, as match() does
+   (which forces nothing for a variable or _ inside a pattern); only a
    clause that matches gets a frame, sized for its variables and where
    bindings, filled in match()'s order. Returns the frame or NULL. */
 static Env *match_simple(Interp *I, Clause *cl, int simple, Env *env,
                          Value **args) {
   for (int i = 0; i < cl->npats; i++) {
-    PatKind k = cl->pats[i]->kind;
-    if (k == P_NIL && force(I, args[i])->kind != V_NIL) return NULL;
-    if (k == P_CONS && force(I, args[i])->kind != V_CONS) return NULL;
-  }
-  Env *frame = env_new(env, simple + cl->nwhere);
-  int n = 0;
-  for (int i = 0; i < cl->npats; i++) {
     Pat *p = cl->pats[i];
-    if (p->kind == P_VAR) {
-      frame->names[n] = p->u.var;
-      frame->vals[n++] = args[i];
-    } else if (p->kind == P_CONS) {
-      Value *v = args[i]; /* forced above, in place */
-      if (p->u.cons.head->kind == P_VAR) {
-        frame->names[n] = p->u.cons.head->u.var;
-        frame->vals[n++] = v->u.cons.head;
+    Value *v;
+    switch (p->kind) {
+    case P_NIL:
+      if (force(I, args[i])->kind != V_NIL) return NULL;
+      break;
+    case P_CONS:
+      if (force(I, args[i])->kind != V_CONS) return NULL;
+      break;
+    case P_NUM:
+      v = force(I, args[i]);
+      if (v->kind != V_NUM || v->u.num != p->u.num) return NULL;
+      break;
+    case P_BOOL:
+      v = force(I, args[i]);
+      if (v->kind != V_BOOL || v->u.b != p->u.b) return NULL;
+      break;
+    case P_CON:
+      if (p->u.con.con->con_arity != p->u.con.n) { /* match's error */
+        Env none = {NULL, 0, 0, NULL, NULL};
+        match(I, p, args[i], &none);
       }
-      if (p->u.cons.tail->kind == P_VAR) {
-        frame->names[n] = p->u.cons.tail->u.var;
-        frame->vals[n++] = v->u.cons.tail;
-      }
+      v = force(I, args[i]);
+      if (v->kind != V_CON || v->u.con.con != p->u.con.con) return NULL;
+      break;
+    case P_TUPLE:
+      v = force(I, args[i]);
+      if (v->kind != V_TUPLE || v->u.tup.n != p->u.tuple.n) return NULL;
+      break;
+    default:
+      break;
     }
   }
-  frame->n = n;
+  if (cl->frame_names) {
+    /* no where bindings: the frame is never added to, so its names can
+       be the clause's own, and its values follow it in one block */
+    int n = simple - 1;
+    Env *frame = val_small(sizeof(Env) + sizeof(Value *) * (size_t)n);
+    frame->up = env;
+    frame->n = frame->cap = n;
+    frame->names = cl->frame_names;
+    frame->vals = (Value **)(frame + 1);
+    simple_vals(cl, args, frame->vals);
+    return frame;
+  }
+  Env *frame = env_new(env, simple + cl->nwhere);
+  for (int i = 0; i < cl->npats; i++) {
+    Pat *p = cl->pats[i];
+    Value *v = args[i]; /* forced above, in place, if looked into */
+    switch (p->kind) {
+    case P_VAR:
+      frame->names[frame->n] = p->u.var;
+      frame->vals[frame->n++] = v;
+      break;
+    case P_CONS:
+      bind_parts(frame, 1, &p->u.cons.head, &v->u.cons.head);
+      bind_parts(frame, 1, &p->u.cons.tail, &v->u.cons.tail);
+      break;
+    case P_CON:
+      bind_parts(frame, p->u.con.n, p->u.con.args, v->u.con.args);
+      break;
+    case P_TUPLE:
+      bind_parts(frame, p->u.tuple.n, p->u.tuple.items, v->u.tup.items);
+      break;
+    default:
+      break;
+    }
+  }
   return frame;
 }
+
+/* Bindings a clause's patterns make before its frame exists: match()
+   binds into this many slots on the C stack (more go to the heap, as
+   env_bind grows a frame), and only a clause that matches gets a frame,
+   of the size it needs. */
+#define MATCH_SCRATCH 16
 
 /* Choose the clause of d that matches args and the body whose guard holds;
    returns the body and its environment for the caller to evaluate. */
 static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
                            Pos pos, Env **out_env) {
-  Env *spare = NULL; /* the frame of a clause that did not match */
+  Sym *snames[MATCH_SCRATCH];
+  Value *svals[MATCH_SCRATCH];
   for (int c = 0; c < d->nclauses; c++) {
     Clause *cl = d->clauses[c];
     Env *frame;
     int simple = args ? clause_simple(cl) : -1;
+    /* Its first pattern that can fail is a constructor's, after variables:
+       the argument is forced here as matching would force it next, and
+       another constructor (or none) rules the clause out before anything
+       is bound, and with it every clause after it whose first such
+       pattern looks there for another constructor still (Shift's fifteen
+       clauses on its second argument). A pattern of the wrong arity is
+       left to matching and its error. */
+    if (cl->quick_col &&
+        cl->quick_con->con_arity == cl->pats[cl->quick_col - 1]->u.con.n) {
+      int col = cl->quick_col;
+      Value *v = force(I, args[col - 1]);
+      Sym *con = v->kind == V_CON ? v->u.con.con : NULL;
+      if (con != cl->quick_con) {
+        while (c + 1 < d->nclauses) {
+          Clause *next = d->clauses[c + 1];
+          clause_simple(next);
+          if (next->quick_col != col || next->quick_con == con ||
+              next->quick_con->con_arity != next->pats[col - 1]->u.con.n)
+            break;
+          c++;
+        }
+        continue;
+      }
+    }
     if (simple > 0) {
       frame = match_simple(I, cl, simple, env, args);
       if (!frame) continue;
     } else {
-      if (spare && spare->cap >= cl->npats + cl->nwhere + 1) {
-        frame = spare; /* nothing made by a failed match refers to it */
-        frame->n = 0;
-        spare = NULL;
-      } else {
-        frame = env_new(env, cl->npats + cl->nwhere + 1);
-      }
+      Env scratch = {env, 0, MATCH_SCRATCH, snames, svals};
       int ok = 1;
       for (int i = 0; i < cl->npats && ok; i++)
-        ok = match(I, cl->pats[i], args[i], frame);
-      if (!ok) {
-        spare = frame;
-        continue;
+        ok = match(I, cl->pats[i], args[i], &scratch);
+      if (!ok) continue;
+      int n = scratch.n;
+      if (cl->nwhere == 0 && n > 0) {
+        /* as match_simple's: a match that succeeds binds the same names
+           in the same order every time, kept once in the clause */
+        if (!cl->frame_names) {
+          Sym **names = GC_MALLOC(sizeof(Sym *) * (size_t)n);
+          memcpy(names, scratch.names, sizeof(Sym *) * (size_t)n);
+          cl->frame_names = names;
+        }
+        frame = val_small(sizeof(Env) + sizeof(Value *) * (size_t)n);
+        frame->up = env;
+        frame->n = frame->cap = n;
+        frame->names = cl->frame_names;
+        frame->vals = (Value **)(frame + 1);
+        for (int i = 0; i < n; i++) frame->vals[i] = scratch.vals[i];
+      } else {
+        frame = env_new(env, n + cl->nwhere);
+        for (int i = 0; i < n; i++) {
+          frame->names[i] = scratch.names[i];
+          frame->vals[i] = scratch.vals[i];
+        }
+        frame->n = n;
       }
     }
     if (cl->nwhere) bind_defs(I, cl->nwhere, cl->where, frame);
@@ -986,12 +1210,19 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
       if (n > a)
         qcs_error(pos, "constructor %s takes %d argument%s, but it is given "
                   "%d", c->name, a, a == 1 ? "" : "s", n);
-      Value **cargs = val_array(a);
-      memcpy(cargs, args, sizeof(Value *) * (size_t)a);
+      /* eval's E_APP (spos given) made args for this call alone */
+      Value **cargs = args;
+      if (!spos) {
+        cargs = val_array(a);
+        memcpy(cargs, args, sizeof(Value *) * (size_t)a);
+      }
       *result = val_con(c, a, cargs);
       if (pos.src) { /* scene errors found later point back here */
         if (spos && !pos.src->prelude) {
           (*result)->u.con.pos = spos;  /* the call's own, in its Expr */
+        } else if (pos.src->prelude && I->origin) {
+          (*result)->u.con.pos = I->origin; /* eval_user_pos's; never
+                                               written after it is set */
         } else {
           Pos *p = val_small(sizeof *p);
           *p = eval_user_pos(I, pos);
@@ -1443,7 +1674,7 @@ Value *eval(Interp *I, Expr *e, Env *env) {
                      ? force(I, lookup(I, e->u.app.fn, env))
                      : eval(I, e->u.app.fn, env);
       int n = e->u.app.n;
-      Value **args = val_array(n);
+      Value **args = val_small(sizeof(Value *) * (size_t)n);
       for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
       /* A built-in that walks a list (sum, length, foldl) runs long in
          frames laid over the stack that eval, delay and lookup have just
