@@ -14,7 +14,7 @@ typedef struct { double c[3]; int id; } rec;
 
 typedef struct {
   bvh *b;
-  const bvh_item *it;
+  bvh_items it;
   int leaf_max, split;
   rec *r;     /* the items, in leaf order once built */
   rec *tmp;   /* BVH_SORT: merge buffer of n records */
@@ -102,7 +102,8 @@ static void build_node(builder *B, int ni, int first, int n, int lvl) {
 #define PREFETCH_AHEAD 16
 static void boxes(builder *B) {
   bvh *b = B->b;
-  const bvh_item *it = B->it;
+  const char *lo = (const char *)B->it.lo, *hi = (const char *)B->it.hi;
+  size_t st = B->it.stride;
   const rec *r = B->r;
   int n = b->n;
   for (int j = 0; j < n;) {
@@ -110,12 +111,16 @@ static void boxes(builder *B) {
     for (int i = 0; i < 3; i++) { nd->lo[i] = INFINITY; nd->hi[i] = -INFINITY; }
     for (int e = j + nd->count; j < e; j++) {
 #if defined(__GNUC__)
-      if (j + PREFETCH_AHEAD < n) __builtin_prefetch(&it[r[j + PREFETCH_AHEAD].id]);
+      if (j + PREFETCH_AHEAD < n) {
+        __builtin_prefetch(lo + (size_t)r[j + PREFETCH_AHEAD].id * st);
+        __builtin_prefetch(hi + (size_t)r[j + PREFETCH_AHEAD].id * st);
+      }
 #endif
-      const bvh_item *k = &it[r[j].id];
+      const double *klo = (const double *)(lo + (size_t)r[j].id * st);
+      const double *khi = (const double *)(hi + (size_t)r[j].id * st);
       for (int i = 0; i < 3; i++) {
-        if (k->lo[i] < nd->lo[i]) nd->lo[i] = k->lo[i];
-        if (k->hi[i] > nd->hi[i]) nd->hi[i] = k->hi[i];
+        if (klo[i] < nd->lo[i]) nd->lo[i] = klo[i];
+        if (khi[i] > nd->hi[i]) nd->hi[i] = khi[i];
       }
     }
   }
@@ -131,6 +136,12 @@ static void boxes(builder *B) {
 }
 
 int bvh_build(bvh *b, const bvh_item *items, int n, int leaf_max, int split) {
+  bvh_items v = {items ? items->lo : NULL, items ? items->hi : NULL,
+                 items ? items->c : NULL, sizeof *items};
+  return bvh_build_view(b, v, n, leaf_max, split);
+}
+
+int bvh_build_view(bvh *b, bvh_items items, int n, int leaf_max, int split) {
   b->nodes = NULL;
   b->idx = NULL;
   b->nnodes = b->n = b->depth = 0;
@@ -150,7 +161,8 @@ int bvh_build(bvh *b, const bvh_item *items, int n, int leaf_max, int split) {
   }
   for (int j = 0; j < n; j++) {
     r[j].id = j;
-    for (int i = 0; i < 3; i++) r[j].c[i] = items[j].c[i];
+    const double *c = (const double *)((const char *)items.c + (size_t)j * items.stride);
+    for (int i = 0; i < 3; i++) r[j].c[i] = c[i];
   }
   b->n = n;
   b->nnodes = 1;

@@ -151,17 +151,6 @@ static int make_key(const soft_key *in, nkey *k) {
   return SOFT_OK;
 }
 
-/* The keys' bounds and centres as BVH items (into items, returned). */
-static bvh_item *items_of(bvh_item *items, const nkey *k, size_t n) {
-  for (size_t j = 0; j < n; j++)
-    for (int i = 0; i < 3; i++) {
-      items[j].lo[i] = k[j].lo[i];
-      items[j].hi[i] = k[j].hi[i];
-      items[j].c[i] = k[j].x0[i];
-    }
-  return items;
-}
-
 /* Keys given one at a time, normalised as they come (soft.h). */
 struct soft_builder {
   nkey *all;        /* the keys that act somewhere, normalised */
@@ -249,17 +238,15 @@ int soft_builder_finish(soft_builder *b, double magic, soft_obj **out,
   o->magic = magic;
   o->nkeys = live;
   o->keys = all;
-  /* The BVH over the keys' bounds, split at the median of their centres;
-   * the keys (152 bytes each) then move once into its leaf order, in
-   * place. */
-  bvh_item *items = malloc((live ? live : 1) * sizeof *items);
-  if (!items ||
-      bvh_build(&o->tree, items_of(items, all, live), (int)live, LEAF_MAX,
-                BVH_SELECT) != BVH_OK) {
-    free(items); free(all); free(o);
+  /* The BVH over the keys' bounds, split at the median of their centres,
+   * read from the keys themselves; the keys (152 bytes each) then move
+   * once into its leaf order, in place. */
+  bvh_items items = {all->lo, all->hi, all->x0, sizeof *all};
+  if (bvh_build_view(&o->tree, items, (int)live, LEAF_MAX, BVH_SELECT) !=
+      BVH_OK) {
+    free(all); free(o);
     return SOFT_ERR_NOMEM;
   }
-  free(items);
   if (!gather(all, o->tree.idx, live)) {
     soft_free(o);
     return SOFT_ERR_NOMEM;
