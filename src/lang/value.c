@@ -97,8 +97,8 @@ Value *val_str(const char *s) {
   return v;
 }
 
-Value **val_array(int n) {
-  return GC_MALLOC(sizeof(Value *) * (size_t)(n > 0 ? n : 1));
+Value **val_array(int n) {  /* batched, as val_small: a call's arguments */
+  return val_small(sizeof(Value *) * (size_t)(n > 0 ? n : 1));
 }
 
 Value *val_tuple(int n, Value **items) {
