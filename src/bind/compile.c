@@ -306,15 +306,20 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   Interp *I = C->I;
   double magic = force_num(I, v->u.con.args[0], pos, "the magic value of a "
                            "SoftObject");
-  size_t cap = 64, n = 0;
-  soft_key *keys = malloc(sizeof *keys * cap);
-  if (!keys) qcs_error(pos, "out of memory");
+  size_t n = 0;
+  /* Each key goes to the builder as it is read, and the list is read as
+     it is forced: nothing here holds more than one key. */
+  soft_builder *b = soft_builder_new();
+  if (!b) qcs_error(pos, "out of memory");
   ErrCleanup cu;
-  err_defer(&cu, free, keys);
+  err_defer(&cu, soft_builder_free, b);
+  double wr = 0, ws = 0;  /* the key least resolved at its centre */
+  double wmax = 0;
   {
     Value *l = force(I, v->u.con.args[1]);
     Sym *last = NULL;  /* the constructor of the key before, and its kind */
     ConKind lastk = K_NONE;
+    soft_key key;
     while (l->kind == V_CONS) {
       eval_check(I, pos);
       Value *k = force(I, l->u.cons.head);
@@ -326,19 +331,12 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
         if (k->kind == V_CON) last = k->u.con.con, lastk = kk;
       }
       Pos kpos = vpos(C, k);
-      if (n == cap) {
-        soft_key *nk = realloc(keys, sizeof *keys * (cap *= 2));
-        if (!nk) qcs_error(pos, "out of memory");
-        keys = nk;
-        cu.arg = keys;
-      }
-      soft_key *key = &keys[n];
-      memset(key, 0, sizeof *key);
+      memset(&key, 0, sizeof key);
       if (kk == K_KEY) {
-        key->kind = SOFT_SPHERE;
-        force_vec3(I, k->u.con.args[0], kpos, "the centre of a Key", key->c);
+        key.kind = SOFT_SPHERE;
+        force_vec3(I, k->u.con.args[0], kpos, "the centre of a Key", key.c);
       } else if (kk == K_QKEY) {
-        key->kind = SOFT_QUADRIC;
+        key.kind = SOFT_QUADRIC;
         Value *m = force(I, k->u.con.args[0]);
         if (m->kind != V_TUPLE || m->u.tup.n != 4)
           qcs_error(kpos, "the matrix of a QuadricKey is four 4-tuples");
@@ -347,17 +345,23 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
           if (row->kind != V_TUPLE || row->u.tup.n != 4)
             qcs_error(kpos, "the matrix of a QuadricKey is four 4-tuples");
           for (int c = 0; c < 4; c++)
-            key->m[r][c] = force_num(I, row->u.tup.items[c], kpos,
-                                     "a QuadricKey matrix entry");
+            key.m[r][c] = force_num(I, row->u.tup.items[c], kpos,
+                                    "a QuadricKey matrix entry");
         }
       } else {
         not_a(C, k, "a key (Key centre R weight or QuadricKey m R weight)");
       }
-      key->R = force_num(I, k->u.con.args[1], kpos, "the radius of a key");
-      key->w = force_num(I, k->u.con.args[2], kpos, "the weight of a key");
-      if (!(key->R > 0) || !isfinite(key->R))
+      key.R = force_num(I, k->u.con.args[1], kpos, "the radius of a key");
+      key.w = force_num(I, k->u.con.args[2], kpos, "the weight of a key");
+      if (!(key.R > 0) || !isfinite(key.R))
         qcs_error(kpos, "a key's radius must be finite and > 0, not %g",
-                  key->R);
+                  key.R);
+      if (soft_builder_add(b, &key)) qcs_error(pos, "out of memory");
+      wmax = fmax(wmax, fabs(key.w));
+      if (key.kind == SOFT_SPHERE) {
+        double S = fmax(fabs(key.c[0]), fmax(fabs(key.c[1]), fabs(key.c[2])));
+        if (S * wr > ws * key.R || wr == 0) wr = key.R, ws = S;
+      }
       n++;
       l = force(I, l->u.cons.tail);
     }
@@ -366,16 +370,7 @@ static int compile_soft(Compile *C, Value *v, Pos pos) {
   err_release(&cu);
   soft_obj *obj = NULL;
   size_t bad = 0;
-  int err = soft_build(keys, n, magic, &obj, &bad);
-  double wr = 0, ws = 0;  /* the key least resolved at its centre */
-  double wmax = 0;
-  for (size_t j = 0; j < n; j++) wmax = fmax(wmax, fabs(keys[j].w));
-  for (size_t j = 0; j < n; j++) {
-    if (keys[j].kind != SOFT_SPHERE) continue;
-    double S = fmax(fabs(keys[j].c[0]), fmax(fabs(keys[j].c[1]), fabs(keys[j].c[2])));
-    if (S * wr > ws * keys[j].R || wr == 0) wr = keys[j].R, ws = S;
-  }
-  free(keys);
+  int err = soft_builder_finish(b, magic, &obj, &bad);
   if (err) {
     if (bad < n)
       qcs_error(pos, "key %zu of this SoftObject: %s", bad + 1,

@@ -28,6 +28,8 @@
 #ifndef QCS_BVH_H
 #define QCS_BVH_H
 
+#include <stddef.h>
+
 /* Depth-first traversal stacks of this many entries are always enough. */
 #define BVH_STACK 64
 
@@ -57,6 +59,15 @@ typedef struct bvh_item {
 /* Build over items[0 .. n) with leaves of at most leaf_max >= 1 items and
  * the given split; on failure *b holds no memory. */
 int bvh_build(bvh *b, const bvh_item *items, int n, int leaf_max, int split);
+
+/* The same over items kept in the caller's own records: item j's box is
+ * lo[0..3) and hi[0..3), its centre c[0..3), each at j * stride bytes past
+ * the pointer given (soft.c's keys, without a copy as bvh_items). */
+typedef struct bvh_items {
+  const double *lo, *hi, *c;
+  size_t stride;  /* bytes from one item's record to the next's */
+} bvh_items;
+int bvh_build_view(bvh *b, bvh_items items, int n, int leaf_max, int split);
 void bvh_free(bvh *b);
 
 /* Whether p lies in the node's box (closed). */

@@ -151,48 +151,108 @@ static int make_key(const soft_key *in, nkey *k) {
   return SOFT_OK;
 }
 
-/* The keys' bounds and centres as BVH items (into items, returned). */
-static bvh_item *items_of(bvh_item *items, const nkey *k, size_t n) {
-  for (size_t j = 0; j < n; j++)
-    for (int i = 0; i < 3; i++) {
-      items[j].lo[i] = k[j].lo[i];
-      items[j].hi[i] = k[j].hi[i];
-      items[j].c[i] = k[j].x0[i];
-    }
-  return items;
+/* Keys given one at a time, normalised as they come (soft.h). */
+struct soft_builder {
+  nkey *all;        /* the keys that act somewhere, normalised */
+  size_t live, cap;
+  size_t n;         /* keys added */
+  int err;          /* the first key's error, or SOFT_OK */
+  size_t bad;       /* that key's index */
+};
+
+soft_builder *soft_builder_new(void) {
+  soft_builder *b = calloc(1, sizeof *b);
+  if (!b) return NULL;
+  b->cap = 64;
+  b->all = malloc(b->cap * sizeof *b->all);
+  if (!b->all) { free(b); return NULL; }
+  return b;
 }
 
-int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
-               size_t *bad_key) {
-  *out = NULL;
-  *bad_key = n;
-  if (!(magic > 0) || !isfinite(magic)) return SOFT_ERR_MAGIC;
-  if (n > (size_t)(1 << 28)) return SOFT_ERR_NOMEM;
-  soft_obj *o = calloc(1, sizeof *o);
-  nkey *all = malloc((n ? n : 1) * sizeof *all);
-  if (!o || !all) { free(o); free(all); return SOFT_ERR_NOMEM; }
-  o->magic = magic;
-  size_t live = 0;
-  for (size_t i = 0; i < n; i++) {
-    int err = make_key(&keys[i], &all[live]);
-    if (err) { *bad_key = i; free(all); free(o); return err; }
-    if (!all[live].empty && all[live].w != 0) live++;  /* others act nowhere */
+void soft_builder_free(void *b) {
+  if (!b) return;
+  free(((soft_builder *)b)->all);
+  free(b);
+}
+
+int soft_builder_add(soft_builder *b, const soft_key *key) {
+  if (b->err) { b->n++; return SOFT_OK; }  /* the build fails anyway */
+  if (b->n >= (size_t)(1 << 28)) return SOFT_ERR_NOMEM;
+  if (b->live == b->cap) {
+    nkey *a = realloc(b->all, 2 * b->cap * sizeof *a);
+    if (!a) return SOFT_ERR_NOMEM;
+    b->all = a;
+    b->cap *= 2;
   }
+  nkey *k = &b->all[b->live];
+  int err = make_key(key, k);
+  if (err) {
+    b->err = err;
+    b->bad = b->n;
+  } else if (!k->empty && k->w != 0) {
+    b->live++;  /* others act nowhere */
+  }
+  b->n++;
+  return SOFT_OK;
+}
+
+/* a[j] = a[idx[j]] for j < n, idx a permutation, in place: each cycle of
+ * idx is walked once, with one key held aside, and idx[j] = j marks slot
+ * j filled; idx ends as the identity, true of the keys now in leaf order.
+ * The key moved next is fetched one move ahead (a cache miss each: the
+ * keys come in the user's order, the leaves in space's). */
+static void gather(nkey *a, int *idx, size_t n) {
+  for (size_t s = 0; s < n; s++) {
+    if ((size_t)idx[s] == s) continue;
+    nkey held = a[s];
+    size_t j = s;
+    for (;;) {
+      size_t k = (size_t)idx[j];
+      idx[j] = (int)j;
+      if (k == s) { a[j] = held; break; }
+#if defined(__GNUC__)
+      const char *next = (const char *)&a[idx[k]];
+      __builtin_prefetch(next);
+      __builtin_prefetch(next + 64);
+      __builtin_prefetch(next + 128);
+      __builtin_prefetch(next + sizeof *a - 1);
+#endif
+      a[j] = a[k];
+      j = k;
+    }
+  }
+}
+
+int soft_builder_finish(soft_builder *b, double magic, soft_obj **out,
+                        size_t *bad_key) {
+  *out = NULL;
+  *bad_key = b->n;
+  int err = SOFT_OK;
+  if (!(magic > 0) || !isfinite(magic)) {
+    err = SOFT_ERR_MAGIC;  /* before any key's, as soft_build checks */
+  } else if (b->err) {
+    err = b->err;
+    *bad_key = b->bad;
+  }
+  soft_obj *o = err ? NULL : calloc(1, sizeof *o);
+  if (!err && !o) err = SOFT_ERR_NOMEM;
+  if (err) { soft_builder_free(b); return err; }
+  nkey *all = b->all;
+  size_t live = b->live;
+  free(b);
+  o->magic = magic;
   o->nkeys = live;
-  /* The BVH over the keys' bounds, split at the median of their centres;
-   * the keys (152 bytes each) then move once into its leaf order. */
-  bvh_item *items = malloc((live ? live : 1) * sizeof *items);
-  o->keys = malloc((live ? live : 1) * sizeof *o->keys);
-  if (!items || !o->keys ||
-      bvh_build(&o->tree, items_of(items, all, live), (int)live, LEAF_MAX,
-                BVH_SELECT) != BVH_OK) {
-    free(items); free(o->keys); free(all); free(o);
+  o->keys = all;
+  /* The BVH over the keys' bounds, split at the median of their centres,
+   * read from the keys themselves; the keys (152 bytes each) then move
+   * once into its leaf order, in place. */
+  bvh_items items = {all->lo, all->hi, all->x0, sizeof *all};
+  if (bvh_build_view(&o->tree, items, (int)live, LEAF_MAX, BVH_SELECT) !=
+      BVH_OK) {
+    free(all); free(o);
     return SOFT_ERR_NOMEM;
   }
-  free(items);
-  for (size_t j = 0; j < live; j++) o->keys[j] = all[o->tree.idx[j]];
-  free(all);
-  all = o->keys;
+  gather(all, o->tree.idx, live);
   for (int i = 0; i < 3; i++) { o->lo[i] = INFINITY; o->hi[i] = -INFINITY; }
   for (size_t j = 0; j < live; j++)
     if (all[j].w > 0)
@@ -202,6 +262,22 @@ int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
       }
   *out = o;
   return SOFT_OK;
+}
+
+int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
+               size_t *bad_key) {
+  *out = NULL;
+  *bad_key = n;
+  if (!(magic > 0) || !isfinite(magic)) return SOFT_ERR_MAGIC;
+  if (n > (size_t)(1 << 28)) return SOFT_ERR_NOMEM;
+  soft_builder *b = soft_builder_new();
+  if (!b) return SOFT_ERR_NOMEM;
+  for (size_t i = 0; i < n; i++)
+    if (soft_builder_add(b, &keys[i])) {
+      soft_builder_free(b);
+      return SOFT_ERR_NOMEM;
+    }
+  return soft_builder_finish(b, magic, out, bad_key);
 }
 
 void soft_free(soft_obj *obj) {

@@ -65,6 +65,20 @@ typedef struct {
  * NULL. */
 int soft_build(const soft_key *keys, size_t n, double magic, soft_obj **out,
                size_t *bad_key);
+
+/* The same, with the keys given one at a time as they are made (a list
+ * of a million keys need not be held whole first): soft_builder_add
+ * normalises each (SOFT_ERR_NOMEM is its only error; a key's own error,
+ * the first, waits for finish), soft_builder_finish builds and returns
+ * what soft_build would for those keys and frees the builder, whatever
+ * the outcome. soft_builder_free (taking void * to serve as a cleanup)
+ * drops a builder not finished. */
+typedef struct soft_builder soft_builder;
+soft_builder *soft_builder_new(void);  /* NULL when out of memory */
+int soft_builder_add(soft_builder *b, const soft_key *key);
+int soft_builder_finish(soft_builder *b, double magic, soft_obj **out,
+                        size_t *bad_key);
+void soft_builder_free(void *b);
 void soft_free(soft_obj *obj);
 const char *soft_strerror(int err);
 

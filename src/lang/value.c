@@ -160,8 +160,8 @@ const char *val_str_chars(Value *v) {
   return buf;
 }
 
-Value **val_array(int n) {
-  return GC_MALLOC(sizeof(Value *) * (size_t)(n > 0 ? n : 1));
+Value **val_array(int n) {  /* batched, as val_small: a call's arguments */
+  return val_small(sizeof(Value *) * (size_t)(n > 0 ? n : 1));
 }
 
 Value *val_tuple(int n, Value **items) {

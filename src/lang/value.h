@@ -96,7 +96,10 @@ struct Value {
        and val_str_chars flattens it, once, when the bytes are wanted. */
     struct { const char *s; Value *left, *right; size_t len; } str;
     struct { int n; Value **items; } tup;
-    struct { Value *head, *tail; } cons;
+    /* tail first: the collector marks an object's last pointer first, so
+       a long list's spine is followed before its elements are and its
+       mark stack does not overflow on a million cells held whole */
+    struct { Value *tail, *head; } cons;
     struct { Sym *con; int n; Value **args; const Pos *pos; } con; /* pos: where it was built, or NULL */
     struct {
       FnKind kind;
