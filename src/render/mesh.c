@@ -334,12 +334,12 @@ static double chord_max(const double u[3], double tau) {
   return sqrt(best) * (1 + 1e-12);
 }
 
-/* The gradient bound of t over [lo, hi]: 0 when found (*b), -1 when the
-   tape is not smooth there (a sharp leaf crosses it, too many live leaves,
-   or no direction n0 with a positive lower bound). */
-static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
-                    GrIv *st, GrBound *b) {
-  int sp = 0, step = 0;
+/* The tape's value range and per-leaf gradient coefficients over
+   [lo, hi] (see GrIv): &st[0], or NULL when more than GR_MAX leaves are
+   live. */
+static const GrIv *gr_tape(const dt_tape *t, const double lo[3],
+                           const double hi[3], GrIv *st) {
+  int sp = 0;
   for (int i = 0; i < t->ncode; i++) {
     const dt_instr *in = &t->code[i];
     GrIv *x = &st[sp];
@@ -392,12 +392,21 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
         rc = gr_lin(a, a, 1 - y->h, 1 - y->l, y, 1 - a->h, 1 - a->l);
         break;
       }
-      if (rc < 0) return -1;
+      if (rc < 0) return NULL;
       a->l = l;
       a->h = h;
     }
   }
-  const GrIv *r = &st[0];
+  return &st[0];
+}
+/* The gradient bound of t over [lo, hi]: 0 when found (*b), -1 when the
+   tape is not smooth there (a sharp leaf crosses it, too many live leaves,
+   or no direction n0 with a positive lower bound). */
+static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
+                    GrIv *st, GrBound *b) {
+  int step = 0;
+  const GrIv *r = gr_tape(t, lo, hi, st);
+  if (!r) return -1;
   memset(b, 0, sizeof *b);
   for (int i = 0; i < r->n; i++) step |= r->step[i];
   if (r->n == 1) {
@@ -492,7 +501,10 @@ typedef struct {
   double org[3], h;        /* finest grid point (i, j, k) is org + h (i, j, k) */
   double clo[3], chi[3];   /* the clip box: outside it is outside */
   double tol, vtol;
-  int depth;
+  int depth;               /* the deepest level the octree may reach */
+  int fine;                /* the level whose side the tolerance fixes */
+  double bad[6];           /* MESH_ETHIN: the cell that was not settled */
+  int badnode;             /* and the node not proven one sheet, or -1 */
   unsigned char *st;       /* scene_box scratch: classes */
   int *one;                /* scene_box scratch: T_ONE's node */
   GrIv *gst;               /* grad_box scratch */
@@ -591,6 +603,106 @@ static int point(Mesher *m, const uint32_t c[3]) {
   return v;
 }
 
+/* Over [lo, hi], node x's field (a rounded node's density, a soft
+   object's field; larger inside): the midpoint of its gradient's bound
+   into g0 (if not NULL) and a lower bound of grad . u (if u is not NULL).
+   0, or -1 when there is no bound (a sharp leaf of the tape crossing the
+   box, too many live leaves). */
+static int grad_dir(Mesher *m, int x, const double lo[3], const double hi[3],
+                    double g0[3], const double *u, double *gl) {
+  const ScNode *nd = &m->s->nodes[x];
+  if (nd->kind == SC_ROUNDED) {
+    const GrIv *r = gr_tape(nd->tape, lo, hi, m->gst);
+    if (!r) return -1;
+    double low = 0;
+    if (g0) g0[0] = g0[1] = g0[2] = 0;
+    for (int i = 0; i < r->n; i++) {
+      if (r->step[i]) return -1;
+      const double *n = nd->tape->leaves[r->leaf[i]].n;
+      for (int q = 0; g0 && q < 3; q++) g0[q] += 0.5 * (r->cl[i] + r->ch[i]) * n[q];
+      if (u) {
+        double k = vec3_dot(n, u), l, h;
+        iv_mul(k, k, r->cl[i], r->ch[i], &l, &h);
+        low += l;
+      }
+    }
+    if (u) *gl = low * (1 - 1e-9) - 1e-300;
+    return 0;
+  }
+  if (nd->kind == SC_SOFT) {
+    double dl[3], dh[3], low = 0;
+    soft_grad_box(nd->soft, lo, hi, dl, dh);
+    for (int q = 0; q < 3; q++) {
+      if (g0) g0[q] = 0.5 * (dl[q] + dh[q]);
+      if (u) low += u[q] > 0 ? u[q] * dl[q] : u[q] * dh[q];
+    }
+    if (u) *gl = low * (1 - 1e-9) - 1e-300;
+    return isfinite(low) ? 0 : -1;
+  }
+  return -1;
+}
+
+/* Every line along u meets node x's surface in [lo, hi] at most once when
+   each part of the box (the box, or its eighths down to k more levels)
+   is proven inside or outside x, or has grad . u > 0 over it: along such
+   a line the field is continuous and every crossing of the level is
+   upward, so two crossings would need a downward one between them. */
+static int sheet_along(Mesher *m, int x, const double lo[3],
+                       const double hi[3], const double u[3], int k) {
+  if (leaf_box(&m->s->nodes[x], lo, hi) != T_ONE) return 1;
+  double gl;
+  if (grad_dir(m, x, lo, hi, NULL, u, &gl) < 0) return 0;
+  if (gl > 0) return 1;
+  if (k == 0) return 0;
+  for (int c = 0; c < 8; c++) {
+    double l2[3], h2[3];
+    for (int a = 0; a < 3; a++) {
+      double mid = 0.5 * (lo[a] + hi[a]);
+      l2[a] = c >> a & 1 ? mid : lo[a];
+      h2[a] = c >> a & 1 ? hi[a] : mid;
+    }
+    if (!sheet_along(m, x, l2, h2, u, k - 1)) return 0;
+  }
+  return 1;
+}
+
+/* Node x's surface in the box is one sheet: a graph over the plane
+   across a direction u (the midpoint of its gradient's bound), since
+   every line along u meets it at most once (sheet_along, parts down to
+   1/4 of the box's side: where the rounding is narrower than the box the
+   density is flat, gradient 0, away from the surface, and only parts
+   proven inside or outside leave those out). So it has no closed part,
+   no tunnel, and is not two sides of a thin part. A plane always is. */
+static int one_sheet(Mesher *m, int x, const double lo[3], const double hi[3]) {
+  const ScNode *nd = &m->s->nodes[x];
+  if (nd->kind == SC_HALFSPACE) return 1;
+  double g0[3];
+  if (grad_dir(m, x, lo, hi, g0, NULL, NULL) < 0) return 0;
+  double len = sqrt(vec3_dot(g0, g0));
+  if (!(len > 0) || !isfinite(len)) return 0;
+  for (int q = 0; q < 3; q++) g0[q] /= len;
+  return sheet_along(m, x, lo, hi, g0, 2);
+}
+
+/* An undecided cell at or below the finest level is settled (meshed by
+   marching tetrahedra from its corners' signs) when each surface that
+   may cross it is one sheet there (one_sheet): the node deciding the
+   solid in the cell, or else every undecided leaf. Two sides of a thin
+   part of one node are never one sheet. 1 settled, 0 not. */
+static int settled(Mesher *m, int c, int one, const double lo[3],
+                   const double hi[3]) {
+  m->badnode = -1;
+  if (c == T_ONE)
+    return one_sheet(m, one, lo, hi) ? 1 : ((void)(m->badnode = one), 0);
+  int f = m->s->nodes[m->node].first;
+  for (int x = f; x <= m->node; x++) {
+    ScKind k = m->s->nodes[x].kind;
+    if (m->st[x - f] != T_ONE || (k != SC_ROUNDED && k != SC_SOFT)) continue;
+    if (!one_sheet(m, x, lo, hi)) return (void)(m->badnode = x), 0;
+  }
+  return 1;
+}
+
 /* Classify the cell (i, j, k) of the level (in units of its side) and
    either drop it (proven empty or full), keep it as a surface leaf, or
    split it. A leaf is kept above the finest level when its error is
@@ -623,7 +735,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     return 0;
   }
   Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0};
-  int leaf = level == m->depth;
+  int leaf = m->uniform && level == m->fine;
   if (c == T_ONE && clip_in && !m->uniform) {
     const ScNode *nd = &m->s->nodes[one];
     if (nd->kind == SC_HALFSPACE) {
@@ -687,7 +799,20 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
       m->npls = (size_t)n0;
     }
   }
+  if (!leaf && level >= m->fine && !m->uniform) {
+    /* the finest level, or below it: a thin part of the object (two of
+       its sides in one cell) or a fold splits the cell further, down to
+       the octree's limit */
+    if (settled(m, c, one, lo, hi)) leaf = 1;
+    else if (level == m->depth) {
+      memcpy(m->bad, lo, sizeof lo);
+      memcpy(m->bad + 3, hi, sizeof hi);
+      m->err = MESH_ETHIN;
+      return -1;
+    } else m->rep->thin++;
+  }
   if (leaf) {
+    if (level > m->rep->deepest) m->rep->deepest = level;
     if (m->nleaves >= m->max_cells) {
       m->err = MESH_ELIMIT;
       return -1;
@@ -1776,8 +1901,9 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   memset(&m, 0, sizeof m);
   m.s = s;
   m.node = node;
-  m.depth = depth;
-  m.h = L / ldexp(1, depth);
+  m.fine = depth;
+  m.depth = MAX_DEPTH;
+  m.h = L / ldexp(1, MAX_DEPTH);
   m.tol = e;
   m.vtol = vtol;
   m.sharp = sharp && !ms->uniform;
@@ -1799,7 +1925,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     m.chi[i] = ms->has_bounds && ms->hi[i] <= hi[i] ? hi[i] : HUGE_VAL;
   }
   rep->depth = depth;
-  rep->h = m.h;
+  rep->h = L / ldexp(1, depth);
+  rep->deepest = depth;
   rep->vtol = vtol;
   int nsub = node - s->nodes[node].first + 1;
   m.st = malloc((size_t)nsub);
@@ -1820,6 +1947,16 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
       snprintf(err, errlen, "the mesh needs more than %zu surface octree "
                "cells (limit max-cells): give a larger tolerance than %g",
                m.max_cells, e);
+    else if (rc == MESH_ETHIN) {
+      *bad_node = m.badnode;
+      snprintf(err, errlen, "a part of the object is thinner than the "
+               "finest cell the octree can make (side %.3g, depth %d): near "
+               "(%.6g, %.6g, %.6g) its surface is not proven one sheet in a "
+               "cell (two sides of a thin part, or a point where it is not "
+               "smooth); nothing was written", m.h, MAX_DEPTH,
+               0.5 * (m.bad[0] + m.bad[3]), 0.5 * (m.bad[1] + m.bad[4]),
+               0.5 * (m.bad[2] + m.bad[5]));
+    }
     goto done;
   }
   rep->leaves = (long)m.nleaves;

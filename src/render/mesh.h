@@ -78,8 +78,12 @@ typedef struct MeshReport {
                               CSG of at most 8 planes (edges and corners
                               kept) */
   int sharp_off;           /* sharp cells were given up (see mesh.c) */
-  int depth;               /* finest level */
+  int depth;               /* finest level (the tolerance's) */
   double h;                /* finest cell side */
+  long thin;               /* cells at or below the finest level split
+                              because a surface in them was not proven
+                              one sheet (a part thinner than the cell) */
+  int deepest;             /* the deepest level of a surface cell */
   double vtol;             /* the vertices' distance bound */
   double certified;        /* the proven bound, see above */
   double measured;         /* the largest distance along the normal from
@@ -98,7 +102,8 @@ enum {
   MESH_EEMPTY,             /* the object has no inside in its box */
   MESH_ETOL,               /* the tolerance is not usable */
   MESH_ELIMIT,             /* max_triangles or max_cells */
-  MESH_EINTERNAL           /* the result failed its own closure check */
+  MESH_EINTERNAL,          /* the result failed its own closure check */
+  MESH_ETHIN               /* a part thinner than the deepest cell */
 };
 
 /* Mesh node of s. On failure returns a MESH_E* code with a message in err;
