@@ -505,6 +505,9 @@ typedef struct {
   int fine;                /* the level whose side the tolerance fixes */
   double bad[6];           /* MESH_ETHIN: the cell that was not settled */
   int badnode;             /* and the node not proven one sheet, or -1 */
+  unsigned char *flip;     /* per node of the subtree: 1 if its solid
+                              enters the object complemented (the right
+                              side of an odd number of differences) */
   unsigned char *st;       /* scene_box scratch: classes */
   int *one;                /* scene_box scratch: T_ONE's node */
   GrIv *gst;               /* grad_box scratch */
@@ -684,11 +687,48 @@ static int one_sheet(Mesher *m, int x, const double lo[3], const double hi[3]) {
   return sheet_along(m, x, lo, hi, g0, 2);
 }
 
+/* Two undecided sharp halfspaces x and y face each other across the box
+   [lo, hi] without meeting in it: their inward normals (as the object
+   sees them: flipped under a difference) are opposed, and their planes
+   are parallel or cross on a line that misses the box. Then the solid
+   between them may be a slab thinner than the cell that no corner sees.
+   (Planes crossing in the box make an edge, meshed as a crease.) */
+static int planes_face(const Mesher *m, int x, int y, const double lo[3],
+                       const double hi[3]) {
+  int f = m->s->nodes[m->node].first;
+  const ScNode *a = &m->s->nodes[x], *b = &m->s->nodes[y];
+  double sa = m->flip[x - f] ? 1 : -1, sb = m->flip[y - f] ? 1 : -1;
+  if (sa * sb * vec3_dot(a->n, b->n) >= 0) return 0;
+  double w[3], u[3], v[3], p0[3];
+  vec3_cross(a->n, b->n, w);
+  double w2 = vec3_dot(w, w);
+  if (!(w2 > 1e-24)) return 1; /* parallel */
+  vec3_cross(b->n, w, u);
+  vec3_cross(w, a->n, v);
+  for (int q = 0; q < 3; q++) p0[q] = (a->d * u[q] + b->d * v[q]) / w2;
+  /* the line p0 + t w against the box, grown a little: where it nearly
+     meets the box, it is taken as an edge */
+  double t0 = -HUGE_VAL, t1 = HUGE_VAL;
+  for (int q = 0; q < 3; q++) {
+    double g = 1e-9 * (hi[q] - lo[q]), l = lo[q] - g, h = hi[q] + g;
+    if (w[q] == 0) {
+      if (p0[q] < l || p0[q] > h) return 1;
+      continue;
+    }
+    double e0 = (l - p0[q]) / w[q], e1 = (h - p0[q]) / w[q];
+    if (e0 > e1) { double t = e0; e0 = e1; e1 = t; }
+    t0 = fmax(t0, e0);
+    t1 = fmin(t1, e1);
+  }
+  return t0 > t1;
+}
+
 /* An undecided cell at or below the finest level is settled (meshed by
    marching tetrahedra from its corners' signs) when each surface that
    may cross it is one sheet there (one_sheet): the node deciding the
-   solid in the cell, or else every undecided leaf. Two sides of a thin
-   part of one node are never one sheet. 1 settled, 0 not. */
+   solid in the cell, or else every undecided leaf; and no two undecided
+   sharp halfspaces face each other across it (planes_face). Two sides
+   of a thin part of one node are never one sheet. 1 settled, 0 not. */
 static int settled(Mesher *m, int c, int one, const double lo[3],
                    const double hi[3]) {
   m->badnode = -1;
@@ -697,7 +737,15 @@ static int settled(Mesher *m, int c, int one, const double lo[3],
   int f = m->s->nodes[m->node].first;
   for (int x = f; x <= m->node; x++) {
     ScKind k = m->s->nodes[x].kind;
-    if (m->st[x - f] != T_ONE || (k != SC_ROUNDED && k != SC_SOFT)) continue;
+    if (m->st[x - f] != T_ONE) continue;
+    if (k == SC_HALFSPACE) {
+      for (int y = f; y < x; y++)
+        if (m->s->nodes[y].kind == SC_HALFSPACE && m->st[y - f] == T_ONE &&
+            !same_surface(m->s, x, y) && planes_face(m, x, y, lo, hi))
+          return (void)(m->badnode = x), 0;
+      continue;
+    }
+    if (k != SC_ROUNDED && k != SC_SOFT) continue;
     if (!one_sheet(m, x, lo, hi)) return (void)(m->badnode = x), 0;
   }
   return 1;
@@ -1934,10 +1982,22 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.gst = malloc(DT_STACK_MAX * sizeof *m.gst);
   m.plmap = malloc((size_t)nsub * sizeof *m.plmap);
   m.pv = malloc((size_t)nsub);
+  m.flip = malloc((size_t)nsub);
+  if (m.flip) { /* the subtree is contiguous, children before parents */
+    int f = s->nodes[node].first;
+    m.flip[nsub - 1] = 0;
+    for (int x = node; x >= f; x--) {
+      const ScNode *nd = &s->nodes[x];
+      if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF) {
+        m.flip[nd->a - f] = m.flip[x - f];
+        m.flip[nd->b - f] = (unsigned char)(m.flip[x - f] ^ (nd->kind == SC_DIFF));
+      }
+    }
+  }
   m.ex = malloc(sizeof *m.ex);
   m.ray = ray_ctx_new(s, vtol);
   int rc = MESH_OK;
-  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.ex || !m.ray) {
+  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.flip || !m.ex || !m.ray) {
     rc = MESH_ENOMEM;
     goto done;
   }
@@ -2083,6 +2143,7 @@ done:
   free(m.gst);
   free(m.plmap);
   free(m.pv);
+  free(m.flip);
   free(m.ex);
   free(m.pls);
   free(m.vert2.k);
