@@ -28,8 +28,13 @@ typedef struct {
 } hmap;
 
 static size_t hslot(const hmap *h, uint64_t key) {
-  uint64_t x = key * 0x9E3779B97F4A7C15ull;
-  x ^= x >> 29;
+  /* murmur3's finalizer: every key bit reaches the low bits (point keys
+     have their low bits 0 when cells stop above the deepest level) */
+  uint64_t x = key ^ key >> 33;
+  x *= 0xff51afd7ed558ccdull;
+  x ^= x >> 33;
+  x *= 0xc4ceb9fe1a85ec53ull;
+  x ^= x >> 33;
   size_t i = (size_t)x & (h->cap - 1);
   while (h->k[i] && h->k[i] != key + 1) i = (i + 1) & (h->cap - 1);
   return i;
@@ -784,6 +789,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   }
   Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0};
   int leaf = m->uniform && level == m->fine;
+  int sheet = 0;           /* the surface in the cell is proven one sheet */
   if (c == T_ONE && clip_in && !m->uniform) {
     const ScNode *nd = &m->s->nodes[one];
     if (nd->kind == SC_HALFSPACE) {
@@ -802,6 +808,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
         soft_grad_box(nd->soft, gl, gh, dl, dh);
         ok = grad_axes(dl, dh, &b) == 0;
       }
+      sheet = ok; /* grad . n0 > 0 over a box holding the cell */
       if (ok) {
         double d = sqrt(3.0) * side;
         if (b.planar) {
@@ -851,7 +858,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     /* the finest level, or below it: a thin part of the object (two of
        its sides in one cell) or a fold splits the cell further, down to
        the octree's limit */
-    if (settled(m, c, one, lo, hi)) leaf = 1;
+    if (sheet || settled(m, c, one, lo, hi)) leaf = 1;
     else if (level == m->depth) {
       memcpy(m->bad, lo, sizeof lo);
       memcpy(m->bad + 3, hi, sizeof hi);
@@ -1735,9 +1742,15 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
   m->nft = 0;
   /* the first pass (count) finds whether the faces are plain: a plain
      cell needs only its corners */
-  if (count) lf->plain = (unsigned char)(l == m->depth || plain_cell(m, l, q));
+  /* with no cell split below the finest level, a finest cell's faces
+     are plain (no smaller neighbour) */
+  if (count)
+    lf->plain = (unsigned char)(l == m->depth || (l == m->fine && !m->rep->thin) ||
+                                plain_cell(m, l, q));
   if (lf->plain) {
-    if (count && l < m->depth && plain_points(m, l, q) < 0) return -1;
+    if (count && l < m->depth && !(l == m->fine && !m->rep->thin) &&
+        plain_points(m, l, q) < 0)
+      return -1;
   } else {
     for (int a = 0; a < 3; a++)
       for (int s = 0; s < 2; s++)
