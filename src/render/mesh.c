@@ -2051,12 +2051,13 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     double thin = INFINITY; /* the box's least side: a hint, not a proof */
     for (int i = 0; i < 3; i++) thin = fmin(thin, hi[i] - lo[i]);
     if (rep->leaves > 0)
-      /* cells were left undecided, so the surface may pass through them
-         between their corners: a solid thinner than a cell */
-      snprintf(err, errlen, "no inside point was found at this tolerance "
-               "(%g): the object is empty, or thinner than a cell (side "
-               "%.3g) everywhere; its box is %.3g thin at the least: try "
-               "meshWith [Tolerance %.2g]", e, m.h, thin, thin / 10);
+      /* every surface cell holds one sheet of each surface in it, and
+         no corner is inside: the surfaces only dip into cells as caps */
+      snprintf(err, errlen, "no corner of any cell is inside the object at "
+               "this tolerance (%g): it is empty, or its surface only dips "
+               "into cells (side %.3g) without reaching a corner; its box "
+               "is %.3g thin at the least: try meshWith [Tolerance %.2g]",
+               e, rep->h, thin, thin / 10);
     else
       snprintf(err, errlen, "the object is empty: every cell of its box "
                "is proven outside it");
