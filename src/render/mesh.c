@@ -692,18 +692,16 @@ static int one_sheet(Mesher *m, int x, const double lo[3], const double hi[3]) {
   return sheet_along(m, x, lo, hi, g0, 2);
 }
 
-/* Two undecided sharp halfspaces x and y face each other across the box
-   [lo, hi] without meeting in it: their inward normals (as the object
-   sees them: flipped under a difference) are opposed, and their planes
-   are parallel or cross on a line that misses the box. Then the solid
-   between them may be a slab thinner than the cell that no corner sees.
-   (Planes crossing in the box make an edge, meshed as a crease.) */
+/* Two undecided sharp halfspaces x and y cross the box [lo, hi] without
+   meeting in it: their planes are parallel or cross on a line that misses
+   the box. Then the solid between them in the box (a slab, or a wedge
+   whose edge lies outside) may be thinner than the cell, and no corner
+   sees it: a marching cell would miss it, and a sharp neighbour holding
+   the wedge's edge would leave its face unmatched. (Planes crossing in
+   the box make an edge there, meshed as a crease.) */
 static int planes_face(const Mesher *m, int x, int y, const double lo[3],
                        const double hi[3]) {
-  int f = m->s->nodes[m->node].first;
   const ScNode *a = &m->s->nodes[x], *b = &m->s->nodes[y];
-  double sa = m->flip[x - f] ? 1 : -1, sb = m->flip[y - f] ? 1 : -1;
-  if (sa * sb * vec3_dot(a->n, b->n) >= 0) return 0;
   double w[3], u[3], v[3], p0[3];
   vec3_cross(a->n, b->n, w);
   double w2 = vec3_dot(w, w);

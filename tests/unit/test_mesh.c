@@ -652,7 +652,7 @@ static void soft_text(char *out, size_t n) {
 static void property(void) {
   static const char *ops[3] = {"Union", "Intersection", "SetDifference"};
   static const char *dops[3] = {"Sum", "Product", "Difference"};
-  int total = 0, good = 0;
+  int total = 0, good = 0, gaveup = 0;
   for (int k = 0; k < 24; k++) {
     char a[400], b[400], obj[2400], tree[1000] = "", name[80];
     double radius = 0.05 + 0.1 * urand(), tol = 0.03;
@@ -727,12 +727,18 @@ static void property(void) {
     printf("# %s: %zu triangles (%ld plane, %ld smooth, %ld sharp cells%s)\n", name,
            rep.triangles, rep.planar, rep.smooth, rep.sharp,
            rep.sharp_off ? ", sharp given up" : "");
+    if (rep.sharp_off) printf("# sharp cells given up in: %s\n", obj);
+    gaveup += rep.sharp_off;
     mesh_free(m);
     scene_free(s);
   }
   printf("# property test: %d of %d random scenes closed, oriented, "
          "self-intersection-free, within tolerance\n", good, total);
   CHECK("property test: most random scenes were not empty", total >= 18);
+  /* scene 7 (mixed) gave them up: a sharp box's edge 0.003 inside a
+     sharp cell, its wedge crossing the marching neighbour's face between
+     corners (see planes_face in mesh.c) */
+  CHECK("property test: no random scene gives up its sharp cells", gaveup == 0);
 }
 
 
