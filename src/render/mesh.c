@@ -677,7 +677,7 @@ static int sheet_along(Mesher *m, int x, const double lo[3],
 /* Node x's surface in the box is one sheet: a graph over the plane
    across a direction u (the midpoint of its gradient's bound), since
    every line along u meets it at most once (sheet_along, parts down to
-   1/4 of the box's side: where the rounding is narrower than the box the
+   1/16 of the box's side: where the rounding is narrower than the box the
    density is flat, gradient 0, away from the surface, and only parts
    proven inside or outside leave those out). So it has no closed part,
    no tunnel, and is not two sides of a thin part. A plane always is. */
@@ -689,7 +689,7 @@ static int one_sheet(Mesher *m, int x, const double lo[3], const double hi[3]) {
   double len = sqrt(vec3_dot(g0, g0));
   if (!(len > 0) || !isfinite(len)) return 0;
   for (int q = 0; q < 3; q++) g0[q] /= len;
-  return sheet_along(m, x, lo, hi, g0, 2);
+  return sheet_along(m, x, lo, hi, g0, 4);
 }
 
 /* Two undecided sharp halfspaces x and y cross the box [lo, hi] without
