@@ -15,7 +15,12 @@
  * bound over the cell grown by the tolerance bounds its triangles'
  * distance (mesh.c, grad_box; core/soft.h, soft_grad_box), or a CSG of at most 8 planes (a sharp cell, meshed exactly);
  * else it is split, down to the finest level whose side the tolerance
- * fixes.
+ * fixes. There, and below it, a cell is kept only when each surface in
+ * it is proven one sheet (mesh.c, settled: every line along one
+ * direction meets it once, after Plantinga and Vegter) and no two
+ * undecided planes cross it without meeting in it; else it splits again
+ * (a part thinner than the cell), down to depth 19, where MESH_ETHIN
+ * refuses naming the place and the node.
  *
  * The leaves of all sizes are cut into tetrahedra that meet face to face
  * (the Kuhn split where a cell's faces are plain, else a centre point and
