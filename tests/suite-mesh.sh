@@ -43,17 +43,27 @@ for t in 0 "0/0" 1e-300; do
   elif grep -q "tolerance" "$tmp/err" && [ ! -e "$tmp/t.stl" ]; then echo "ok mesh: tolerance $t refused"
   else echo "FAIL mesh: tolerance $t: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 done
-# a rod thinner than the default tolerance's cells: not "empty" but said
-# to be thinner than a cell, with a tolerance to try, which then works
-printf 'mesh "rod.stl" (Scale (20, 0.1, 0.1) (Rounded 0.1 UnitCube))\n' > "$tmp/rod.qcs"
-if (cd "$tmp" && "$top/$QCS" rod.qcs > out 2> err); then echo "FAIL mesh: a rod thinner than a cell gave no error"
-elif grep -q "thinner than a cell" "$tmp/err" && [ ! -e "$tmp/rod.stl" ] &&
-     try=$(sed -n 's/.*try meshWith \[Tolerance \([0-9.e-]*\)\].*/\1/p' "$tmp/err") && [ -n "$try" ]; then
-  printf 'meshWith [Tolerance %s] "rod.stl" (Scale (20, 0.1, 0.1) (Rounded 0.1 UnitCube))\n' "$try" > "$tmp/rod2.qcs"
-  if (cd "$tmp" && "$top/$QCS" rod2.qcs > out 2> err2) && [ -s "$tmp/rod.stl" ]; then
-    echo "ok mesh: a rod thinner than a cell is said to be, and the tolerance suggested ($try) meshes it"
-  else echo "FAIL mesh: the suggested tolerance $try: $(head -c 300 "$tmp/err2" | tr '\n' ' ')"; fi
+# a rod 0.03 thick beside a block, at a tolerance whose cells are 0.07
+# wide: its cells split until each side of the rod is one sheet, so it is
+# meshed (two parts, read back closed) and the report says so; a hair
+# 1e-6 thick (under the deepest cell, 3.9e-5 here) is refused, naming it
+cat > "$tmp/rod.qcs" <<'Q'
+rod = Rounded 0.01 (Shift (2, 0, 0) (Scale (0.03, 0.03, 1.5) UnitCube));
+meshWith [Tolerance 0.1] "rod.stl" (Union (Rounded 0.01 UnitCube) rod)
+Q
+if (cd "$tmp" && "$top/$QCS" rod.qcs > out 2> err) && [ -s "$tmp/rod.stl" ] &&
+   grep -q "thin parts: [0-9]* cells split below the finest level" "$tmp/err"; then
+  r=$(python3 tests/mesh_read.py "$tmp/rod.stl" 2>&1)
+  case $r in
+    *"parts=2 closed=1"*) echo "ok mesh: a rod thinner than a cell is meshed: $r" ;;
+    *) echo "FAIL mesh: a rod thinner than a cell: $r" ;;
+  esac
 else echo "FAIL mesh: thin rod: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
+printf 'meshWith [Tolerance 0.1] "hair.stl" (Union UnitCube (Rounded 0.0000001 (Shift (0, 2, 0) (Scale (20, 0.000001, 0.000001) UnitCube))))\n' > "$tmp/hair.qcs"
+if (cd "$tmp" && "$top/$QCS" hair.qcs > out 2> err); then echo "FAIL mesh: a hair thinner than the deepest cell gave no error"
+elif grep -q "hair.qcs:1:54: error: hair.stl: a part of the object is thinner than the finest cell the octree can make" "$tmp/err" &&
+     [ ! -e "$tmp/hair.stl" ]; then echo "ok mesh: a hair thinner than the deepest cell is refused, naming it, no file"
+else echo "FAIL mesh: hair: $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
 printf 'meshWith [MaxTriangles 1000] "big.stl" (Rounded 0.2 UnitCube)\n' > "$tmp/big.qcs"
 if (cd "$tmp" && "$top/$QCS" big.qcs > out 2> err); then echo "FAIL mesh: MaxTriangles ignored"
 elif grep -q "max-triangles" "$tmp/err" && [ ! -e "$tmp/big.stl" ]; then echo "ok mesh: MaxTriangles refuses, no file"

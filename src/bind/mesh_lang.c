@@ -22,10 +22,14 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
   fprintf(f, "  octree: %ld cells visited, %ld proven empty, %ld proven "
           "full, %ld surface cells meshed: %ld proven one plane, %ld proven "
           "smooth enough, %ld sharp (a CSG of planes, meshed exactly), %ld at "
-          "the finest level (depth %d, cell %.4g)\n",
+          "the finest level (depth %d, cell %.4g) or below\n",
           r->cells, r->empty, r->full, r->leaves, r->planar, r->smooth,
           r->sharp, r->leaves - r->planar - r->smooth - r->sharp, r->depth,
           r->h);
+  if (r->thin)
+    fprintf(f, "  thin parts: %ld cells split below the finest level (a "
+            "surface in them not proven one sheet), down to depth %d (cell "
+            "%.4g)\n", r->thin, r->deepest, ldexp(r->h, r->depth - r->deepest));
   if (r->sharp_off)
     fprintf(f, "  sharp cells given up: two of them decided a degenerate "
             "case apart; the mesh was made again without them\n");
@@ -82,12 +86,14 @@ int mesh_lang_capture(void *ctx, const struct Scene *s,
   ms.max_triangles = MESH_DEFAULT_MAX_TRIANGLES;
   int bad;
   char e2[400];
-  if (do_mesh(s, &ms, path, 0, &bad, e2, sizeof e2) == 0) return 0;
+  int rc = do_mesh(s, &ms, path, 0, &bad, e2, sizeof e2);
+  if (rc == 0) return 0;
   if (bad >= 0) {
     Pos p = compile_node_pos(s, bad);
     if (p.src)
-      snprintf(err, errlen, "%s (the unbounded part: %s:%d:%d)", e2,
-               p.src->name, p.line, p.col);
+      snprintf(err, errlen, "%s (the %s part: %s:%d:%d)", e2,
+               rc == MESH_EUNBOUNDED ? "unbounded" : "thin", p.src->name,
+               p.line, p.col);
     else snprintf(err, errlen, "%s", e2);
   } else {
     snprintf(err, errlen, "%s", e2);

@@ -28,8 +28,13 @@ typedef struct {
 } hmap;
 
 static size_t hslot(const hmap *h, uint64_t key) {
-  uint64_t x = key * 0x9E3779B97F4A7C15ull;
-  x ^= x >> 29;
+  /* murmur3's finalizer: every key bit reaches the low bits (point keys
+     have their low bits 0 when cells stop above the deepest level) */
+  uint64_t x = key ^ key >> 33;
+  x *= 0xff51afd7ed558ccdull;
+  x ^= x >> 33;
+  x *= 0xc4ceb9fe1a85ec53ull;
+  x ^= x >> 33;
   size_t i = (size_t)x & (h->cap - 1);
   while (h->k[i] && h->k[i] != key + 1) i = (i + 1) & (h->cap - 1);
   return i;
@@ -334,12 +339,12 @@ static double chord_max(const double u[3], double tau) {
   return sqrt(best) * (1 + 1e-12);
 }
 
-/* The gradient bound of t over [lo, hi]: 0 when found (*b), -1 when the
-   tape is not smooth there (a sharp leaf crosses it, too many live leaves,
-   or no direction n0 with a positive lower bound). */
-static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
-                    GrIv *st, GrBound *b) {
-  int sp = 0, step = 0;
+/* The tape's value range and per-leaf gradient coefficients over
+   [lo, hi] (see GrIv): &st[0], or NULL when more than GR_MAX leaves are
+   live. */
+static const GrIv *gr_tape(const dt_tape *t, const double lo[3],
+                           const double hi[3], GrIv *st) {
+  int sp = 0;
   for (int i = 0; i < t->ncode; i++) {
     const dt_instr *in = &t->code[i];
     GrIv *x = &st[sp];
@@ -392,12 +397,21 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
         rc = gr_lin(a, a, 1 - y->h, 1 - y->l, y, 1 - a->h, 1 - a->l);
         break;
       }
-      if (rc < 0) return -1;
+      if (rc < 0) return NULL;
       a->l = l;
       a->h = h;
     }
   }
-  const GrIv *r = &st[0];
+  return &st[0];
+}
+/* The gradient bound of t over [lo, hi]: 0 when found (*b), -1 when the
+   tape is not smooth there (a sharp leaf crosses it, too many live leaves,
+   or no direction n0 with a positive lower bound). */
+static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
+                    GrIv *st, GrBound *b) {
+  int step = 0;
+  const GrIv *r = gr_tape(t, lo, hi, st);
+  if (!r) return -1;
   memset(b, 0, sizeof *b);
   for (int i = 0; i < r->n; i++) step |= r->step[i];
   if (r->n == 1) {
@@ -492,7 +506,13 @@ typedef struct {
   double org[3], h;        /* finest grid point (i, j, k) is org + h (i, j, k) */
   double clo[3], chi[3];   /* the clip box: outside it is outside */
   double tol, vtol;
-  int depth;
+  int depth;               /* the deepest level the octree may reach */
+  int fine;                /* the level whose side the tolerance fixes */
+  double bad[6];           /* MESH_ETHIN: the cell that was not settled */
+  int badnode;             /* and the node not proven one sheet, or -1 */
+  unsigned char *flip;     /* per node of the subtree: 1 if its solid
+                              enters the object complemented (the right
+                              side of an odd number of differences) */
   unsigned char *st;       /* scene_box scratch: classes */
   int *one;                /* scene_box scratch: T_ONE's node */
   GrIv *gst;               /* grad_box scratch */
@@ -591,6 +611,149 @@ static int point(Mesher *m, const uint32_t c[3]) {
   return v;
 }
 
+/* Over [lo, hi], node x's field (a rounded node's density, a soft
+   object's field; larger inside): the midpoint of its gradient's bound
+   into g0 (if not NULL) and a lower bound of grad . u (if u is not NULL).
+   0, or -1 when there is no bound (a sharp leaf of the tape crossing the
+   box, too many live leaves). */
+static int grad_dir(Mesher *m, int x, const double lo[3], const double hi[3],
+                    double g0[3], const double *u, double *gl) {
+  const ScNode *nd = &m->s->nodes[x];
+  if (nd->kind == SC_ROUNDED) {
+    const GrIv *r = gr_tape(nd->tape, lo, hi, m->gst);
+    if (!r) return -1;
+    double low = 0;
+    if (g0) g0[0] = g0[1] = g0[2] = 0;
+    for (int i = 0; i < r->n; i++) {
+      if (r->step[i]) return -1;
+      const double *n = nd->tape->leaves[r->leaf[i]].n;
+      for (int q = 0; g0 && q < 3; q++) g0[q] += 0.5 * (r->cl[i] + r->ch[i]) * n[q];
+      if (u) {
+        double k = vec3_dot(n, u), l, h;
+        iv_mul(k, k, r->cl[i], r->ch[i], &l, &h);
+        low += l;
+      }
+    }
+    if (u) *gl = low * (1 - 1e-9) - 1e-300;
+    return 0;
+  }
+  if (nd->kind == SC_SOFT) {
+    double dl[3], dh[3], low = 0;
+    soft_grad_box(nd->soft, lo, hi, dl, dh);
+    for (int q = 0; q < 3; q++) {
+      if (g0) g0[q] = 0.5 * (dl[q] + dh[q]);
+      if (u) low += u[q] > 0 ? u[q] * dl[q] : u[q] * dh[q];
+    }
+    if (u) *gl = low * (1 - 1e-9) - 1e-300;
+    return isfinite(low) ? 0 : -1;
+  }
+  return -1;
+}
+
+/* Every line along u meets node x's surface in [lo, hi] at most once when
+   each part of the box (the box, or its eighths down to k more levels)
+   is proven inside or outside x, or has grad . u > 0 over it: along such
+   a line the field is continuous and every crossing of the level is
+   upward, so two crossings would need a downward one between them. */
+static int sheet_along(Mesher *m, int x, const double lo[3],
+                       const double hi[3], const double u[3], int k) {
+  if (leaf_box(&m->s->nodes[x], lo, hi) != T_ONE) return 1;
+  double gl;
+  if (grad_dir(m, x, lo, hi, NULL, u, &gl) < 0) return 0;
+  if (gl > 0) return 1;
+  if (k == 0) return 0;
+  for (int c = 0; c < 8; c++) {
+    double l2[3], h2[3];
+    for (int a = 0; a < 3; a++) {
+      double mid = 0.5 * (lo[a] + hi[a]);
+      l2[a] = c >> a & 1 ? mid : lo[a];
+      h2[a] = c >> a & 1 ? hi[a] : mid;
+    }
+    if (!sheet_along(m, x, l2, h2, u, k - 1)) return 0;
+  }
+  return 1;
+}
+
+/* Node x's surface in the box is one sheet: a graph over the plane
+   across a direction u (the midpoint of its gradient's bound), since
+   every line along u meets it at most once (sheet_along, parts down to
+   1/16 of the box's side: where the rounding is narrower than the box the
+   density is flat, gradient 0, away from the surface, and only parts
+   proven inside or outside leave those out). So it has no closed part,
+   no tunnel, and is not two sides of a thin part. A plane always is. */
+static int one_sheet(Mesher *m, int x, const double lo[3], const double hi[3]) {
+  const ScNode *nd = &m->s->nodes[x];
+  if (nd->kind == SC_HALFSPACE) return 1;
+  double g0[3];
+  if (grad_dir(m, x, lo, hi, g0, NULL, NULL) < 0) return 0;
+  double len = sqrt(vec3_dot(g0, g0));
+  if (!(len > 0) || !isfinite(len)) return 0;
+  for (int q = 0; q < 3; q++) g0[q] /= len;
+  return sheet_along(m, x, lo, hi, g0, 4);
+}
+
+/* Two undecided sharp halfspaces x and y cross the box [lo, hi] without
+   meeting in it: their planes are parallel or cross on a line that misses
+   the box. Then the solid between them in the box (a slab, or a wedge
+   whose edge lies outside) may be thinner than the cell, and no corner
+   sees it: a marching cell would miss it, and a sharp neighbour holding
+   the wedge's edge would leave its face unmatched. (Planes crossing in
+   the box make an edge there, meshed as a crease.) */
+static int planes_face(const Mesher *m, int x, int y, const double lo[3],
+                       const double hi[3]) {
+  const ScNode *a = &m->s->nodes[x], *b = &m->s->nodes[y];
+  double w[3], u[3], v[3], p0[3];
+  vec3_cross(a->n, b->n, w);
+  double w2 = vec3_dot(w, w);
+  if (!(w2 > 1e-24)) return 1; /* parallel */
+  vec3_cross(b->n, w, u);
+  vec3_cross(w, a->n, v);
+  for (int q = 0; q < 3; q++) p0[q] = (a->d * u[q] + b->d * v[q]) / w2;
+  /* the line p0 + t w against the box, grown a little: where it nearly
+     meets the box, it is taken as an edge */
+  double t0 = -HUGE_VAL, t1 = HUGE_VAL;
+  for (int q = 0; q < 3; q++) {
+    double g = 1e-9 * (hi[q] - lo[q]), l = lo[q] - g, h = hi[q] + g;
+    if (w[q] == 0) {
+      if (p0[q] < l || p0[q] > h) return 1;
+      continue;
+    }
+    double e0 = (l - p0[q]) / w[q], e1 = (h - p0[q]) / w[q];
+    if (e0 > e1) { double t = e0; e0 = e1; e1 = t; }
+    t0 = fmax(t0, e0);
+    t1 = fmin(t1, e1);
+  }
+  return t0 > t1;
+}
+
+/* An undecided cell at or below the finest level is settled (meshed by
+   marching tetrahedra from its corners' signs) when each surface that
+   may cross it is one sheet there (one_sheet): the node deciding the
+   solid in the cell, or else every undecided leaf; and no two undecided
+   sharp halfspaces face each other across it (planes_face). Two sides
+   of a thin part of one node are never one sheet. 1 settled, 0 not. */
+static int settled(Mesher *m, int c, int one, const double lo[3],
+                   const double hi[3]) {
+  m->badnode = -1;
+  if (c == T_ONE)
+    return one_sheet(m, one, lo, hi) ? 1 : ((void)(m->badnode = one), 0);
+  int f = m->s->nodes[m->node].first;
+  for (int x = f; x <= m->node; x++) {
+    ScKind k = m->s->nodes[x].kind;
+    if (m->st[x - f] != T_ONE) continue;
+    if (k == SC_HALFSPACE) {
+      for (int y = f; y < x; y++)
+        if (m->s->nodes[y].kind == SC_HALFSPACE && m->st[y - f] == T_ONE &&
+            !same_surface(m->s, x, y) && planes_face(m, x, y, lo, hi))
+          return (void)(m->badnode = x), 0;
+      continue;
+    }
+    if (k != SC_ROUNDED && k != SC_SOFT) continue;
+    if (!one_sheet(m, x, lo, hi)) return (void)(m->badnode = x), 0;
+  }
+  return 1;
+}
+
 /* Classify the cell (i, j, k) of the level (in units of its side) and
    either drop it (proven empty or full), keep it as a surface leaf, or
    split it. A leaf is kept above the finest level when its error is
@@ -623,7 +786,8 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     return 0;
   }
   Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0};
-  int leaf = level == m->depth;
+  int leaf = m->uniform && level == m->fine;
+  int sheet = 0;           /* the surface in the cell is proven one sheet */
   if (c == T_ONE && clip_in && !m->uniform) {
     const ScNode *nd = &m->s->nodes[one];
     if (nd->kind == SC_HALFSPACE) {
@@ -642,6 +806,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
         soft_grad_box(nd->soft, gl, gh, dl, dh);
         ok = grad_axes(dl, dh, &b) == 0;
       }
+      sheet = ok; /* grad . n0 > 0 over a box holding the cell */
       if (ok) {
         double d = sqrt(3.0) * side;
         if (b.planar) {
@@ -687,7 +852,20 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
       m->npls = (size_t)n0;
     }
   }
+  if (!leaf && level >= m->fine && !m->uniform) {
+    /* the finest level, or below it: a thin part of the object (two of
+       its sides in one cell) or a fold splits the cell further, down to
+       the octree's limit */
+    if (sheet || settled(m, c, one, lo, hi)) leaf = 1;
+    else if (level == m->depth) {
+      memcpy(m->bad, lo, sizeof lo);
+      memcpy(m->bad + 3, hi, sizeof hi);
+      m->err = MESH_ETHIN;
+      return -1;
+    } else m->rep->thin++;
+  }
   if (leaf) {
+    if (level > m->rep->deepest) m->rep->deepest = level;
     if (m->nleaves >= m->max_cells) {
       m->err = MESH_ELIMIT;
       return -1;
@@ -1562,9 +1740,15 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
   m->nft = 0;
   /* the first pass (count) finds whether the faces are plain: a plain
      cell needs only its corners */
-  if (count) lf->plain = (unsigned char)(l == m->depth || plain_cell(m, l, q));
+  /* with no cell split below the finest level, a finest cell's faces
+     are plain (no smaller neighbour) */
+  if (count)
+    lf->plain = (unsigned char)(l == m->depth || (l == m->fine && !m->rep->thin) ||
+                                plain_cell(m, l, q));
   if (lf->plain) {
-    if (count && l < m->depth && plain_points(m, l, q) < 0) return -1;
+    if (count && l < m->depth && !(l == m->fine && !m->rep->thin) &&
+        plain_points(m, l, q) < 0)
+      return -1;
   } else {
     for (int a = 0; a < 3; a++)
       for (int s = 0; s < 2; s++)
@@ -1776,8 +1960,9 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   memset(&m, 0, sizeof m);
   m.s = s;
   m.node = node;
-  m.depth = depth;
-  m.h = L / ldexp(1, depth);
+  m.fine = depth;
+  m.depth = MAX_DEPTH;
+  m.h = L / ldexp(1, MAX_DEPTH);
   m.tol = e;
   m.vtol = vtol;
   m.sharp = sharp && !ms->uniform;
@@ -1799,7 +1984,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     m.chi[i] = ms->has_bounds && ms->hi[i] <= hi[i] ? hi[i] : HUGE_VAL;
   }
   rep->depth = depth;
-  rep->h = m.h;
+  rep->h = L / ldexp(1, depth);
+  rep->deepest = depth;
   rep->vtol = vtol;
   int nsub = node - s->nodes[node].first + 1;
   m.st = malloc((size_t)nsub);
@@ -1807,10 +1993,22 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.gst = malloc(DT_STACK_MAX * sizeof *m.gst);
   m.plmap = malloc((size_t)nsub * sizeof *m.plmap);
   m.pv = malloc((size_t)nsub);
+  m.flip = malloc((size_t)nsub);
+  if (m.flip) { /* the subtree is contiguous, children before parents */
+    int f = s->nodes[node].first;
+    m.flip[nsub - 1] = 0;
+    for (int x = node; x >= f; x--) {
+      const ScNode *nd = &s->nodes[x];
+      if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF) {
+        m.flip[nd->a - f] = m.flip[x - f];
+        m.flip[nd->b - f] = (unsigned char)(m.flip[x - f] ^ (nd->kind == SC_DIFF));
+      }
+    }
+  }
   m.ex = malloc(sizeof *m.ex);
   m.ray = ray_ctx_new(s, vtol);
   int rc = MESH_OK;
-  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.ex || !m.ray) {
+  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.flip || !m.ex || !m.ray) {
     rc = MESH_ENOMEM;
     goto done;
   }
@@ -1820,6 +2018,16 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
       snprintf(err, errlen, "the mesh needs more than %zu surface octree "
                "cells (limit max-cells): give a larger tolerance than %g",
                m.max_cells, e);
+    else if (rc == MESH_ETHIN) {
+      *bad_node = m.badnode;
+      snprintf(err, errlen, "a part of the object is thinner than the "
+               "finest cell the octree can make (side %.3g, depth %d): near "
+               "(%.6g, %.6g, %.6g) its surface is not proven one sheet in a "
+               "cell (two sides of a thin part, or a point where it is not "
+               "smooth); nothing was written", m.h, MAX_DEPTH,
+               0.5 * (m.bad[0] + m.bad[3]), 0.5 * (m.bad[1] + m.bad[4]),
+               0.5 * (m.bad[2] + m.bad[5]));
+    }
     goto done;
   }
   rep->leaves = (long)m.nleaves;
@@ -1841,12 +2049,13 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     double thin = INFINITY; /* the box's least side: a hint, not a proof */
     for (int i = 0; i < 3; i++) thin = fmin(thin, hi[i] - lo[i]);
     if (rep->leaves > 0)
-      /* cells were left undecided, so the surface may pass through them
-         between their corners: a solid thinner than a cell */
-      snprintf(err, errlen, "no inside point was found at this tolerance "
-               "(%g): the object is empty, or thinner than a cell (side "
-               "%.3g) everywhere; its box is %.3g thin at the least: try "
-               "meshWith [Tolerance %.2g]", e, m.h, thin, thin / 10);
+      /* every surface cell holds one sheet of each surface in it, and
+         no corner is inside: the surfaces only dip into cells as caps */
+      snprintf(err, errlen, "no corner of any cell is inside the object at "
+               "this tolerance (%g): it is empty, or its surface only dips "
+               "into cells (side %.3g) without reaching a corner; its box "
+               "is %.3g thin at the least: try meshWith [Tolerance %.2g]",
+               e, rep->h, thin, thin / 10);
     else
       snprintf(err, errlen, "the object is empty: every cell of its box "
                "is proven outside it");
@@ -1946,6 +2155,7 @@ done:
   free(m.gst);
   free(m.plmap);
   free(m.pv);
+  free(m.flip);
   free(m.ex);
   free(m.pls);
   free(m.vert2.k);

@@ -15,7 +15,12 @@
  * bound over the cell grown by the tolerance bounds its triangles'
  * distance (mesh.c, grad_box; core/soft.h, soft_grad_box), or a CSG of at most 8 planes (a sharp cell, meshed exactly);
  * else it is split, down to the finest level whose side the tolerance
- * fixes.
+ * fixes. There, and below it, a cell is kept only when each surface in
+ * it is proven one sheet (mesh.c, settled: every line along one
+ * direction meets it once, after Plantinga and Vegter) and no two
+ * undecided planes cross it without meeting in it; else it splits again
+ * (a part thinner than the cell), down to depth 19, where MESH_ETHIN
+ * refuses naming the place and the node.
  *
  * The leaves of all sizes are cut into tetrahedra that meet face to face
  * (the Kuhn split where a cell's faces are plain, else a centre point and
@@ -78,8 +83,12 @@ typedef struct MeshReport {
                               CSG of at most 8 planes (edges and corners
                               kept) */
   int sharp_off;           /* sharp cells were given up (see mesh.c) */
-  int depth;               /* finest level */
+  int depth;               /* finest level (the tolerance's) */
   double h;                /* finest cell side */
+  long thin;               /* cells at or below the finest level split
+                              because a surface in them was not proven
+                              one sheet (a part thinner than the cell) */
+  int deepest;             /* the deepest level of a surface cell */
   double vtol;             /* the vertices' distance bound */
   double certified;        /* the proven bound, see above */
   double measured;         /* the largest distance along the normal from
@@ -98,7 +107,8 @@ enum {
   MESH_EEMPTY,             /* the object has no inside in its box */
   MESH_ETOL,               /* the tolerance is not usable */
   MESH_ELIMIT,             /* max_triangles or max_cells */
-  MESH_EINTERNAL           /* the result failed its own closure check */
+  MESH_EINTERNAL,          /* the result failed its own closure check */
+  MESH_ETHIN               /* a part thinner than the deepest cell */
 };
 
 /* Mesh node of s. On failure returns a MESH_E* code with a message in err;

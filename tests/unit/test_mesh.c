@@ -313,6 +313,142 @@ static void one(const char *name, const char *src, double tol, long euler,
 }
 
 
+/* ---- thin parts: thinner than the finest cell ---------------------------- */
+
+/* p is inside the mesh: the parity of the triangles a ray from p crosses
+   (Moller-Trumbore, an oblique direction that no test face contains). */
+static int mesh_contains(const Mesh *m, const double p[3]) {
+  static const double d[3] = {0.5773, 0.6234, 0.5274};
+  int n = 0;
+  for (size_t i = 0; i < m->nt; i++) {
+    const double *a = m->v + 3 * m->t[3 * i], *b = m->v + 3 * m->t[3 * i + 1],
+                 *c = m->v + 3 * m->t[3 * i + 2];
+    double e1[3], e2[3], pv[3], tv[3], qv[3];
+    for (int j = 0; j < 3; j++) e1[j] = b[j] - a[j], e2[j] = c[j] - a[j], tv[j] = p[j] - a[j];
+    vec3_cross(d, e2, pv);
+    double det = vec3_dot(e1, pv);
+    if (det == 0) continue;
+    double u = vec3_dot(tv, pv) / det;
+    if (u < 0 || u > 1) continue;
+    vec3_cross(tv, e1, qv);
+    double v = vec3_dot(d, qv) / det;
+    if (v < 0 || u + v > 1) continue;
+    if (vec3_dot(e2, qv) / det > 0) n++;
+  }
+  return n & 1;
+}
+
+/* An object with a part thinner than the finest cell (the tolerance's
+   cell side, given by the report, is checked to exceed the part's
+   thickness): meshed closed and oriented with the object's Euler
+   characteristic and components (known by construction), and each of
+   the np points, chosen in the thin part from its definition (and
+   checked inside by point classification), inside the mesh by ray
+   parity. */
+static void thin(const char *name, const char *src, double tol, double thick,
+                 long euler, long comps, const double (*pts)[3], int np) {
+  char buf[600];
+  Scene *s = compile(src);
+  CHECK(name, s != NULL);
+  if (!s) return;
+  MeshSettings ms = {0};
+  ms.tol = tol;
+  Mesh *m;
+  MeshReport rep;
+  char err[400];
+  int bad;
+  int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  snprintf(buf, sizeof buf, "%s: meshed (%s)", name, rc ? err : "ok");
+  CHECK(buf, rc == 0);
+  if (rc) {
+    scene_free(s);
+    return;
+  }
+  snprintf(buf, sizeof buf, "%s: the part (%.3g thick) is thinner than the "
+           "finest cell (%.3g)", name, thick, rep.h);
+  CHECK(buf, thick < rep.h);
+  long eu;
+  MeshCheck ck;
+  snprintf(buf, sizeof buf, "%s: closed, oriented (edge counting), Euler "
+           "characteristic %ld, %ld component(s)", name, euler, comps);
+  CHECK(buf, closed_oriented(m, &eu) && eu == euler && mesh_check(m, &ck) == 0 &&
+                 ck.components == comps);
+  if (eu != euler || ck.components != comps)
+    printf("# %s: Euler characteristic %ld, %ld component(s)\n", name, eu,
+           ck.components);
+  snprintf(buf, sizeof buf, "%s: outward (signed volume > 0), sharp cells kept", name);
+  CHECK(buf, volume(m) > 0 && !rep.sharp_off);
+  int in = 0, inmesh = 0;
+  for (int i = 0; i < np; i++) {
+    in += scene_inside(s, s->root, pts[i]) == 1;
+    inmesh += mesh_contains(m, pts[i]);
+  }
+  snprintf(buf, sizeof buf, "%s: %d points of the thin part inside the object", name, np);
+  CHECK(buf, in == np);
+  snprintf(buf, sizeof buf, "%s: and inside the mesh (%d of %d)", name, inmesh, np);
+  CHECK(buf, inmesh == np);
+  printf("# %s: %zu triangles, %ld cells split below the finest level (side "
+         "%.3g), down to depth %d\n", name, rep.triangles, rep.thin, rep.h,
+         rep.deepest);
+  mesh_free(m);
+  scene_free(s);
+}
+
+static void thin_parts(void) {
+  double pts[64][3];
+  int n = 0;
+  /* a fin 0.03 thick on a rounded cube, one density tree */
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++, n++) {
+      pts[n][0] = 0.315;
+      pts[n][1] = 1.1 + 0.1 * i;
+      pts[n][2] = 0.2 + 0.2 * j;
+    }
+  thin("thin fin (rounded)", "Rounded 0.01 (DensityUnion UnitCube (Shift (0.3, 1, 0) "
+       "(Scale (0.03, 0.5, 1) UnitCube)))", 0.1, 0.03, 2, 1, pts, n);
+  /* a rod 0.03 thick beside the block: two components */
+  for (n = 0; n < 14; n++) {
+    pts[n][0] = pts[n][1] = 2.015;
+    pts[n][1] = 0.015;
+    pts[n][2] = 0.1 * (n + 1);
+  }
+  thin("thin rod beside a block (rounded)", "Rounded 0.01 (DensityUnion UnitCube "
+       "(Shift (2, 0, 0) (Scale (0.03, 0.03, 1.5) UnitCube)))", 0.1, 0.03, 4, 2, pts, n);
+  /* a slab 0.03 thick through an exact sphere (rounded with soft) */
+  n = 0;
+  for (int i = 0; i < 8; i++) {
+    double a = 2 * 3.14159265358979 * i / 8;
+    for (int r = 0; r < 3; r++, n++) {
+      pts[n][0] = (0.6 + 0.15 * r) * cos(a);
+      pts[n][1] = 0;
+      pts[n][2] = (0.6 + 0.15 * r) * sin(a);
+    }
+  }
+  thin("thin slab through a sphere (rounded and soft)", "Union (Sphere 0.5) (Rounded "
+       "0.01 (Shift (-1, -0.015, -1) (Scale (2, 0.03, 2) UnitCube)))", 0.1, 0.03, 2,
+       1, pts, n);
+  /* a soft key 0.05 across (its surface alone at magic 0.5 is the
+     sphere of half its reach) beside a ball key: two components */
+  n = 0;
+  for (int i = 0; i < 7; i++, n++) {
+    pts[n][0] = 1.2 + (i == 1 ? 0.015 : i == 2 ? -0.015 : 0);
+    pts[n][1] = i == 3 ? 0.015 : i == 4 ? -0.015 : 0;
+    pts[n][2] = i == 5 ? 0.015 : i == 6 ? -0.015 : 0;
+  }
+  thin("small soft key beside a ball key", "SoftObject 0.5 [Key (0, 0, 0) 1 1, "
+       "Key (1.2, 0, 0) 0.05 1]", 0.1, 0.05, 4, 2, pts, n);
+  /* a sharp fin 0.03 thick on a rounded cube (sharp CSG with rounded) */
+  n = 0;
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++, n++) {
+      pts[n][0] = 0.315;
+      pts[n][1] = 1.02 + 0.1 * i;
+      pts[n][2] = 0.2 + 0.2 * j;
+    }
+  thin("thin sharp fin on a rounded cube", "Union (Rounded 0.05 UnitCube) (Sharp "
+       "(Shift (0.3, 0.9, 0) (Scale (0.03, 0.6, 1) UnitCube)))", 0.1, 0.03, 2, 1, pts, n);
+}
+
 /* ---- the property test: random scenes, fixed seed ------------------------ */
 
 /* orient3d, plain doubles: the sign of det(b - a, c - a, d - a). */
@@ -516,7 +652,7 @@ static void soft_text(char *out, size_t n) {
 static void property(void) {
   static const char *ops[3] = {"Union", "Intersection", "SetDifference"};
   static const char *dops[3] = {"Sum", "Product", "Difference"};
-  int total = 0, good = 0;
+  int total = 0, good = 0, gaveup = 0;
   for (int k = 0; k < 24; k++) {
     char a[400], b[400], obj[2400], tree[1000] = "", name[80];
     double radius = 0.05 + 0.1 * urand(), tol = 0.03;
@@ -591,12 +727,18 @@ static void property(void) {
     printf("# %s: %zu triangles (%ld plane, %ld smooth, %ld sharp cells%s)\n", name,
            rep.triangles, rep.planar, rep.smooth, rep.sharp,
            rep.sharp_off ? ", sharp given up" : "");
+    if (rep.sharp_off) printf("# sharp cells given up in: %s\n", obj);
+    gaveup += rep.sharp_off;
     mesh_free(m);
     scene_free(s);
   }
   printf("# property test: %d of %d random scenes closed, oriented, "
          "self-intersection-free, within tolerance\n", good, total);
   CHECK("property test: most random scenes were not empty", total >= 18);
+  /* scene 7 (mixed) gave them up: a sharp box's edge 0.003 inside a
+     sharp cell, its wedge crossing the marching neighbour's face between
+     corners (see planes_face in mesh.c) */
+  CHECK("property test: no random scene gives up its sharp cells", gaveup == 0);
 }
 
 
@@ -748,6 +890,7 @@ int main(void) {
   one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
   bad_input();
   sharp_corners();
+  thin_parts();
   property();
   soft_adaptive(); /* after the property test: it draws from urand too */
   CHECK_DONE();
