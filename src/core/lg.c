@@ -12,8 +12,26 @@
 
 /* x*y for non-negative bounds where 0 * inf means 0 (a factor that is
  * identically zero contributes nothing). */
-static double mulnn(double x, double y) {
-  return x == 0 || y == 0 ? 0 : x * y;
+static inline double mulnn(double x, double y) {
+  /* x * y is NaN only for 0 * inf (the operands are >= +0 and not NaN),
+     so this is the product with that case made 0, without a branch on
+     each operand; bit for bit the same as testing them. */
+  double r = x * y;
+  return r == r ? r : 0;
+}
+
+/* iv_mul (interval.h), to the last bit: when both intervals are ordered
+   and start at +0 or above, rounding is monotonic, so the least corner
+   product is a0 b0 and the greatest a1 b1 (no -0 can tie with +0 there);
+   otherwise the four corners. */
+static inline void mul_range(double a0, double a1, double b0, double b1,
+                             double *lo, double *hi) {
+  if (!signbit(a0) && !signbit(b0) && a0 <= a1 && b0 <= b1) {
+    *lo = a0 * b0;
+    *hi = a1 * b1;
+    return;
+  }
+  iv_mul(a0, a1, b0, b1, lo, hi);
 }
 
 /* max and min of two numbers that are never NaN (fmax and fmin are calls
@@ -94,29 +112,49 @@ static void eval_bounds(const dt_tape *t, const dt_ray_leaf *ray,
     }
     sp--;
     int x = sp - 1, y = sp;
-    double rl, rh, rL, rG;
-    dt_range_op(in->op, lo[x], hi[x], lo[y], hi[y], &rl, &rh);
+    double xl = lo[x], xh = hi[x], yl = lo[y], yh = hi[y];
+    /* dt_range_op and the L, G rules per op, the same operations in the
+       same order as the general forms (interval.h, mul_range) */
     switch (in->op) {
     case DT_SUM:
+      lo[x] = xl + yl;
+      hi[x] = xh + yh;
+      L[x] = L[x] + L[y];
+      G[x] = G[x] + G[y];
+      break;
     case DT_DIFF:
+      lo[x] = xl - yh;
+      hi[x] = xh - yl;
+      L[x] = L[x] + L[y];
+      G[x] = G[x] + G[y];
+      break;
     case DT_RDIFF:
-      rL = L[x] + L[y];
-      rG = G[x] + G[y];
+      lo[x] = yl - xh;
+      hi[x] = yh - xl;
+      L[x] = L[x] + L[y];
+      G[x] = G[x] + G[y];
       break;
     default: {
       /* Product x*y, or Union 1 - (1-x)(1-y) = 1 - X*Y with X = 1-x:
        * (XY)' = X'Y + XY', (XY)'' = X''Y + 2X'Y' + XY''. */
-      int u = in->op == DT_UNION;
-      double mx = u ? maxabs(1 - hi[x], 1 - lo[x]) : maxabs(lo[x], hi[x]);
-      double my = u ? maxabs(1 - hi[y], 1 - lo[y]) : maxabs(lo[y], hi[y]);
-      rL = mulnn(L[x], my) + mulnn(mx, L[y]);
-      rG = mulnn(G[x], my) + 2 * mulnn(L[x], L[y]) + mulnn(mx, G[y]);
+      double mx, my;
+      if (in->op == DT_PRODUCT) {
+        mul_range(xl, xh, yl, yh, &lo[x], &hi[x]);
+        mx = maxabs(xl, xh);
+        my = maxabs(yl, yh);
+      } else {
+        double l, h;
+        mul_range(1 - xh, 1 - xl, 1 - yh, 1 - yl, &l, &h);
+        lo[x] = 1 - h;
+        hi[x] = 1 - l;
+        mx = maxabs(1 - xh, 1 - xl);
+        my = maxabs(1 - yh, 1 - yl);
+      }
+      double Lx = L[x], Ly = L[y];
+      L[x] = mulnn(Lx, my) + mulnn(mx, Ly);
+      G[x] = mulnn(G[x], my) + 2 * mulnn(Lx, Ly) + mulnn(mx, G[y]);
     }
     }
-    lo[x] = rl;
-    hi[x] = rh;
-    L[x] = rL;
-    G[x] = rG;
   }
   out->lo = lo[0];
   out->hi = hi[0];
