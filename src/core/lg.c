@@ -576,6 +576,31 @@ int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
   return spans_run(&q, spans, nspans, 0);
 }
 
+/* LG_ANY (a shadow ray) without a search, when the answer is plain: the
+ * ray starts outside the outer bound (os[0] begins after t0, and
+ * outside it rho <= 0.5: not inside) and meets the inner bound (is, m
+ * spans moved in, clipped to [t0, t1]) at a point where the density is
+ * above 0.5 (evaluated: inside the inner bound it is >= 0.5, so the
+ * evaluation only rules out a density of exactly 0.5 there). The inside
+ * predicate changes between the two, so the search would report a
+ * crossing after t0; this reports one, at that point, in q->out and
+ * returns 1. Else 0: search. Not with a trace hook, which wants every
+ * segment. */
+static int any_inside(const lg_query *q, const csg_span *os,
+                      const csg_span *is, int m) {
+  if (q->mode != LG_ANY || q->hook || m == 0 || q->maxout < 1) return 0;
+  if (!(os[0].t0 > q->t0)) return 0;
+  double tm = 0.5 * (is[0].t0 + is[0].t1);
+  if (!(tm > q->t0 && tm <= q->t1)) return 0;
+  double p[3];
+  for (int i = 0; i < 3; i++) p[i] = q->o[i] + tm * q->d[i];
+  if (q->stats) q->stats->evals++;
+  if (!(dt_density(q->tape, p) > 0.5)) return 0;
+  q->out[0].t = tm;
+  q->out[0].kind = LG_ENTER;
+  return 1;
+}
+
 /* Figure 7 (c): search where outer and not inner. */
 int lg_search_bounded(const lg_query *q, const csg_tape *outer,
                       const csg_tape *inner) {
@@ -611,8 +636,12 @@ int lg_search_bounded(const lg_query *q, const csg_tape *outer,
         if (s.t0 < s.t1) is[w++] = s;
       }
       m = w;
-      int k = csg_spans_diff(os, n, is, m, ds);
-      r = spans_run(q, ds, k, 1);
+      if (any_inside(q, os, is, m)) {
+        r = 1;
+      } else {
+        int k = csg_spans_diff(os, n, is, m, ds);
+        r = spans_run(q, ds, k, 1);
+      }
     }
   }
   if (mem != local) free(mem);
