@@ -652,6 +652,27 @@ int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
   return prune(t, NULL, NULL, rl, NULL, 0, s0, s1, buf, view);
 }
 
+int dt_prune_rl_same(const dt_tape *t, const dt_ray_leaf *rl, double s0,
+                     double s1) {
+  if (t->prog) {   /* the leaves it may reach: its live list, or all */
+    int n = t->live ? t->nlive : t->nleaves;
+    for (int k = 0; k < n; k++) {
+      int i = t->live ? t->live[k] : k;
+      if (leaf_const(&t->leaves[i], rl[i].base, rl[i].nd, s0, s1) >= 0)
+        return 0;
+    }
+    return 1;
+  }
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF &&
+        leaf_const(&t->leaves[in->arg], rl[in->arg].base, rl[in->arg].nd, s0,
+                   s1) >= 0)
+      return 0;
+  }
+  return 1;
+}
+
 int dt_prune_class(const dt_tape *t, const signed char *cls, dt_instr *buf,
                    dt_leaf *leaves, dt_instr *pbuf, dt_prune_prog *prog,
                    int *live, dt_tape *view) {

@@ -215,6 +215,13 @@ double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
 int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
                 dt_instr *buf, dt_tape *view);
 
+/* 1 if no leaf that t's code may reach is constant over o + s d, s in
+ * [s0, s1] (rl: the ray's table): then nothing folds, and dt_prune_rl
+ * would give t's own code, so t itself may stand for its view there.
+ * 0 if some leaf may be constant (prune). */
+int dt_prune_rl_same(const dt_tape *t, const dt_ray_leaf *rl, double s0,
+                     double s1);
+
 /* The specialisation of t to a region where the leaves' classes are
  * known: cls[i] is 0 or 1 for a leaf constant there at that value, -1 for
  * a live one (render.c decides them over a tile's frustum).  Folds as

@@ -376,6 +376,30 @@ static void trace(search *s, const segment *sg, const lg_bounds *lb,
   s->hook->fn(s->hook->ctx, &ev);
 }
 
+/* The view of t over [a, b] (dt_prune_rl into buf), or t itself when
+ * nothing would fold there (dt_prune_rl_same): the same code either way,
+ * without the copy.  t's code then stays in use as the view's, which is
+ * safe: t is the interval's view or a segment's ancestor's, kept until
+ * every descendant is searched. */
+static void view_of(const dt_tape *t, const dt_ray_leaf *rl, double a,
+                    double b, dt_instr *buf, dt_tape *view) {
+#ifdef LG_CHECK_SAME
+  dt_tape chk;
+  dt_instr cbuf[4096];
+  dt_prune_rl(t, rl, a, b, cbuf, &chk);
+  if (dt_prune_rl_same(t, rl, a, b)) {
+    if (chk.ncode != t->ncode ||
+        memcmp(chk.code, t->code, sizeof *cbuf * (size_t)chk.ncode))
+      __builtin_trap();
+  }
+#endif
+  if (dt_prune_rl_same(t, rl, a, b)) {
+    *view = *t;
+    return;
+  }
+  dt_prune_rl(t, rl, a, b, buf, view);
+}
+
 /* Figure 9 over [a, b] of the (span-pruned) tape t.  Returns 0 when the
  * output is full.  A segment's tape is pruned from its parent's, not from
  * t: the search is depth first, so when a segment of depth k is popped
@@ -398,8 +422,8 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     if (sg.depth > 0) {
       int from = sg.depth - 1 < s->nlv - 1 ? sg.depth - 1 : s->nlv - 1;
       int to = sg.depth < s->nlv ? sg.depth : s->nlv;
-      dt_prune_rl(from ? &lv[from] : t, s->rl, sg.a, sg.b,
-                  s->lvbuf + (size_t)to * (size_t)s->ncode, &lv[to]);
+      view_of(from ? &lv[from] : t, s->rl, sg.a, sg.b,
+              s->lvbuf + (size_t)to * (size_t)s->ncode, &lv[to]);
       vp = &lv[to];
     }
     int nc = vp->ncode;
@@ -522,7 +546,7 @@ static int run(const lg_query *q, const double *iv, int n, int bounded_iv) {
     if (hhi < b) b = hhi;
     if (!(a <= b)) continue;
     dt_tape view;
-    dt_prune_rl(t, rl, a, b, buf, &view);
+    view_of(t, rl, a, b, buf, &view);
     if (!search_interval(&s, &view, a, b)) break;
   }
   if (buf != local) free(buf);
