@@ -225,7 +225,7 @@ typedef struct {
 
 static double feval(search *s, const dt_tape *t, double x, double *df) {
   if (s->st) s->st->evals++;
-  return dt_density_rl(t, s->rl, x, df) - 0.5;
+  return dt_density_rl_in(t, s->rl, x, df) - 0.5;
 }
 
 /* Returns 0 when out is full (the search stops). */
