@@ -896,6 +896,23 @@ typedef struct Hit {
   double grad[3]; /* gradient there, from the root search */
 } Hit;
 
+/* A halfspace primitive's crossing in (t0, t1) (prim_hit's case, inlined
+   into trace for the unbounded ones: the floor is tried by every ray). */
+static inline int halfspace_hit(const ScNode *n, int node, int pi,
+                                const double o[3], const double d[3],
+                                double t0, double t1, Hit *h) {
+  double nd = vec3_dot(n->n, d);
+  if (nd == 0) return 0;
+  double t = (n->d - vec3_dot(n->n, o)) / nd;
+  if (!(t > t0 && t < t1)) return 0;
+  h->t = t;
+  h->id = node;
+  h->flip = 0;
+  h->has_grad = 0;
+  h->prim = pi;
+  return 1;
+}
+
 /* The first surface crossing of one primitive in (t0, t1); with any != 0
    (a shadow ray) a rounded primitive may report any t in (t0, t1] when
    there is a crossing, and none when there is none. */
@@ -906,17 +923,8 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
   int node = T->prims[pi].node;
   const ScNode *n = &s->nodes[node];
   switch (n->kind) {
-  case SC_HALFSPACE: {
-    double nd = vec3_dot(n->n, d);
-    if (nd == 0) return 0;
-    double t = (n->d - vec3_dot(n->n, o)) / nd;
-    if (!(t > t0 && t < t1)) return 0;
-    h->t = t;
-    h->id = node;
-    h->flip = 0;
-    h->has_grad = 0;
-    break;
-  }
+  case SC_HALFSPACE:
+    return halfspace_hit(n, node, pi, o, d, t0, t1, h);
   case SC_ROUNDED: {
     lg_root roots[8];
     double tol = ray_dist_tol(c, o, d);
@@ -987,7 +995,11 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
   c->tapes = tc ? tc->tape : NULL;
   for (int i = 0; i < T->nunbounded; i++) {
     Hit h;
-    if (prim_hit(T, T->unbounded[i], o, d, t0, t1, c, &h, any)) {
+    int pi = T->unbounded[i], node = T->prims[pi].node;
+    const ScNode *n = &T->s->nodes[node];
+    if (n->kind == SC_HALFSPACE
+            ? halfspace_hit(n, node, pi, o, d, t0, t1, &h)
+            : prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
       *best = h;
       t1 = h.t;
       found = 1;
@@ -1126,7 +1138,8 @@ static inline void shade_hit(Worker *W, const double o[3], const double d[3],
   memcpy(nrm, n, sizeof n);
   const double *col = T->prims[hp->prim].colour;
   for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
-  double scale = fmax(1.0, sqrt(vec3_dot(p, p)));
+  double pp = sqrt(vec3_dot(p, p));   /* fmax(1, pp) without a libm call */
+  double scale = isnan(pp) || 1.0 > pp ? 1.0 : pp;
   double eps = T->eps * scale;
   for (int l = 0; l < T->nlights; l++) {
     double L[3];

@@ -128,10 +128,16 @@ static int crossings_to_spans(const double *t, const int *kind, int nroots,
   return n;
 }
 
+/* fmax(a, b) without the call into libm (gcc and clang call it): the
+   larger, or the one that is not NaN. Callers pass no -0. */
+static inline double max_nn(double a, double b) {
+  return isnan(b) || a > b ? a : b;
+}
+
 double ray_dist_tol(const RayCtx *c, const double o[3], const double d[3]) {
   double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
-  return fmax(c->tol, RAY_TOL_FLOOR * scale) / len;
+  double scale = max_nn(1.0, max_nn(fabs(o[0]), max_nn(fabs(o[1]), fabs(o[2]))));
+  return max_nn(c->tol, RAY_TOL_FLOOR * scale) / len;
 }
 
 static int rounded_spans(const ScNode *n, int id, const double o[3],
