@@ -1196,12 +1196,20 @@ static inline void put_pixel(const Tracer *T, int x, int y, const double sum[3],
   const RenderSettings *rs = T->rs;
   int g = T->grid;
   size_t k = img_index(im, x - im->x0, y - im->y0);
-  for (int i = 0; i < 3; i++) im->rgba[4 * k + (size_t)i] = (float)(sum[i] / (g * g));
+  /* one sample: dividing by 1 is exact, so it is skipped */
+  for (int i = 0; i < 3; i++)
+    im->rgba[4 * k + (size_t)i] = (float)(g == 1 ? sum[i] : sum[i] / (g * g));
   im->rgba[4 * k + 3] = rs->alpha ? (float)hits / (float)(g * g) : 1;
   if (im->z) im->z[k] = (float)zmin;
   if (im->n)
     for (int i = 0; i < 3; i++) im->n[3 * k + (size_t)i] = (float)nrm0[i];
   if (im->cost) im->cost[k] = (float)cost;
+}
+
+/* The offset (s + 0.5) / g of sample s of g across a pixel; 0.5 for one
+   sample (the same value: dividing by 1 is exact) without a division. */
+static inline double sample_off(int s, int g) {
+  return g == 1 ? 0.5 : (s + 0.5) / g;
 }
 
 /* One sample of a pixel into its sums: the ray's work (for the largest),
@@ -1243,7 +1251,8 @@ static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
     for (int x = x0; x < x1; x++)
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++, sp++) {
-          camera_ray(&T->cam, x + (sx + 0.5) / g, y + (sy + 0.5) / g, sp->d);
+          camera_ray(&T->cam, x + sample_off(sx, g), y + sample_off(sy, g),
+                     sp->d);
           long w0 = ray_work(W->c);
           sp->found = primary_hit(W, T->cam.eye, sp->d, &sp->h, tc);
           sp->work = ray_work(W->c) - w0;
@@ -1312,7 +1321,7 @@ static void render_tile(Worker *W, int tile) {
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++) {
           double d[3], rgb[3], z, nrm[3];
-          camera_ray(&T->cam, x + (sx + 0.5) / g, y + (sy + 0.5) / g, d);
+          camera_ray(&T->cam, x + sample_off(sx, g), y + sample_off(sy, g), d);
           long w0 = ray_work(W->c);
           Hit h;
           int found = primary_hit(W, T->cam.eye, d, &h, NULL);
