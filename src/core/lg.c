@@ -380,7 +380,9 @@ static void trace(search *s, const segment *sg, const lg_bounds *lb,
  * nothing would fold there (dt_prune_rl_same): the same code either way,
  * without the copy.  t's code then stays in use as the view's, which is
  * safe: t is the interval's view or a segment's ancestor's, kept until
- * every descendant is searched. */
+ * every descendant is searched.  (For a segment's view only: an
+ * interval's view of a tile's tape mostly folds, and the check would
+ * cost more than it saves.) */
 static void view_of(const dt_tape *t, const dt_ray_leaf *rl, double a,
                     double b, dt_instr *buf, dt_tape *view) {
 #ifdef LG_CHECK_SAME
@@ -545,8 +547,8 @@ static int run(const lg_query *q, const double *iv, int n, int bounded_iv) {
     if (hlo > a) a = hlo;
     if (hhi < b) b = hhi;
     if (!(a <= b)) continue;
-    dt_tape view;
-    view_of(t, rl, a, b, buf, &view);
+    dt_tape view;   /* pruned always: a tile's view mostly folds here */
+    dt_prune_rl(t, rl, a, b, buf, &view);
     if (!search_interval(&s, &view, a, b)) break;
   }
   if (buf != local) free(buf);
