@@ -94,6 +94,13 @@ units: $(UNIT_BINS) $(REPLAY_BINS)
 # tests and fuzz targets are not held to it.
 $(OBJS): ALL_CFLAGS += -Wconversion
 
+# The tracer's kernels at -O3 (unless OPT is given on the command line, as
+# the sanitizer builds do): about 5% fewer instructions on the rounded
+# scenes, the same pictures bit for bit (no fast-math, no contraction).
+HOT_OBJS := $(filter $(BUILD)/core/%,$(OBJS)) $(BUILD)/scene/ray.o \
+            $(BUILD)/render/render.o $(BUILD)/render/camera.o
+$(HOT_OBJS): OPT = -O3
+
 $(BUILD)/%.o: src/%.c | $(BUILD)/prelude.inc $(BUILD)/kit.inc
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -c -o $@ $<

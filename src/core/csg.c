@@ -452,6 +452,23 @@ int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
   /* One convex polyhedron (a typical bound): straight to out. */
   if (t->nrcode == 1 && t->rcode[0].op == CSG_CONVEX && maxout >= 1)
     return convex_span(t, t->rcode[0].arg, o, d, s0, s1, out);
+  /* Two convex polyhedra and one operation (a bound with a hole): the
+     same spans and merge as the loop below, without its scratch lists. */
+  if (t->nrcode == 3 && t->rcode[0].op == CSG_CONVEX &&
+      t->rcode[1].op == CSG_CONVEX) {
+    csg_span x, y, m[2];
+    int nx = convex_span(t, t->rcode[0].arg, o, d, s0, s1, &x);
+    int ny = convex_span(t, t->rcode[1].arg, o, d, s0, s1, &y), n;
+    switch (t->rcode[2].op) {
+    case CSG_UNION: n = csg_spans_union(&x, nx, &y, ny, m); break;
+    case CSG_INTER: n = csg_spans_inter(&x, nx, &y, ny, m); break;
+    case CSG_DIFF: n = csg_spans_diff(&x, nx, &y, ny, m); break;
+    default: n = csg_spans_diff(&y, ny, &x, nx, m); break;
+    }
+    if (n > maxout) return -1;
+    memcpy(out, m, (size_t)n * sizeof *out);
+    return n;
+  }
   csg_span local[CSG_LOCAL_SPANS];
   int need = csg_scratch_spans(t);
   if (!scratch) {

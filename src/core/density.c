@@ -298,42 +298,13 @@ void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],
 }
 
 /* dt_density_ray with the leaves' distances from the ray's table: the same
- * operations in the same order, so the same result to the last bit. */
+ * operations in the same order, so the same result to the last bit
+ * (dt_density_rl_in, density.h). */
 double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
                      double *drho_ds) {
-  double v[DT_STACK_MAX], dv[DT_STACK_MAX];
-  int sp = 0;
-  for (int i = 0; i < t->ncode; i++) {
-    const dt_instr *in = &t->code[i];
-    if (in->op == DT_LEAF) {
-      const dt_leaf *lf = &t->leaves[in->arg];
-      double nd = rl[in->arg].nd;
-      double dist = rl[in->arg].base + s * nd, dda = 0;
-      if (lf->r > 0) v[sp] = dt_halfspace_da(dist * lf->inv_r, &dda);
-      else v[sp] = dt_halfspace(dist, 0);
-      dv[sp] = dda * nd * lf->inv_r;
-      sp++;
-    } else if (in->op == DT_CONST) {
-      v[sp] = in->c;
-      dv[sp] = 0;
-      sp++;
-    } else {
-      sp--;
-      double x = v[sp - 1], y = v[sp], dx = dv[sp - 1], dy = dv[sp];
-      switch (in->op) {
-      case DT_SUM: dv[sp - 1] = dx + dy; v[sp - 1] = x + y; break;
-      case DT_PRODUCT: dv[sp - 1] = dx * y + x * dy; v[sp - 1] = x * y; break;
-      case DT_DIFF: dv[sp - 1] = dx - dy; v[sp - 1] = x - y; break;
-      case DT_RDIFF: dv[sp - 1] = dy - dx; v[sp - 1] = y - x; break;
-      default:
-        dv[sp - 1] = dx * (1 - y) + dy * (1 - x);
-        v[sp - 1] = x + y - x * y;
-        break;
-      }
-    }
-  }
-  if (drho_ds) *drho_ds = dv[0];
-  return v[0];
+  double dd, v = dt_density_rl_in(t, rl, s, &dd);
+  if (drho_ds) *drho_ds = dd;
+  return v;
 }
 
 /* eq. (5): Displacement.  The paper's trigonometric root
@@ -650,6 +621,27 @@ int dt_prune_ray(const dt_tape *t, const double o[3], const double d[3],
 int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
                 dt_instr *buf, dt_tape *view) {
   return prune(t, NULL, NULL, rl, NULL, 0, s0, s1, buf, view);
+}
+
+int dt_prune_rl_same(const dt_tape *t, const dt_ray_leaf *rl, double s0,
+                     double s1) {
+  if (t->prog) {   /* the leaves it may reach: its live list, or all */
+    int n = t->live ? t->nlive : t->nleaves;
+    for (int k = 0; k < n; k++) {
+      int i = t->live ? t->live[k] : k;
+      if (leaf_const(&t->leaves[i], rl[i].base, rl[i].nd, s0, s1) >= 0)
+        return 0;
+    }
+    return 1;
+  }
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF &&
+        leaf_const(&t->leaves[in->arg], rl[in->arg].base, rl[in->arg].nd, s0,
+                   s1) >= 0)
+      return 0;
+  }
+  return 1;
 }
 
 int dt_prune_class(const dt_tape *t, const signed char *cls, dt_instr *buf,

@@ -210,10 +210,58 @@ void dt_ray_leaves(const dt_tape *t, const double o[3], const double d[3],
                    dt_ray_leaf *rl);
 double dt_density_rl(const dt_tape *t, const dt_ray_leaf *rl, double s,
                      double *drho_ds);
+
+/* dt_density_rl itself, static inline for the root search's inner loop
+ * (lg.c), where the call and the stack set-up cost as much as a short
+ * view's arithmetic.  drho_ds must not be NULL. */
+static inline double dt_density_rl_in(const dt_tape *t, const dt_ray_leaf *rl,
+                                      double s, double *drho_ds) {
+  double v[DT_STACK_MAX], dv[DT_STACK_MAX];
+  v[0] = dv[0] = 0;   /* (a tape has code: only for the compiler's sake) */
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      double nd = rl[in->arg].nd;
+      double dist = rl[in->arg].base + s * nd, dda = 0;
+      if (lf->r > 0) v[sp] = dt_halfspace_da(dist * lf->inv_r, &dda);
+      else v[sp] = dt_halfspace(dist, 0);
+      dv[sp] = dda * nd * lf->inv_r;
+      sp++;
+    } else if (in->op == DT_CONST) {
+      v[sp] = in->c;
+      dv[sp] = 0;
+      sp++;
+    } else {
+      sp--;
+      double x = v[sp - 1], y = v[sp], dx = dv[sp - 1], dy = dv[sp];
+      switch (in->op) {
+      case DT_SUM: dv[sp - 1] = dx + dy; v[sp - 1] = x + y; break;
+      case DT_PRODUCT: dv[sp - 1] = dx * y + x * dy; v[sp - 1] = x * y; break;
+      case DT_DIFF: dv[sp - 1] = dx - dy; v[sp - 1] = x - y; break;
+      case DT_RDIFF: dv[sp - 1] = dy - dx; v[sp - 1] = y - x; break;
+      default:
+        dv[sp - 1] = dx * (1 - y) + dy * (1 - x);
+        v[sp - 1] = x + y - x * y;
+        break;
+      }
+    }
+  }
+  *drho_ds = dv[0];
+  return v[0];
+}
 /* As dt_prune_ray, but the view keeps t's density range lo, hi (it still
  * bounds the view's) instead of recomputing it; t may itself be a view. */
 int dt_prune_rl(const dt_tape *t, const dt_ray_leaf *rl, double s0, double s1,
                 dt_instr *buf, dt_tape *view);
+
+/* 1 if no leaf that t's code may reach is constant over o + s d, s in
+ * [s0, s1] (rl: the ray's table): then nothing folds, and dt_prune_rl
+ * would give t's own code, so t itself may stand for its view there.
+ * 0 if some leaf may be constant (prune). */
+int dt_prune_rl_same(const dt_tape *t, const dt_ray_leaf *rl, double s0,
+                     double s1);
 
 /* The specialisation of t to a region where the leaves' classes are
  * known: cls[i] is 0 or 1 for a leaf constant there at that value, -1 for

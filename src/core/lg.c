@@ -12,8 +12,26 @@
 
 /* x*y for non-negative bounds where 0 * inf means 0 (a factor that is
  * identically zero contributes nothing). */
-static double mulnn(double x, double y) {
-  return x == 0 || y == 0 ? 0 : x * y;
+static inline double mulnn(double x, double y) {
+  /* x * y is NaN only for 0 * inf (the operands are >= +0 and not NaN),
+     so this is the product with that case made 0, without a branch on
+     each operand; bit for bit the same as testing them. */
+  double r = x * y;
+  return r == r ? r : 0;
+}
+
+/* iv_mul (interval.h), to the last bit: when both intervals are ordered
+   and start at +0 or above, rounding is monotonic, so the least corner
+   product is a0 b0 and the greatest a1 b1 (no -0 can tie with +0 there);
+   otherwise the four corners. */
+static inline void mul_range(double a0, double a1, double b0, double b1,
+                             double *lo, double *hi) {
+  if (!signbit(a0) && !signbit(b0) && a0 <= a1 && b0 <= b1) {
+    *lo = a0 * b0;
+    *hi = a1 * b1;
+    return;
+  }
+  iv_mul(a0, a1, b0, b1, lo, hi);
 }
 
 /* max and min of two numbers that are never NaN (fmax and fmin are calls
@@ -94,29 +112,49 @@ static void eval_bounds(const dt_tape *t, const dt_ray_leaf *ray,
     }
     sp--;
     int x = sp - 1, y = sp;
-    double rl, rh, rL, rG;
-    dt_range_op(in->op, lo[x], hi[x], lo[y], hi[y], &rl, &rh);
+    double xl = lo[x], xh = hi[x], yl = lo[y], yh = hi[y];
+    /* dt_range_op and the L, G rules per op, the same operations in the
+       same order as the general forms (interval.h, mul_range) */
     switch (in->op) {
     case DT_SUM:
+      lo[x] = xl + yl;
+      hi[x] = xh + yh;
+      L[x] = L[x] + L[y];
+      G[x] = G[x] + G[y];
+      break;
     case DT_DIFF:
+      lo[x] = xl - yh;
+      hi[x] = xh - yl;
+      L[x] = L[x] + L[y];
+      G[x] = G[x] + G[y];
+      break;
     case DT_RDIFF:
-      rL = L[x] + L[y];
-      rG = G[x] + G[y];
+      lo[x] = yl - xh;
+      hi[x] = yh - xl;
+      L[x] = L[x] + L[y];
+      G[x] = G[x] + G[y];
       break;
     default: {
       /* Product x*y, or Union 1 - (1-x)(1-y) = 1 - X*Y with X = 1-x:
        * (XY)' = X'Y + XY', (XY)'' = X''Y + 2X'Y' + XY''. */
-      int u = in->op == DT_UNION;
-      double mx = u ? maxabs(1 - hi[x], 1 - lo[x]) : maxabs(lo[x], hi[x]);
-      double my = u ? maxabs(1 - hi[y], 1 - lo[y]) : maxabs(lo[y], hi[y]);
-      rL = mulnn(L[x], my) + mulnn(mx, L[y]);
-      rG = mulnn(G[x], my) + 2 * mulnn(L[x], L[y]) + mulnn(mx, G[y]);
+      double mx, my;
+      if (in->op == DT_PRODUCT) {
+        mul_range(xl, xh, yl, yh, &lo[x], &hi[x]);
+        mx = maxabs(xl, xh);
+        my = maxabs(yl, yh);
+      } else {
+        double l, h;
+        mul_range(1 - xh, 1 - xl, 1 - yh, 1 - yl, &l, &h);
+        lo[x] = 1 - h;
+        hi[x] = 1 - l;
+        mx = maxabs(1 - xh, 1 - xl);
+        my = maxabs(1 - yh, 1 - yl);
+      }
+      double Lx = L[x], Ly = L[y];
+      L[x] = mulnn(Lx, my) + mulnn(mx, Ly);
+      G[x] = mulnn(G[x], my) + 2 * mulnn(Lx, Ly) + mulnn(mx, G[y]);
     }
     }
-    lo[x] = rl;
-    hi[x] = rh;
-    L[x] = rL;
-    G[x] = rG;
   }
   out->lo = lo[0];
   out->hi = hi[0];
@@ -187,7 +225,7 @@ typedef struct {
 
 static double feval(search *s, const dt_tape *t, double x, double *df) {
   if (s->st) s->st->evals++;
-  return dt_density_rl(t, s->rl, x, df) - 0.5;
+  return dt_density_rl_in(t, s->rl, x, df) - 0.5;
 }
 
 /* Returns 0 when out is full (the search stops). */
@@ -338,6 +376,32 @@ static void trace(search *s, const segment *sg, const lg_bounds *lb,
   s->hook->fn(s->hook->ctx, &ev);
 }
 
+/* The view of t over [a, b] (dt_prune_rl into buf), or t itself when
+ * nothing would fold there (dt_prune_rl_same): the same code either way,
+ * without the copy.  t's code then stays in use as the view's, which is
+ * safe: t is the interval's view or a segment's ancestor's, kept until
+ * every descendant is searched.  (For a segment's view only: an
+ * interval's view of a tile's tape mostly folds, and the check would
+ * cost more than it saves.) */
+static void view_of(const dt_tape *t, const dt_ray_leaf *rl, double a,
+                    double b, dt_instr *buf, dt_tape *view) {
+#ifdef LG_CHECK_SAME
+  dt_tape chk;
+  dt_instr cbuf[4096];
+  dt_prune_rl(t, rl, a, b, cbuf, &chk);
+  if (dt_prune_rl_same(t, rl, a, b)) {
+    if (chk.ncode != t->ncode ||
+        memcmp(chk.code, t->code, sizeof *cbuf * (size_t)chk.ncode))
+      __builtin_trap();
+  }
+#endif
+  if (dt_prune_rl_same(t, rl, a, b)) {
+    *view = *t;
+    return;
+  }
+  dt_prune_rl(t, rl, a, b, buf, view);
+}
+
 /* Figure 9 over [a, b] of the (span-pruned) tape t.  Returns 0 when the
  * output is full.  A segment's tape is pruned from its parent's, not from
  * t: the search is depth first, so when a segment of depth k is popped
@@ -360,8 +424,8 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     if (sg.depth > 0) {
       int from = sg.depth - 1 < s->nlv - 1 ? sg.depth - 1 : s->nlv - 1;
       int to = sg.depth < s->nlv ? sg.depth : s->nlv;
-      dt_prune_rl(from ? &lv[from] : t, s->rl, sg.a, sg.b,
-                  s->lvbuf + (size_t)to * (size_t)s->ncode, &lv[to]);
+      view_of(from ? &lv[from] : t, s->rl, sg.a, sg.b,
+              s->lvbuf + (size_t)to * (size_t)s->ncode, &lv[to]);
       vp = &lv[to];
     }
     int nc = vp->ncode;
@@ -483,7 +547,7 @@ static int run(const lg_query *q, const double *iv, int n, int bounded_iv) {
     if (hlo > a) a = hlo;
     if (hhi < b) b = hhi;
     if (!(a <= b)) continue;
-    dt_tape view;
+    dt_tape view;   /* pruned always: a tile's view mostly folds here */
     dt_prune_rl(t, rl, a, b, buf, &view);
     if (!search_interval(&s, &view, a, b)) break;
   }
@@ -538,6 +602,31 @@ int lg_roots_spans(const dt_tape *t, const double o[3], const double d[3],
   return spans_run(&q, spans, nspans, 0);
 }
 
+/* LG_ANY (a shadow ray) without a search, when the answer is plain: the
+ * ray starts outside the outer bound (os[0] begins after t0, and
+ * outside it rho <= 0.5: not inside) and meets the inner bound (is, m
+ * spans moved in, clipped to [t0, t1]) at a point where the density is
+ * above 0.5 (evaluated: inside the inner bound it is >= 0.5, so the
+ * evaluation only rules out a density of exactly 0.5 there). The inside
+ * predicate changes between the two, so the search would report a
+ * crossing after t0; this reports one, at that point, in q->out and
+ * returns 1. Else 0: search. Not with a trace hook, which wants every
+ * segment. */
+static int any_inside(const lg_query *q, const csg_span *os,
+                      const csg_span *is, int m) {
+  if (q->mode != LG_ANY || q->hook || m == 0 || q->maxout < 1) return 0;
+  if (!(os[0].t0 > q->t0)) return 0;
+  double tm = 0.5 * (is[0].t0 + is[0].t1);
+  if (!(tm > q->t0 && tm <= q->t1)) return 0;
+  double p[3];
+  for (int i = 0; i < 3; i++) p[i] = q->o[i] + tm * q->d[i];
+  if (q->stats) q->stats->evals++;
+  if (!(dt_density(q->tape, p) > 0.5)) return 0;
+  q->out[0].t = tm;
+  q->out[0].kind = LG_ENTER;
+  return 1;
+}
+
 /* Figure 7 (c): search where outer and not inner. */
 int lg_search_bounded(const lg_query *q, const csg_tape *outer,
                       const csg_tape *inner) {
@@ -573,8 +662,12 @@ int lg_search_bounded(const lg_query *q, const csg_tape *outer,
         if (s.t0 < s.t1) is[w++] = s;
       }
       m = w;
-      int k = csg_spans_diff(os, n, is, m, ds);
-      r = spans_run(q, ds, k, 1);
+      if (any_inside(q, os, is, m)) {
+        r = 1;
+      } else {
+        int k = csg_spans_diff(os, n, is, m, ds);
+        r = spans_run(q, ds, k, 1);
+      }
     }
   }
   if (mem != local) free(mem);

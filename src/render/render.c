@@ -896,6 +896,23 @@ typedef struct Hit {
   double grad[3]; /* gradient there, from the root search */
 } Hit;
 
+/* A halfspace primitive's crossing in (t0, t1) (prim_hit's case, inlined
+   into trace for the unbounded ones: the floor is tried by every ray). */
+static inline int halfspace_hit(const ScNode *n, int node, int pi,
+                                const double o[3], const double d[3],
+                                double t0, double t1, Hit *h) {
+  double nd = vec3_dot(n->n, d);
+  if (nd == 0) return 0;
+  double t = (n->d - vec3_dot(n->n, o)) / nd;
+  if (!(t > t0 && t < t1)) return 0;
+  h->t = t;
+  h->id = node;
+  h->flip = 0;
+  h->has_grad = 0;
+  h->prim = pi;
+  return 1;
+}
+
 /* The first surface crossing of one primitive in (t0, t1); with any != 0
    (a shadow ray) a rounded primitive may report any t in (t0, t1] when
    there is a crossing, and none when there is none. */
@@ -906,17 +923,8 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
   int node = T->prims[pi].node;
   const ScNode *n = &s->nodes[node];
   switch (n->kind) {
-  case SC_HALFSPACE: {
-    double nd = vec3_dot(n->n, d);
-    if (nd == 0) return 0;
-    double t = (n->d - vec3_dot(n->n, o)) / nd;
-    if (!(t > t0 && t < t1)) return 0;
-    h->t = t;
-    h->id = node;
-    h->flip = 0;
-    h->has_grad = 0;
-    break;
-  }
+  case SC_HALFSPACE:
+    return halfspace_hit(n, node, pi, o, d, t0, t1, h);
   case SC_ROUNDED: {
     lg_root roots[8];
     double tol = ray_dist_tol(c, o, d);
@@ -987,7 +995,11 @@ static int trace(const Tracer *T, const double o[3], const double d[3],
   c->tapes = tc ? tc->tape : NULL;
   for (int i = 0; i < T->nunbounded; i++) {
     Hit h;
-    if (prim_hit(T, T->unbounded[i], o, d, t0, t1, c, &h, any)) {
+    int pi = T->unbounded[i], node = T->prims[pi].node;
+    const ScNode *n = &T->s->nodes[node];
+    if (n->kind == SC_HALFSPACE
+            ? halfspace_hit(n, node, pi, o, d, t0, t1, &h)
+            : prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
       *best = h;
       t1 = h.t;
       found = 1;
@@ -1126,7 +1138,8 @@ static inline void shade_hit(Worker *W, const double o[3], const double d[3],
   memcpy(nrm, n, sizeof n);
   const double *col = T->prims[hp->prim].colour;
   for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
-  double scale = fmax(1.0, sqrt(vec3_dot(p, p)));
+  double pp = sqrt(vec3_dot(p, p));   /* fmax(1, pp) without a libm call */
+  double scale = isnan(pp) || 1.0 > pp ? 1.0 : pp;
   double eps = T->eps * scale;
   for (int l = 0; l < T->nlights; l++) {
     double L[3];
@@ -1183,12 +1196,20 @@ static inline void put_pixel(const Tracer *T, int x, int y, const double sum[3],
   const RenderSettings *rs = T->rs;
   int g = T->grid;
   size_t k = img_index(im, x - im->x0, y - im->y0);
-  for (int i = 0; i < 3; i++) im->rgba[4 * k + (size_t)i] = (float)(sum[i] / (g * g));
+  /* one sample: dividing by 1 is exact, so it is skipped */
+  for (int i = 0; i < 3; i++)
+    im->rgba[4 * k + (size_t)i] = (float)(g == 1 ? sum[i] : sum[i] / (g * g));
   im->rgba[4 * k + 3] = rs->alpha ? (float)hits / (float)(g * g) : 1;
   if (im->z) im->z[k] = (float)zmin;
   if (im->n)
     for (int i = 0; i < 3; i++) im->n[3 * k + (size_t)i] = (float)nrm0[i];
   if (im->cost) im->cost[k] = (float)cost;
+}
+
+/* The offset (s + 0.5) / g of sample s of g across a pixel; 0.5 for one
+   sample (the same value: dividing by 1 is exact) without a division. */
+static inline double sample_off(int s, int g) {
+  return g == 1 ? 0.5 : (s + 0.5) / g;
 }
 
 /* One sample of a pixel into its sums: the ray's work (for the largest),
@@ -1230,7 +1251,8 @@ static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
     for (int x = x0; x < x1; x++)
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++, sp++) {
-          camera_ray(&T->cam, x + (sx + 0.5) / g, y + (sy + 0.5) / g, sp->d);
+          camera_ray(&T->cam, x + sample_off(sx, g), y + sample_off(sy, g),
+                     sp->d);
           long w0 = ray_work(W->c);
           sp->found = primary_hit(W, T->cam.eye, sp->d, &sp->h, tc);
           sp->work = ray_work(W->c) - w0;
@@ -1299,7 +1321,7 @@ static void render_tile(Worker *W, int tile) {
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++) {
           double d[3], rgb[3], z, nrm[3];
-          camera_ray(&T->cam, x + (sx + 0.5) / g, y + (sy + 0.5) / g, d);
+          camera_ray(&T->cam, x + sample_off(sx, g), y + sample_off(sy, g), d);
           long w0 = ray_work(W->c);
           Hit h;
           int found = primary_hit(W, T->cam.eye, d, &h, NULL);

@@ -26,6 +26,22 @@ RayCtx *ray_ctx_new(const Scene *s, double tol) {
       return NULL;
     }
   }
+  /* Intersections of halfspaces (children have lower indices). Without
+     memory the table is simply absent: the merges do the same work. */
+  int any = 0;
+  c->convex = s->n > 0 ? malloc((size_t)s->n) : NULL;
+  for (int i = 0; c->convex && i < s->n; i++) {
+    const ScNode *n = &s->nodes[i];
+    c->convex[i] = n->kind == SC_HALFSPACE ||
+                   (n->kind == SC_INTER && c->convex[n->a] && c->convex[n->b]);
+    any |= n->kind == SC_INTER && c->convex[i];
+  }
+  if (!any) {
+    free(c->convex);
+    c->convex = NULL;
+  }
+  c->conv_scene = s;
+  c->conv_n = c->convex ? s->n : 0;
   return c;
 }
 
@@ -37,6 +53,8 @@ void ray_ctx_free(RayCtx *c) {
   }
   if (c->soft) soft_scratch_free(c->soft);
   free(c->frames);
+  free(c->convex);
+  free(c->cstack);
   free(c);
 }
 
@@ -128,10 +146,16 @@ static int crossings_to_spans(const double *t, const int *kind, int nroots,
   return n;
 }
 
+/* fmax(a, b) without the call into libm (gcc and clang call it): the
+   larger, or the one that is not NaN. Callers pass no -0. */
+static inline double max_nn(double a, double b) {
+  return isnan(b) || a > b ? a : b;
+}
+
 double ray_dist_tol(const RayCtx *c, const double o[3], const double d[3]) {
   double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  double scale = fmax(1.0, fmax(fabs(o[0]), fmax(fabs(o[1]), fabs(o[2]))));
-  return fmax(c->tol, RAY_TOL_FLOOR * scale) / len;
+  double scale = max_nn(1.0, max_nn(fabs(o[0]), max_nn(fabs(o[1]), fabs(o[2]))));
+  return max_nn(c->tol, RAY_TOL_FLOOR * scale) / len;
 }
 
 static int rounded_spans(const ScNode *n, int id, const double o[3],
@@ -187,6 +211,62 @@ static int soft_spans(const ScNode *n, int id, const double o[3],
                             out);
 }
 
+/* An intersection of halfspaces only (RayCtx.convex), for this scene. */
+static int is_convex(const Scene *s, int node, const RayCtx *c) {
+  return c->convex && c->conv_scene == s && node < c->conv_n &&
+         s->nodes[node].kind == SC_INTER && c->convex[node];
+}
+
+/* The span of such a node: its halfspaces' spans in the order the
+   recursion visits them (a before b), clipped one after another: the
+   larger start and the smaller end, the earlier on ties, empty as soon
+   as a halfspace misses or start >= end, which is what the pairwise
+   merges (csg_spans_inter) give in any tree shape; the ids and flips
+   are the winning halfspaces'. *out: one span; the count, or -1 when
+   memory runs out. */
+static int convex_spans(const Scene *s, int node, const double o[3],
+                        const double d[3], double t0, double t1, RayCtx *c,
+                        csg_span *out) {
+  size_t sp = 0;
+  int have = 0;
+  csg_span cur = {0, 0, -1, -1, 0, 0};
+  if (!c->cap_cstack) {
+    c->cstack = malloc(64 * sizeof *c->cstack);
+    if (!c->cstack) return -1;
+    c->cap_cstack = 64;
+  }
+  c->cstack[sp++] = node;
+  while (sp) {
+    int k = c->cstack[--sp];
+    const ScNode *n = &s->nodes[k];
+    if (n->kind == SC_INTER) {   /* a first: pushed last */
+      if (sp + 2 > c->cap_cstack) {
+        int *q = realloc(c->cstack, 2 * c->cap_cstack * sizeof *q);
+        if (!q) return -1;
+        c->cstack = q;
+        c->cap_cstack *= 2;
+      }
+      c->cstack[sp++] = n->b;
+      c->cstack[sp++] = n->a;
+      continue;
+    }
+    csg_span h;
+    if (!halfspace_spans(n, k, o, d, t0, t1, &h)) return 0;
+    if (!have) {
+      cur = h;
+      have = 1;
+      continue;
+    }
+    const csg_span *lo = cur.t0 >= h.t0 ? &cur : &h;
+    const csg_span *hi = cur.t1 <= h.t1 ? &cur : &h;
+    if (!(lo->t0 < hi->t1)) return 0;
+    csg_span m = {lo->t0, hi->t1, lo->id0, hi->id1, lo->flip0, hi->flip1};
+    cur = m;
+  }
+  *out = cur;
+  return 1;
+}
+
 /* The spans of a leaf node (not a set operation) into *spans: the count,
    or -1 when memory runs out. */
 static int leaf_spans(const Scene *s, int node, const double o[3],
@@ -195,6 +275,12 @@ static int leaf_spans(const Scene *s, int node, const double o[3],
   const ScNode *n = &s->nodes[node];
   csg_span *out;
   int cnt;
+  if (is_convex(s, node, c)) {
+    out = alloc_spans(c, 1);
+    if (!out) return -1;
+    *spans = out;
+    return convex_spans(s, node, o, d, t0, t1, c, out);
+  }
   switch (n->kind) {
   case SC_HALFSPACE:
     out = alloc_spans(c, 1);
@@ -249,8 +335,9 @@ int ray_spans(const Scene *s, int node, const double o[3], const double d[3],
   csg_span *res;
   int cnt;
   for (;;) {
-    /* Descend the left spine of node to a leaf, a frame per operation. */
-    while (is_op(nodes[node].kind)) {
+    /* Descend the left spine of node to a leaf, a frame per operation
+       (an intersection of halfspaces counts as a leaf). */
+    while (is_op(nodes[node].kind) && !is_convex(s, node, c)) {
       if (sp == c->cap_frames && grow_frames(c)) goto oom;
       c->frames[sp].node = node;
       c->frames[sp].na = -1; /* a not done yet */

@@ -74,6 +74,15 @@ typedef struct RayCtx {
      (render.c's tiles) sets it only for rays whose searched intervals
      lie in that region, where both give the same views and roots. */
   const dt_tape *const *tapes;
+  /* Per node of the scene the ctx was made for (conv_scene, conv_n
+     nodes): 1 if its subtree only intersects halfspaces, whose one span
+     ray_spans clips plane by plane (the spans and ids the merges would
+     give) on the stack cstack. NULL: no such node, or no memory. */
+  const Scene *conv_scene;
+  unsigned char *convex;
+  int conv_n;
+  int *cstack;
+  size_t cap_cstack;
 } RayCtx;
 
 /* The finest root tolerance doubles allow at coordinates of size scale

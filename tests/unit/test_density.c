@@ -458,6 +458,7 @@ static int same_code(const dt_tape *a, const dt_tape *b) {
 static void test_prune_class(void) {
   rng_t g = {77};
   int bad_code = 0, bad_value = 0, cut = 0, grouped = 0, segs = 0;
+  int same_said = 0, bad_same = 0;
   for (int sc = 0; sc < 60; sc++) {
     dt_tape *tp;
     if (sc % 2) {
@@ -534,6 +535,25 @@ static void test_prune_class(void) {
         dt_prune_rl(tp, rl1, s0, s1, v1, &a);
         dt_prune_rl(&tile, rl2, s0, s1, v2, &b);
         if (!same_code(&a, &b)) bad_code++;
+        /* dt_prune_rl_same: when it says nothing folds, pruning gives the
+           tape's own code (the whole tape, the cut one with its groups,
+           and a segment's view cut again to a part of its segment) */
+        {
+          double u0 = rng_range(&g, s0, s1), u1 = rng_range(&g, u0, s1);
+          const dt_tape *from[3] = {tp, &tile, &b};
+          const dt_ray_leaf *rls[3] = {rl1, rl2, rl2};
+          for (int f = 0; f < 3; f++) {
+            double x0 = f == 2 ? u0 : s0, x1 = f == 2 ? u1 : s1;
+            dt_instr *w = malloc((size_t)tp->ncode * sizeof *w);
+            dt_tape c;
+            dt_prune_rl(from[f], rls[f], x0, x1, w, &c);
+            if (dt_prune_rl_same(from[f], rls[f], x0, x1)) {
+              same_said++;
+              if (!same_code(&c, from[f])) bad_same++;
+            }
+            free(w);
+          }
+        }
         for (int j = 0; j <= 8; j++) {
           double s = s0 + (s1 - s0) * j / 8, d1, d2;
           double x = dt_density_rl(&a, rl1, s, &d1);
@@ -563,6 +583,12 @@ static void test_prune_class(void) {
         bad_value == 0);
   CHECK("the regions cut leaves, in tapes with and without groups",
         cut > 300 && grouped > 0 && grouped < 60);
+  if (getenv("QCS_TEST_VERBOSE"))
+    printf("# prune_rl_same: %d of %d prunes said to keep the code\n",
+           same_said, 3 * segs);
+  CHECK("dt_prune_rl_same: where it says nothing folds, the pruned code is "
+        "the tape's own, instruction for instruction",
+        bad_same == 0 && same_said > 100);
 }
 
 int main(void) {

@@ -964,6 +964,7 @@ static int squash(lspan *s, int n, long double w) {
 
 static void test_csg(void) {
   rng_t g = {31337};
+  long two_convex = 0;   /* the two-convex fast path */
   long rays = 0, spans = 0, ends = 0, bad = 0, flip_bad = 0, one_convex = 0,
        parallel = 0, squashed = 0, id_ties = 0;
   double max_err = 0, max_ratio = 0;
@@ -986,6 +987,8 @@ static void test_csg(void) {
     csg_tape *tp = csg_builder_finish(b, &err);
     if (!tp) { bad++; note("csg tape %d: %s", sc, csg_strerror(err)); continue; }
     one_convex += tp->nrcode == 1 && tp->rcode[0].op == CSG_CONVEX;
+    two_convex += tp->nrcode == 3 && tp->rcode[0].op == CSG_CONVEX &&
+                  tp->rcode[1].op == CSG_CONVEX;
     int nsc = csg_scratch_spans(tp);
     csg_span *scratch = malloc(sizeof *scratch * (size_t)nsc);
     csg_span out[700];
@@ -1104,6 +1107,11 @@ static void test_csg(void) {
         "starts and away at span ends", flip_bad == 0);
   CHECK("csg: the random tapes include one-convex tapes, parallel planes and "
         "non-empty spans", one_convex > 30 && parallel > 100 && spans > rays / 3);
+  if (getenv("QCS_TEST_VERBOSE"))
+    printf("# csg: %ld tapes of two convex groups and one operation\n",
+           two_convex);
+  CHECK("csg: the random tapes include two convex groups under one operation "
+        "(csg_ray_spans' second fast path)", two_convex > 10);
   if (first_problem) printf("#   first problem: %s\n", first_problem);
   printf("# summary | csg spans | %ld rays over 400 tapes (%ld one convex "
          "group) | %ld spans, %ld ends, %ld id ties, %ld lists squashed | max "
