@@ -257,25 +257,34 @@ static void soft_adaptive(void) {
   scene_free(s);
 }
 
-static void one(const char *name, const char *src, double tol, long euler,
-                long comps, double vol, int check_surface) {
-  char buf[600];
+/* src compiled and meshed at tol, checked to succeed; the scene (its
+   mesh in *m, the report in *rep), or NULL with nothing left to free. */
+static Scene *compile_mesh(const char *name, const char *src, double tol,
+                           Mesh **m, MeshReport *rep) {
+  char buf[600], err[400];
   Scene *s = compile(src);
   CHECK(name, s != NULL);
-  if (!s) return;
+  if (!s) return NULL;
   MeshSettings ms = {0};
   ms.tol = tol;
-  Mesh *m;
-  MeshReport rep;
-  char err[300];
   int bad;
-  int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  int rc = mesh_scene(s, s->root, &ms, m, rep, &bad, err, sizeof err);
   snprintf(buf, sizeof buf, "%s: meshed (%s)", name, rc ? err : "ok");
   CHECK(buf, rc == 0);
   if (rc) {
     scene_free(s);
-    return;
+    return NULL;
   }
+  return s;
+}
+
+static void one(const char *name, const char *src, double tol, long euler,
+                long comps, double vol, int check_surface) {
+  char buf[600];
+  Mesh *m;
+  MeshReport rep;
+  Scene *s = compile_mesh(name, src, tol, &m, &rep);
+  if (!s) return;
   long eu;
   snprintf(buf, sizeof buf, "%s: closed and consistently oriented by edge counting", name);
   CHECK(buf, closed_oriented(m, &eu));
@@ -348,22 +357,10 @@ static int mesh_contains(const Mesh *m, const double p[3]) {
 static void thin(const char *name, const char *src, double tol, double thick,
                  long euler, long comps, const double (*pts)[3], int np) {
   char buf[600];
-  Scene *s = compile(src);
-  CHECK(name, s != NULL);
-  if (!s) return;
-  MeshSettings ms = {0};
-  ms.tol = tol;
   Mesh *m;
   MeshReport rep;
-  char err[400];
-  int bad;
-  int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
-  snprintf(buf, sizeof buf, "%s: meshed (%s)", name, rc ? err : "ok");
-  CHECK(buf, rc == 0);
-  if (rc) {
-    scene_free(s);
-    return;
-  }
+  Scene *s = compile_mesh(name, src, tol, &m, &rep);
+  if (!s) return;
   snprintf(buf, sizeof buf, "%s: the part (%.3g thick) is thinner than the "
            "finest cell (%.3g)", name, thick, rep.h);
   CHECK(buf, thick < rep.h);
