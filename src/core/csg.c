@@ -481,6 +481,35 @@ static int plane_span(const csg_plane *p, int id, const double o[3],
   return 1;
 }
 
+/* One plane of convex_span (base = n.o - d, kd = n.d): its own span
+ * [a, b] within [s0, s1], as plane_span has it, clipping [*t0, *t1].
+ * 0 when the span is found empty (the rest cannot refill it). */
+static inline int clip_plane(double base, double kd, int id, double s0,
+                             double s1, double *t0, double *t1, int *id0,
+                             int *id1) {
+  double a = s0, b = s1;
+  if (kd == 0) return base < 0;
+  double ts = -base / kd;
+  if (kd > 0) {
+    if (ts < s1) b = ts;
+    if (!(a < b)) return 0;
+    if (b < *t1) {
+      *t1 = b;
+      *id1 = id;
+      if (!(*t0 < *t1)) return 0;
+    }
+  } else {
+    if (ts > s0) a = ts;
+    if (!(a < b)) return 0;
+    if (a > *t0) {
+      *t0 = a;
+      *id0 = id;
+      if (!(*t0 < *t1)) return 0;
+    }
+  }
+  return 1;
+}
+
 /* The span (or none) of the intersection of group g's planes: the planes'
  * spans clipped one after another, which is what csg_spans_inter makes of
  * them in any tree shape (the larger start and the smaller end win, the
@@ -492,40 +521,16 @@ static inline int convex_span(const csg_tape *t, const double *dots, int g,
   int id0 = -1, id1 = -1;
   const struct csg_gplane *p = t->gpl + t->gstart[g];
   const struct csg_gplane *end = t->gpl + t->gstart[g + 1];
-  for (; p < end; p++) {
-    int id = p->id;
-    double base, kd;
-    if (dots) {   /* the same values (dot_slot) */
-      base = dots[p->u] - p->d;
-      kd = dots[p->u + 1];
-    } else {
-      base = vec3_dot(p->n, o) - p->d;
-      kd = vec3_dot(p->n, d);
-    }
-    /* The plane's own span [a, b] within [s0, s1], as plane_span has it. */
-    double a = s0, b = s1;
-    if (kd == 0) {
-      if (!(base < 0)) return 0;
-      continue;
-    }
-    double ts = -base / kd;
-    if (kd > 0) {
-      if (ts < s1) b = ts;
-      if (!(a < b)) return 0;
-      if (b < t1) {
-        t1 = b;
-        id1 = id;
-        if (!(t0 < t1)) return 0;   /* empty: the rest cannot refill it */
-      }
-    } else {
-      if (ts > s0) a = ts;
-      if (!(a < b)) return 0;
-      if (a > t0) {
-        t0 = a;
-        id0 = id;
-        if (!(t0 < t1)) return 0;
-      }
-    }
+  if (dots) {   /* the same values (dot_slot) */
+    for (; p < end; p++)
+      if (!clip_plane(dots[p->u] - p->d, dots[p->u + 1], p->id, s0, s1,
+                      &t0, &t1, &id0, &id1))
+        return 0;
+  } else {
+    for (; p < end; p++)
+      if (!clip_plane(vec3_dot(p->n, o) - p->d, vec3_dot(p->n, d), p->id,
+                      s0, s1, &t0, &t1, &id0, &id1))
+        return 0;
   }
   if (!(t0 < t1)) return 0;
   csg_span sp = {t0, t1, id0, id1, 0, 0};
@@ -557,7 +562,7 @@ static inline int ray_spans(const csg_tape *t, const double *dots,
     default: n = csg_spans_diff(&y, ny, &x, nx, m); break;
     }
     if (n > maxout) return -1;
-    memcpy(out, m, (size_t)n * sizeof *out);
+    for (int i = 0; i < n; i++) out[i] = m[i];   /* at most 2: no memcpy */
     return n;
   }
   csg_span local[CSG_LOCAL_SPANS];
