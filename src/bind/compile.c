@@ -495,7 +495,8 @@ static int compile_rounded(Compile *C, Value *tree, double r, Pos pos) {
   nd->outer = bnd_outer(t, 0.5, &fo);
   nd->inner = bnd_inner(t, 0.5, &fi);
   nd->bound_flags = fo | fi;
-  if (!nd->outer || !nd->inner) {
+  if (!nd->outer || !nd->inner ||
+      csg_tape_share_dirs(nd->inner, nd->outer) != CSG_OK) {
     dt_tape_free(t);
     if (nd->outer) csg_tape_free(nd->outer);
     if (nd->inner) csg_tape_free(nd->inner);

@@ -38,6 +38,7 @@ void csg_tape_free(csg_tape *t) {
   free(t->gstart);
   free(t->gplane);
   free(t->gpl);
+  free(t->dir);
   free(t);
 }
 
@@ -173,6 +174,88 @@ static int reorder(const csg_instr *in, int n, csg_instr *out, int *depth) {
                       depth) == TAPE_OK ? CSG_OK : CSG_ENOMEM;
 }
 
+/* The index of n in dir[0 .. nd), bit for bit (same = 1), or equal
+ * component by component (same = 0, zeros of either sign alike), or -1. */
+static int find_dir(double (*dir)[3], int nd, const double n[3], int same) {
+  for (int j = 0; j < nd; j++)
+    if (same ? memcmp(dir[j], n, sizeof dir[j]) == 0
+             : dir[j][0] == n[0] && dir[j][1] == n[1] && dir[j][2] == n[2])
+      return j;
+  return -1;
+}
+
+/* The place in csg_ray_dots' table of gpl plane p's dot products, the
+ * directions dir[0 .. *nd) (appended to if need be, up to CSG_DIRS_MAX;
+ * -1 past it).  A normal equal to a direction or its negation component
+ * by component gives the same dot products but for the sign of a zero
+ * (its nonzero products are the same and adding a zero to a nonzero sum
+ * is exact; round to nearest is symmetric): a zero n.d is only tested
+ * against 0, and a zero n.o only shows in n.o - p.d when p.d is 0, so
+ * such a plane takes the direction's unless its offset is 0. */
+static int dot_slot(double (*dir)[3], int *nd, const struct csg_gplane *p) {
+  double m[3] = {-p->n[0], -p->n[1], -p->n[2]};
+  int j = find_dir(dir, *nd, p->n, 1);
+  if (j >= 0) return 4 * j;
+  if (p->d != 0) {
+    if ((j = find_dir(dir, *nd, p->n, 0)) >= 0) return 4 * j;
+    if ((j = find_dir(dir, *nd, m, 0)) >= 0) return 4 * j + 2;
+  }
+  if (*nd == CSG_DIRS_MAX) return -1;
+  memcpy(dir[*nd], p->n, sizeof dir[*nd]);
+  return 4 * (*nd)++;
+}
+
+/* t's direction table (csg.h): base's directions first (base may be
+ * NULL), then those t's groups add.  Past CSG_DIRS_MAX: t keeps its
+ * table as it was if base is given, else has none. */
+static int dir_table(csg_tape *t, const csg_tape *base) {
+  int np = t->gstart[t->ngroups], nb = base ? base->ndirs : 0;
+  double (*dir)[3] = malloc((CSG_DIRS_MAX + 1) * sizeof *dir);
+  int *u = malloc(((size_t)np + 1) * sizeof *u);
+  if (!dir || !u) {
+    free(dir);
+    free(u);
+    return CSG_ENOMEM;
+  }
+  if (nb > 0) memcpy(dir, base->dir, (size_t)nb * sizeof *dir);
+  int nd = nb, k = 0;
+  for (; k < np; k++)
+    if ((u[k] = dot_slot(dir, &nd, &t->gpl[k])) < 0) break;
+  if (k < np) {
+    free(dir);
+    free(u);
+    return CSG_OK;   /* base given: t as it was; else no table */
+  }
+  for (k = 0; k < np; k++) t->gpl[k].u = u[k];
+  free(u);
+  free(t->dir);
+  t->dir = dir;
+  t->ndirs = nd;
+  t->dirs_of = base;
+  return CSG_OK;
+}
+
+int csg_tape_share_dirs(csg_tape *t, const csg_tape *base) {
+  if (!t->dir || !base->dir) return CSG_OK;
+  return dir_table(t, base);
+}
+
+void csg_ray_dots(const csg_tape *t, const double o[3], const double d[3],
+                  double *dots) {
+  const double (*dir)[3] = (const double (*)[3])t->dir;
+  const double o0 = o[0], o1 = o[1], o2 = o[2];
+  const double d0 = d[0], d1 = d[1], d2 = d[2];
+  for (int u = 0, n = t->ndirs; u < n; u++) {
+    const double *v = dir[u];   /* vec3_dot's sums, in its order */
+    double a = v[0] * o0 + v[1] * o1 + v[2] * o2;
+    double b = v[0] * d0 + v[1] * d1 + v[2] * d2;
+    dots[4 * u] = a;
+    dots[4 * u + 1] = b;
+    dots[4 * u + 2] = -a;
+    dots[4 * u + 3] = -b;
+  }
+}
+
 /* The ray program of t (csg.h): maximal subtrees of intersected planes
  * (more than one plane) become CSG_CONVEX groups.  A subtree is the
  * contiguous stretch of postfix code that ends at its root, so a group's
@@ -236,7 +319,7 @@ static int ray_program(csg_tape *t) {
     t->gpl[k].d = p->d;
     t->gpl[k].id = t->gplane[k];
   }
-  return CSG_OK;
+  return dir_table(t, NULL);
 }
 
 csg_tape *csg_builder_finish(csg_builder *b, int *err) {
@@ -398,45 +481,56 @@ static int plane_span(const csg_plane *p, int id, const double o[3],
   return 1;
 }
 
+/* One plane of convex_span (base = n.o - d, kd = n.d): its own span
+ * [a, b] within [s0, s1], as plane_span has it, clipping [*t0, *t1].
+ * 0 when the span is found empty (the rest cannot refill it). */
+static inline int clip_plane(double base, double kd, int id, double s0,
+                             double s1, double *t0, double *t1, int *id0,
+                             int *id1) {
+  double a = s0, b = s1;
+  if (kd == 0) return base < 0;
+  double ts = -base / kd;
+  if (kd > 0) {
+    if (ts < s1) b = ts;
+    if (!(a < b)) return 0;
+    if (b < *t1) {
+      *t1 = b;
+      *id1 = id;
+      if (!(*t0 < *t1)) return 0;
+    }
+  } else {
+    if (ts > s0) a = ts;
+    if (!(a < b)) return 0;
+    if (a > *t0) {
+      *t0 = a;
+      *id0 = id;
+      if (!(*t0 < *t1)) return 0;
+    }
+  }
+  return 1;
+}
+
 /* The span (or none) of the intersection of group g's planes: the planes'
  * spans clipped one after another, which is what csg_spans_inter makes of
  * them in any tree shape (the larger start and the smaller end win, the
  * earlier operand on ties), without the merges. */
-static int convex_span(const csg_tape *t, int g, const double o[3],
-                       const double d[3], double s0, double s1,
-                       csg_span *out) {
+static inline int convex_span(const csg_tape *t, const double *dots, int g,
+                              const double o[3], const double d[3],
+                              double s0, double s1, csg_span *out) {
   double t0 = s0, t1 = s1;
   int id0 = -1, id1 = -1;
   const struct csg_gplane *p = t->gpl + t->gstart[g];
   const struct csg_gplane *end = t->gpl + t->gstart[g + 1];
-  for (; p < end; p++) {
-    int id = p->id;
-    double base = vec3_dot(p->n, o) - p->d;
-    double kd = vec3_dot(p->n, d);
-    /* The plane's own span [a, b] within [s0, s1], as plane_span has it. */
-    double a = s0, b = s1;
-    if (kd == 0) {
-      if (!(base < 0)) return 0;
-      continue;
-    }
-    double ts = -base / kd;
-    if (kd > 0) {
-      if (ts < s1) b = ts;
-      if (!(a < b)) return 0;
-      if (b < t1) {
-        t1 = b;
-        id1 = id;
-        if (!(t0 < t1)) return 0;   /* empty: the rest cannot refill it */
-      }
-    } else {
-      if (ts > s0) a = ts;
-      if (!(a < b)) return 0;
-      if (a > t0) {
-        t0 = a;
-        id0 = id;
-        if (!(t0 < t1)) return 0;
-      }
-    }
+  if (dots) {   /* the same values (dot_slot) */
+    for (; p < end; p++)
+      if (!clip_plane(dots[p->u] - p->d, dots[p->u + 1], p->id, s0, s1,
+                      &t0, &t1, &id0, &id1))
+        return 0;
+  } else {
+    for (; p < end; p++)
+      if (!clip_plane(vec3_dot(p->n, o) - p->d, vec3_dot(p->n, d), p->id,
+                      s0, s1, &t0, &t1, &id0, &id1))
+        return 0;
   }
   if (!(t0 < t1)) return 0;
   csg_span sp = {t0, t1, id0, id1, 0, 0};
@@ -445,20 +539,22 @@ static int convex_span(const csg_tape *t, int g, const double o[3],
 }
 
 /* Roth's ray casting: one span per halfspace, combined bottom-up with the
- * span-list set operations. */
-int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
-                  double s0, double s1, csg_span *out, int maxout,
-                  csg_span *scratch, int nscratch) {
+ * span-list set operations; dots as csg_ray_spans_dots has them, or
+ * NULL. */
+static inline int ray_spans(const csg_tape *t, const double *dots,
+                            const double o[3], const double d[3], double s0,
+                            double s1, csg_span *out, int maxout,
+                            csg_span *scratch, int nscratch) {
   /* One convex polyhedron (a typical bound): straight to out. */
   if (t->nrcode == 1 && t->rcode[0].op == CSG_CONVEX && maxout >= 1)
-    return convex_span(t, t->rcode[0].arg, o, d, s0, s1, out);
+    return convex_span(t, dots, t->rcode[0].arg, o, d, s0, s1, out);
   /* Two convex polyhedra and one operation (a bound with a hole): the
      same spans and merge as the loop below, without its scratch lists. */
   if (t->nrcode == 3 && t->rcode[0].op == CSG_CONVEX &&
       t->rcode[1].op == CSG_CONVEX) {
     csg_span x, y, m[2];
-    int nx = convex_span(t, t->rcode[0].arg, o, d, s0, s1, &x);
-    int ny = convex_span(t, t->rcode[1].arg, o, d, s0, s1, &y), n;
+    int nx = convex_span(t, dots, t->rcode[0].arg, o, d, s0, s1, &x);
+    int ny = convex_span(t, dots, t->rcode[1].arg, o, d, s0, s1, &y), n;
     switch (t->rcode[2].op) {
     case CSG_UNION: n = csg_spans_union(&x, nx, &y, ny, m); break;
     case CSG_INTER: n = csg_spans_inter(&x, nx, &y, ny, m); break;
@@ -466,7 +562,7 @@ int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
     default: n = csg_spans_diff(&y, ny, &x, nx, m); break;
     }
     if (n > maxout) return -1;
-    memcpy(out, m, (size_t)n * sizeof *out);
+    for (int i = 0; i < n; i++) out[i] = m[i];   /* at most 2: no memcpy */
     return n;
   }
   csg_span local[CSG_LOCAL_SPANS];
@@ -485,7 +581,7 @@ int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
     if (in->op <= CSG_ALL || in->op == CSG_CONVEX) {
       int c = 0;
       if (in->op == CSG_CONVEX)
-        c = convex_span(t, in->arg, o, d, s0, s1, &scratch[top]);
+        c = convex_span(t, dots, in->arg, o, d, s0, s1, &scratch[top]);
       else if (in->op == CSG_PLANE)
         c = plane_span(&t->planes[in->arg], in->arg, o, d, s0, s1,
                        &scratch[top]);
@@ -515,6 +611,19 @@ int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
   if (cnt[0] > maxout) return -1;
   memcpy(out, scratch, (size_t)cnt[0] * sizeof *out);
   return cnt[0];
+}
+
+int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
+                  double s0, double s1, csg_span *out, int maxout,
+                  csg_span *scratch, int nscratch) {
+  return ray_spans(t, NULL, o, d, s0, s1, out, maxout, scratch, nscratch);
+}
+
+int csg_ray_spans_dots(const csg_tape *t, const double *dots,
+                       const double o[3], const double d[3], double s0,
+                       double s1, csg_span *out, int maxout,
+                       csg_span *scratch, int nscratch) {
+  return ray_spans(t, dots, o, d, s0, s1, out, maxout, scratch, nscratch);
 }
 
 /* The three-valued set operations of csg_box_class. */

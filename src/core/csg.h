@@ -18,6 +18,7 @@
 
 #define CSG_STACK_MAX 64
 #define CSG_LOCAL_SPANS 256   /* internal scratch when the caller gives none */
+#define CSG_DIRS_MAX 64       /* directions a tape's dot table may hold */
 
 typedef enum {
   CSG_PLANE,   /* planes[arg] */
@@ -52,7 +53,18 @@ typedef struct csg_tape {
   csg_instr *rcode;
   int ngroups;
   int *gstart, *gplane;
-  struct csg_gplane { double n[3], d; int id; } *gpl;
+  struct csg_gplane { double n[3], d; int id, u; } *gpl;
+  /* The groups' plane normals, for dot products a ray computes once per
+   * direction (csg_ray_dots): dir[0 .. ndirs) directions, gpl[k].u the
+   * place of gpl[k]'s dot products in csg_ray_dots' table (those of a
+   * direction, or of its negation, that give the plane's values: see
+   * dot_slot in csg.c).  dir is NULL when the groups need more than
+   * CSG_DIRS_MAX directions (no table).  A tape linked to another by
+   * csg_tape_share_dirs starts its table with the other's (dirs_of is
+   * that tape): one csg_ray_dots serves both. */
+  int ndirs;
+  double (*dir)[3];
+  const struct csg_tape *dirs_of;
 } csg_tape;
 
 /* One inside interval of a ray, t0 < t1.  id0/id1 name the plane whose
@@ -106,6 +118,27 @@ int csg_scratch_spans(const csg_tape *t);
 int csg_ray_spans(const csg_tape *t, const double o[3], const double d[3],
                   double s0, double s1, csg_span *out, int maxout,
                   csg_span *scratch, int nscratch);
+
+/* Make t's direction table begin with base's (t->dirs_of = base), so
+ * that csg_ray_dots(t, ...) serves ray queries on both (an inner bound
+ * and its outer bound share their planes' normals).  Without effect
+ * (dirs_of stays NULL) if either has no table or the union would exceed
+ * CSG_DIRS_MAX.  Returns CSG_OK or CSG_ENOMEM (t unchanged). */
+int csg_tape_share_dirs(csg_tape *t, const csg_tape *base);
+
+/* The dot products of t's directions with o and d: dots[4u] = dir[u].o,
+ * dots[4u + 1] = dir[u].d (as vec3_dot has them), dots[4u + 2] and
+ * dots[4u + 3] their negations.  t->dir must not be NULL; dots holds
+ * 4 * t->ndirs. */
+void csg_ray_dots(const csg_tape *t, const double o[3], const double d[3],
+                  double *dots);
+
+/* csg_ray_spans with the dot products of csg_ray_dots(x, o, d, dots)
+ * where x is t or t->dirs_of: the same spans, bit for bit. */
+int csg_ray_spans_dots(const csg_tape *t, const double *dots,
+                       const double o[3], const double d[3], double s0,
+                       double s1, csg_span *out, int maxout,
+                       csg_span *scratch, int nscratch);
 
 /* Span-list set operations (Roth).  Inputs sorted and disjoint; out must
  * hold na + nb spans.  Return the output count. */

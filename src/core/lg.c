@@ -642,11 +642,23 @@ int lg_search_bounded(const lg_query *q, const csg_tape *outer,
     if (!mem) return -1;
   }
   csg_span *os = mem, *is = os + no, *ds = is + ni, *sc = ds + no + ni;
-  int n = csg_ray_spans(outer, o, d, t0, t1, os, no, sc, nsc), r = -1;
+  /* An inner bound linked to its outer bound (csg_tape_share_dirs): the
+     dot products of their planes' common normals once. */
+  double dbuf[4 * CSG_DIRS_MAX];
+  const double *dots = NULL;
+  if (inner && inner->dirs_of == outer) {
+    csg_ray_dots(inner, o, d, dbuf);
+    dots = dbuf;
+  }
+  int n = dots ? csg_ray_spans_dots(outer, dots, o, d, t0, t1, os, no, sc, nsc)
+               : csg_ray_spans(outer, o, d, t0, t1, os, no, sc, nsc);
+  int r = -1;
   if (n == 0) {   /* the ray misses the outer bound: no crossing */
     r = 0;
   } else if (n > 0) {
-    int m = inner ? csg_ray_spans(inner, o, d, t0, t1, is, ni, sc, nsc) : 0;
+    int m = !inner ? 0
+          : dots ? csg_ray_spans_dots(inner, dots, o, d, t0, t1, is, ni, sc, nsc)
+                 : csg_ray_spans(inner, o, d, t0, t1, is, ni, sc, nsc);
     if (m >= 0) {
       /* A crossing on a surface the two bounds share (a lone halfspace,
        * whose 0.5 isosurface is its plane; a sharp leaf's plane) lies on

@@ -17,6 +17,10 @@
  *  3. csg_ray_spans (convex groups, the one-convex fast path) against
  *     spans made by long double clipping: every plane crossing sorted,
  *     each elementary interval classified at its midpoint by the tree.
+ *  3b. csg_ray_spans_dots (dot products shared by a tape's and a linked
+ *     tape's planes of equal or opposite normals, csg_tape_share_dirs)
+ *     against csg_ray_spans, bit for bit, on normals with zeros of either
+ *     sign, offsets of 0 and rays whose dot products are zeros.
  *  4. render_scene's Z and N planes on figure12's objects against
  *     ray_spans along the same pixel rays (the camera re-derived in long
  *     double) and against PointInObject sign checks.
@@ -1315,6 +1319,113 @@ static void test_render(void) {
   scene_free(s);
 }
 
+/* ==== shared dot products (csg_ray_dots) ============================== */
+
+/* A normal from a small pool: an axis or its negation, written with zeros
+   of either sign, or one of a few fixed oblique directions. */
+static void pool_normal(rng_t *g, double n[3]) {
+  static const double ob[3][3] = {{0.6, 0.8, 0}, {1, 1, 1}, {-0.3, 0.2, 0.9}};
+  int k = (int)(rng_u64(g) % 9);
+  double sg = rng_unit(g) < 0.5 ? -1 : 1;
+  if (k < 6) {
+    for (int i = 0; i < 3; i++) n[i] = rng_unit(g) < 0.5 ? -0.0 : 0.0;
+    n[k % 3] = sg;
+  } else {
+    for (int i = 0; i < 3; i++) n[i] = sg * ob[k - 6][i];
+  }
+}
+
+/* A random tree over planes of pool normals: two or three convex groups
+   (intersections of 3 to 6 planes) joined by random operations. */
+static csg_tape *pool_tape(rng_t *g) {
+  csg_builder *b = csg_builder_new();
+  int ng = 2 + (int)(rng_u64(g) % 2);
+  for (int k = 0; k < ng; k++) {
+    int np = 3 + (int)(rng_u64(g) % 4);
+    for (int j = 0; j < np; j++) {
+      double n[3];
+      pool_normal(g, n);
+      double d = rng_unit(g) < 0.4 ? 0 : (double)(int)rng_range(g, -3, 4) / 2;
+      csg_builder_plane(b, n, d);
+      if (j > 0) csg_builder_op(b, CSG_INTER);
+    }
+    if (k > 0) {
+      static const csg_op ops[3] = {CSG_UNION, CSG_INTER, CSG_DIFF};
+      csg_builder_op(b, ops[rng_u64(g) % 3]);
+    }
+  }
+  int err;
+  return csg_builder_finish(b, &err);
+}
+
+/* Spans equal bit for bit (t as stored: the sign of a zero counts). */
+static int spans_same(const csg_span *a, const csg_span *b, int n) {
+  for (int i = 0; i < n; i++)
+    if (memcmp(&a[i].t0, &b[i].t0, sizeof a[i].t0) ||
+        memcmp(&a[i].t1, &b[i].t1, sizeof a[i].t1) || a[i].id0 != b[i].id0 ||
+        a[i].id1 != b[i].id1 || a[i].flip0 != b[i].flip0 ||
+        a[i].flip1 != b[i].flip1)
+      return 0;
+  return 1;
+}
+
+static void test_csg_dots(void) {
+  rng_t g = {4242};
+  int bad = 0, linked = 0, shared = 0, zeros = 0, pairs = 0;
+  long rays = 0;
+  for (int sc = 0; sc < 200; sc++) {
+    csg_tape *a = pool_tape(&g), *b = pool_tape(&g);
+    if (!a || !b || csg_tape_share_dirs(b, a) != CSG_OK) {
+      bad++;
+      note("dots tapes %d: not built", sc);
+      csg_tape_free(a);
+      csg_tape_free(b);
+      continue;
+    }
+    pairs++;
+    linked += b->dirs_of == a;
+    shared += b->ndirs < a->gstart[a->ngroups] + b->gstart[b->ngroups];
+    double dots[4 * CSG_DIRS_MAX];
+    for (int k = 0; k < 200 && b->dirs_of == a; k++) {
+      double o[3], d[3];
+      for (int i = 0; i < 3; i++) {
+        double u = rng_unit(&g);
+        o[i] = u < 0.2 ? 0.0 : u < 0.3 ? -0.0 : u < 0.5
+             ? (double)(int)rng_range(&g, -3, 4) / 2 : rng_range(&g, -3, 3);
+        u = rng_unit(&g);
+        d[i] = u < 0.3 ? (u < 0.15 ? 0.0 : -0.0) : rng_range(&g, -1, 1);
+      }
+      if (d[0] == 0 && d[1] == 0 && d[2] == 0) d[rng_u64(&g) % 3] = 1;
+      double s0 = rng_unit(&g) < 0.5 ? -INFINITY : rng_range(&g, -2, 0);
+      double s1 = rng_unit(&g) < 0.5 ? INFINITY : rng_range(&g, 0, 4);
+      csg_ray_dots(b, o, d, dots);
+      for (int u = 0; u < b->ndirs; u++) zeros += dots[4 * u] == 0;
+      for (int w = 0; w < 2; w++) {
+        const csg_tape *t = w ? b : a;
+        csg_span x[64], y[64];
+        int nx = csg_ray_spans(t, o, d, s0, s1, x, 64, NULL, 0);
+        int ny = csg_ray_spans_dots(t, dots, o, d, s0, s1, y, 64, NULL, 0);
+        rays++;
+        if (nx != ny || (nx > 0 && !spans_same(x, y, nx))) {
+          if (!bad || getenv("FASTPATHS_VERBOSE"))
+            note("dots tapes %d ray %d tape %d: %d spans, %d with shared "
+                 "dots", sc, k, w, nx, ny);
+          bad++;
+        }
+      }
+    }
+    csg_tape_free(a);
+    csg_tape_free(b);
+  }
+  printf("# dots: %d tape pairs, %d linked, %d sharing, %ld span queries, "
+         "%d zero dot products\n", pairs, linked, shared, rays, zeros);
+  CHECK("csg_ray_spans_dots = csg_ray_spans bit for bit (shared and "
+        "negated normals, zeros of either sign, offsets 0)", bad == 0);
+  CHECK("dots: the pairs are linked and share directions, with zero dot "
+        "products among the rays", linked == pairs && shared > pairs / 2 &&
+        zeros > 1000);
+}
+
 int main(void) {
   char base;
   stab_init("fastpaths", &base);
@@ -1322,6 +1433,7 @@ int main(void) {
   test_first();
   test_prune();
   test_csg();
+  test_csg_dots();
   test_render();
   CHECK_DONE();
 }
