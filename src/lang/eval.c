@@ -322,15 +322,20 @@ static int known_bind(Interp *I, Pat *p, Expr *a, Env *env, Sym **names,
 
 typedef enum { KNOWN_NUM, KNOWN_BOOL, KNOWN_VEC } KnownWant;
 
+/* Whether known_call can look into d applied to n arguments at all: one
+   clause taking exactly those, no pattern binding, guard or where. */
+static inline int known_call_may(const Def *d, int n) {
+  if (d->arity != n || d->nclauses != 1 || d->pat || n > 4) return 0;
+  const Clause *c = d->clauses[0];
+  return c->nbodies == 1 && !c->guards[0] && !c->nwhere;
+}
+
 static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out,
                       int *bout, KnownWant want) {
   Def *d = f->u.fn.u.def;
   int n = e->u.app.n;
-  if (d->arity != n || d->nclauses != 1 || d->pat || n > 4 ||
-      known_calls >= KNOWN_CALL_DEPTH)
-    return 0;
+  if (!known_call_may(d, n) || known_calls >= KNOWN_CALL_DEPTH) return 0;
   Clause *c = d->clauses[0];
-  if (c->nbodies != 1 || c->guards[0] || c->nwhere) return 0;
   /* a tuple is not a Real nor a Bool: known before binding anything */
   if (want != KNOWN_VEC && c->bodies[0]->kind == E_TUPLE) return 0;
   Sym *names[KNOWN_BIND_MAX];
@@ -352,6 +357,27 @@ static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out,
   return ok;
 }
 
+/* known_num of e, an E_APP of f, a function value that is not a
+   defined one: a built-in defined on every Real (floor x, min a b) given
+   known Reals. */
+static int known_builtin_num(Interp *I, Expr *e, Env *env, Value *f,
+                             double *out) {
+  if (e->u.app.n > 2 || f->u.fn.kind != F_BUILTIN || f->u.fn.arity != e->u.app.n)
+    return 0;
+  if (e->u.app.n == 2 && builtin_is_vec_num(f->u.fn.u.bi)) {
+    /* dot n v of tuples of Reals known: what the built-in would give */
+    double a[VEC_BLOCK_MAX], b[VEC_BLOCK_MAX];
+    int na = known_vec(I, e->u.app.args[0], env, a);
+    if (!na) return 0;
+    int nb = known_vec(I, e->u.app.args[1], env, b);
+    return nb && builtin_vec_num(f->u.fn.u.bi, a, na, b, nb, out);
+  }
+  double x[2];
+  for (int i = 0; i < e->u.app.n; i++)
+    if (!known_num(I, e->u.app.args[i], env, &x[i])) return 0;
+  return builtin_num(f->u.fn.u.bi, e->u.app.n, x, out);
+}
+
 static int known_num(Interp *I, Expr *e, Env *env, double *out) {
   char probe; /* a chain of a million '+' is left to eval, which checks */
   if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
@@ -369,15 +395,10 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
                    (\x -> x * 3) y: see known_call */
     if (e->u.app.fn->kind != E_VAR) return 0;
     Value *f = known_var(e->u.app.fn, env);
-    if (f && f->kind == V_FUNC && f->u.fn.kind == F_DEF)
+    if (!f || f->kind != V_FUNC) return 0;
+    if (f->u.fn.kind == F_DEF)
       return known_call(I, e, env, f, out, NULL, KNOWN_NUM);
-    if (e->u.app.n > 2 || !f || f->kind != V_FUNC || f->u.fn.kind != F_BUILTIN ||
-        f->u.fn.arity != e->u.app.n)
-      return 0;
-    double x[2];
-    for (int i = 0; i < e->u.app.n; i++)
-      if (!known_num(I, e->u.app.args[i], env, &x[i])) return 0;
-    return builtin_num(f->u.fn.u.bi, e->u.app.n, x, out);
+    return known_builtin_num(I, e, env, f, out);
   }
   case E_NEG:
     if (!known_num(I, e->u.neg, env, out)) return 0;
@@ -547,10 +568,27 @@ static __attribute__((noinline)) Value *delay_slow(Interp *I, Expr *e,
     if ((n = known_vec(I, e, env, t)) > 0) return vec_block(n, t);
     break;
   case E_APP: {
-    if (known_num(I, e, env, &x)) return val_num(x);
-    Value *c = known_con(I, e, env);
-    if (c) return c;
-    if ((n = known_vec(I, e, env, t)) > 0) return vec_block(n, t);
+    /* what known_num, known_con and known_vec would each try, with the
+       function looked up once: most arguments that are calls (Shift v a,
+       Union (...) (...)) name a function of several clauses or a
+       constructor, and fail at the first look */
+    Expr *fe = e->u.app.fn;
+    if (fe->kind != E_VAR) break;
+    Value *f = known_var(fe, env);
+    if (!f) { /* a constructor (or a name not defined) */
+      Value *c = known_con(I, e, env);
+      if (c) return c;
+      break;
+    }
+    if (f->kind != V_FUNC) break;
+    if (f->u.fn.kind == F_DEF) {
+      if (!known_call_may(f->u.fn.u.def, e->u.app.n)) break;
+      if (known_call(I, e, env, f, &x, NULL, KNOWN_NUM)) return val_num(x);
+      if ((n = known_call(I, e, env, f, t, NULL, KNOWN_VEC)) > 0)
+        return vec_block(n, t);
+    } else if (known_builtin_num(I, e, env, f, &x)) {
+      return val_num(x);
+    }
     break;
   }
   default:
