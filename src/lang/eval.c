@@ -357,6 +357,35 @@ static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out,
   return ok;
 }
 
+/* known_num (known_vec) with a literal or a name (most operands) looked
+   at here, without the call and its stack check. */
+static inline int known_num_at(Interp *I, Expr *e, Env *env, double *out) {
+  if (e->kind == E_NUM) {
+    *out = e->u.num;
+    return 1;
+  }
+  if (e->kind == E_VAR) {
+    Value *v = known_var(e, env);
+    if (!v || v->kind != V_NUM) return 0;
+    *out = v->u.num;
+    return 1;
+  }
+  return known_num(I, e, env, out);
+}
+static inline int known_vec_at(Interp *I, Expr *e, Env *env, double *out) {
+  if (e->kind == E_VAR) {
+    Value *v = known_var(e, env);
+    if (!v || v->kind != V_TUPLE || v->u.tup.n > VEC_BLOCK_MAX) return 0;
+    for (int i = 0; i < v->u.tup.n; i++) {
+      Value *x = v->u.tup.items[i];
+      if (x->kind != V_NUM) return 0;
+      out[i] = x->u.num;
+    }
+    return v->u.tup.n;
+  }
+  return known_vec(I, e, env, out);
+}
+
 /* known_num of e, an E_APP of f, a function value that is not a
    defined one: a built-in defined on every Real (floor x, min a b) given
    known Reals. */
@@ -367,9 +396,9 @@ static int known_builtin_num(Interp *I, Expr *e, Env *env, Value *f,
   if (e->u.app.n == 2 && builtin_is_vec_num(f->u.fn.u.bi)) {
     /* dot n v of tuples of Reals known: what the built-in would give */
     double a[VEC_BLOCK_MAX], b[VEC_BLOCK_MAX];
-    int na = known_vec(I, e->u.app.args[0], env, a);
+    int na = known_vec_at(I, e->u.app.args[0], env, a);
     if (!na) return 0;
-    int nb = known_vec(I, e->u.app.args[1], env, b);
+    int nb = known_vec_at(I, e->u.app.args[1], env, b);
     return nb && builtin_vec_num(f->u.fn.u.bi, a, na, b, nb, out);
   }
   double x[2];
@@ -410,7 +439,8 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
     if (op != T_PLUS && op != T_MINUS && op != T_STAR && op != T_SLASH &&
         op != T_CARET)
       return 0;
-    if (!known_num(I, e->u.bin.a, env, &a) || !known_num(I, e->u.bin.b, env, &b))
+    if (!known_num_at(I, e->u.bin.a, env, &a) ||
+        !known_num_at(I, e->u.bin.b, env, &b))
       return 0;
     *out = op == T_PLUS ? a + b : op == T_MINUS ? a - b : op == T_STAR ? a * b
          : op == T_SLASH ? a / b : pow(a, b);
@@ -486,7 +516,7 @@ static int known_vec(Interp *I, Expr *e, Env *env, double *out) {
     int n = e->u.tuple.n;
     if (n > VEC_BLOCK_MAX) return 0;
     for (int i = 0; i < n; i++)
-      if (!known_num(I, e->u.tuple.items[i], env, &out[i])) return 0;
+      if (!known_num_at(I, e->u.tuple.items[i], env, &out[i])) return 0;
     return n;
   }
   case E_NEG: { /* as eval's: (-1) * t */
@@ -1794,12 +1824,40 @@ Value *eval(Interp *I, Expr *e, Env *env) {
     case E_WILD:
       qcs_error(e->pos, "'_' stands only in patterns");
     case E_APP: {
+      Expr *fe = e->u.app.fn;
+      int n = e->u.app.n;
+      if (fe->kind == E_VAR && fe->u.vslot == RES_GLOBAL && n > 0 &&
+          fe->u.var->con_arity == n) {
+        /* a constructor given all its arguments (Union (Shift v a) ...):
+           what call() makes of it, with the value and its arguments in
+           one block as known_con makes them, and no look-up or call */
+        Value *v = val_small(sizeof(Value) + sizeof(Value *) * (size_t)n);
+        Value **cargs = (Value **)(v + 1);
+        v->kind = V_CON;
+        v->u.con.con = fe->u.var;
+        v->u.con.n = n;
+        v->u.con.args = cargs;
+        v->u.con.pos = NULL;
+        for (int i = 0; i < n; i++) cargs[i] = delay(I, e->u.app.args[i], env);
+        if (e->pos.src) { /* as call() sets it */
+          if (!e->pos.src->prelude) {
+            v->u.con.pos = &e->pos;
+          } else if (I->origin) {
+            v->u.con.pos = I->origin;
+          } else {
+            Pos *p = val_small(sizeof *p);
+            *p = eval_user_pos(I, e->pos);
+            v->u.con.pos = p;
+          }
+        }
+        result = v;
+        goto done;
+      }
       /* a named function (the common case) without a nested eval: what
          eval's E_VAR does, less its step check, made here for the call */
       Value *f = e->u.app.fn->kind == E_VAR
                      ? force(I, lookup(I, e->u.app.fn, env))
                      : eval(I, e->u.app.fn, env);
-      int n = e->u.app.n;
       Value **args = val_small(sizeof(Value *) * (size_t)n);
       for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
       /* A built-in that walks a list (sum, length, foldl) runs long in
