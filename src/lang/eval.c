@@ -612,9 +612,14 @@ static __attribute__((noinline)) Value *delay_slow(Interp *I, Expr *e,
     }
     if (f->kind != V_FUNC) break;
     if (f->u.fn.kind == F_DEF) {
-      if (!known_call_may(f->u.fn.u.def, e->u.app.n)) break;
-      if (known_call(I, e, env, f, &x, NULL, KNOWN_NUM)) return val_num(x);
-      if ((n = known_call(I, e, env, f, t, NULL, KNOWN_VEC)) > 0)
+      Def *d = f->u.fn.u.def;
+      if (!known_call_may(d, e->u.app.n)) break;
+      /* a body that is a tuple (ShiftPlane's) is no Real, and a literal
+         no tuple: the look that cannot succeed is not taken */
+      ExprKind bk = d->clauses[0]->bodies[0]->kind;
+      if (bk != E_TUPLE && known_call(I, e, env, f, &x, NULL, KNOWN_NUM))
+        return val_num(x);
+      if (bk != E_NUM && (n = known_call(I, e, env, f, t, NULL, KNOWN_VEC)) > 0)
         return vec_block(n, t);
     } else if (known_builtin_num(I, e, env, f, &x)) {
       return val_num(x);
@@ -1800,6 +1805,55 @@ static Value *range(Interp *I, Expr *e, Env *env) {
 
 /* ---- the evaluator ---- */
 
+/* eval of e, an E_APP of a constructor (a global, resolved so) to all its
+   arguments (the prelude's Union (Shift v a) (Shift v b)): what call()
+   makes of it, with the value and its arguments in one block as known_con
+   makes them, and no look-up or call() round. Out of line, to keep eval's
+   own frame as it was for the other cases. */
+static __attribute__((noinline)) Value *eval_con(Interp *I, Expr *e,
+                                                 Env *env) {
+  Expr *fe = e->u.app.fn;
+  int n = e->u.app.n;
+  Value *v = val_small(sizeof(Value) + sizeof(Value *) * (size_t)n);
+  Value **cargs = (Value **)(v + 1);
+  v->kind = V_CON;
+  v->u.con.con = fe->u.var;
+  v->u.con.n = n;
+  v->u.con.args = cargs;
+  v->u.con.pos = NULL;
+  for (int i = 0; i < n; i++) cargs[i] = delay(I, e->u.app.args[i], env);
+  if (e->pos.src) { /* as call() sets it */
+    if (!e->pos.src->prelude) {
+      v->u.con.pos = &e->pos;
+    } else if (I->origin) {
+      v->u.con.pos = I->origin;
+    } else {
+      Pos *p = val_small(sizeof *p);
+      *p = eval_user_pos(I, e->pos);
+      v->u.con.pos = p;
+    }
+  }
+  return v;
+}
+
+/* eval of e, an E_TUPLE: a block of Reals if they are known, else the
+   tuple and its items' array in one block (one allocation, one object for
+   the collector), the items delayed. */
+static __attribute__((noinline)) Value *eval_tuple(Interp *I, Expr *e,
+                                                   Env *env) {
+  double t[VEC_BLOCK_MAX];
+  int n = known_vec(I, e, env, t);
+  if (n > 0) return vec_block(n, t);
+  n = e->u.tuple.n;
+  Value *v = val_small(sizeof(Value) + sizeof(Value *) * (size_t)n);
+  Value **items = (Value **)(v + 1);
+  v->kind = V_TUPLE;
+  v->u.tup.n = n;
+  v->u.tup.items = items;
+  for (int i = 0; i < n; i++) items[i] = delay(I, e->u.tuple.items[i], env);
+  return v;
+}
+
 Value *eval(Interp *I, Expr *e, Env *env) {
   int depth = I->ntrace;
   const Pos *origin = I->origin;
@@ -1828,29 +1882,7 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       int n = e->u.app.n;
       if (fe->kind == E_VAR && fe->u.vslot == RES_GLOBAL && n > 0 &&
           fe->u.var->con_arity == n) {
-        /* a constructor given all its arguments (Union (Shift v a) ...):
-           what call() makes of it, with the value and its arguments in
-           one block as known_con makes them, and no look-up or call */
-        Value *v = val_small(sizeof(Value) + sizeof(Value *) * (size_t)n);
-        Value **cargs = (Value **)(v + 1);
-        v->kind = V_CON;
-        v->u.con.con = fe->u.var;
-        v->u.con.n = n;
-        v->u.con.args = cargs;
-        v->u.con.pos = NULL;
-        for (int i = 0; i < n; i++) cargs[i] = delay(I, e->u.app.args[i], env);
-        if (e->pos.src) { /* as call() sets it */
-          if (!e->pos.src->prelude) {
-            v->u.con.pos = &e->pos;
-          } else if (I->origin) {
-            v->u.con.pos = I->origin;
-          } else {
-            Pos *p = val_small(sizeof *p);
-            *p = eval_user_pos(I, e->pos);
-            v->u.con.pos = p;
-          }
-        }
-        result = v;
+        result = eval_con(I, e, env);
         goto done;
       }
       /* a named function (the common case) without a nested eval: what
@@ -1910,19 +1942,9 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       e = kb ? e->u.cond.t : e->u.cond.f;
       continue;
     }
-    case E_TUPLE: {
-      double t[VEC_BLOCK_MAX];
-      int n = known_vec(I, e, env, t);
-      if (n > 0) {
-        result = vec_block(n, t);
-        goto done;
-      }
-      n = e->u.tuple.n;
-      Value **items = val_array(n);
-      for (int i = 0; i < n; i++) items[i] = delay(I, e->u.tuple.items[i], env);
-      result = val_tuple(n, items);
+    case E_TUPLE:
+      result = eval_tuple(I, e, env);
       goto done;
-    }
     case E_LIST: {
       result = I->v_nil;
       for (int i = e->u.tuple.n - 1; i >= 0; i--)
