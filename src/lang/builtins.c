@@ -161,11 +161,23 @@ static Value *bi_seq(Interp *I, Value **args, Pos pos) {
 
 /* ---- vectors ---- */
 
+static double dot3(const double *a, const double *b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 static Value *bi_dot(Interp *I, Value **args, Pos pos) {
   double a[3], b[3];
   force_vec3(I, args[0], pos, "the first argument of dot", a);
   force_vec3(I, args[1], pos, "the second argument of dot", b);
-  return val_num(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+  return val_num(dot3(a, b));
+}
+
+int builtin_is_vec_num(const Builtin *b) { return b->fn == bi_dot; }
+
+int builtin_vec_num(const Builtin *b, const double *x, int na, const double *y,
+                    int nb, double *out) {
+  if (b->fn != bi_dot || na != 3 || nb != 3) return 0;
+  *out = dot3(x, y);
+  return 1;
 }
 static Value *bi_cross(Interp *I, Value **args, Pos pos) {
   double a[3], b[3];

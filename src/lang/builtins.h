@@ -79,6 +79,13 @@ void builtins_install(Interp *I);
    min, ...: no error, no loop for any Real), sets *out to its value at x
    and returns 1; else returns 0. */
 int builtin_num(const Builtin *b, int n, const double *x, double *out);
+/* Likewise for a Real function of two tuples of Reals, of na and nb items
+   (dot of two 3-tuples): its value in *out and 1, or 0 if b is not such a
+   function or the sizes are not the ones it takes. */
+int builtin_vec_num(const Builtin *b, const double *x, int na, const double *y,
+                    int nb, double *out);
+/* Is b such a function (builtin_vec_num can succeed for it)? */
+int builtin_is_vec_num(const Builtin *b);
 /* Is b one of the built-ins that walk a whole list in one call (length,
    sum, product, foldl)? eval.c clears the stack and registers it runs
    over, so that a list it consumes is not kept by a stale pointer. */

@@ -322,15 +322,20 @@ static int known_bind(Interp *I, Pat *p, Expr *a, Env *env, Sym **names,
 
 typedef enum { KNOWN_NUM, KNOWN_BOOL, KNOWN_VEC } KnownWant;
 
+/* Whether known_call can look into d applied to n arguments at all: one
+   clause taking exactly those, no pattern binding, guard or where. */
+static inline int known_call_may(const Def *d, int n) {
+  if (d->arity != n || d->nclauses != 1 || d->pat || n > 4) return 0;
+  const Clause *c = d->clauses[0];
+  return c->nbodies == 1 && !c->guards[0] && !c->nwhere;
+}
+
 static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out,
                       int *bout, KnownWant want) {
   Def *d = f->u.fn.u.def;
   int n = e->u.app.n;
-  if (d->arity != n || d->nclauses != 1 || d->pat || n > 4 ||
-      known_calls >= KNOWN_CALL_DEPTH)
-    return 0;
+  if (!known_call_may(d, n) || known_calls >= KNOWN_CALL_DEPTH) return 0;
   Clause *c = d->clauses[0];
-  if (c->nbodies != 1 || c->guards[0] || c->nwhere) return 0;
   /* a tuple is not a Real nor a Bool: known before binding anything */
   if (want != KNOWN_VEC && c->bodies[0]->kind == E_TUPLE) return 0;
   Sym *names[KNOWN_BIND_MAX];
@@ -352,6 +357,56 @@ static int known_call(Interp *I, Expr *e, Env *env, Value *f, double *out,
   return ok;
 }
 
+/* known_num (known_vec) with a literal or a name (most operands) looked
+   at here, without the call and its stack check. */
+static inline int known_num_at(Interp *I, Expr *e, Env *env, double *out) {
+  if (e->kind == E_NUM) {
+    *out = e->u.num;
+    return 1;
+  }
+  if (e->kind == E_VAR) {
+    Value *v = known_var(e, env);
+    if (!v || v->kind != V_NUM) return 0;
+    *out = v->u.num;
+    return 1;
+  }
+  return known_num(I, e, env, out);
+}
+static inline int known_vec_at(Interp *I, Expr *e, Env *env, double *out) {
+  if (e->kind == E_VAR) {
+    Value *v = known_var(e, env);
+    if (!v || v->kind != V_TUPLE || v->u.tup.n > VEC_BLOCK_MAX) return 0;
+    for (int i = 0; i < v->u.tup.n; i++) {
+      Value *x = v->u.tup.items[i];
+      if (x->kind != V_NUM) return 0;
+      out[i] = x->u.num;
+    }
+    return v->u.tup.n;
+  }
+  return known_vec(I, e, env, out);
+}
+
+/* known_num of e, an E_APP of f, a function value that is not a
+   defined one: a built-in defined on every Real (floor x, min a b) given
+   known Reals. */
+static int known_builtin_num(Interp *I, Expr *e, Env *env, Value *f,
+                             double *out) {
+  if (e->u.app.n > 2 || f->u.fn.kind != F_BUILTIN || f->u.fn.arity != e->u.app.n)
+    return 0;
+  if (e->u.app.n == 2 && builtin_is_vec_num(f->u.fn.u.bi)) {
+    /* dot n v of tuples of Reals known: what the built-in would give */
+    double a[VEC_BLOCK_MAX], b[VEC_BLOCK_MAX];
+    int na = known_vec_at(I, e->u.app.args[0], env, a);
+    if (!na) return 0;
+    int nb = known_vec_at(I, e->u.app.args[1], env, b);
+    return nb && builtin_vec_num(f->u.fn.u.bi, a, na, b, nb, out);
+  }
+  double x[2];
+  for (int i = 0; i < e->u.app.n; i++)
+    if (!known_num(I, e->u.app.args[i], env, &x[i])) return 0;
+  return builtin_num(f->u.fn.u.bi, e->u.app.n, x, out);
+}
+
 static int known_num(Interp *I, Expr *e, Env *env, double *out) {
   char probe; /* a chain of a million '+' is left to eval, which checks */
   if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
@@ -369,15 +424,10 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
                    (\x -> x * 3) y: see known_call */
     if (e->u.app.fn->kind != E_VAR) return 0;
     Value *f = known_var(e->u.app.fn, env);
-    if (f && f->kind == V_FUNC && f->u.fn.kind == F_DEF)
+    if (!f || f->kind != V_FUNC) return 0;
+    if (f->u.fn.kind == F_DEF)
       return known_call(I, e, env, f, out, NULL, KNOWN_NUM);
-    if (e->u.app.n > 2 || !f || f->kind != V_FUNC || f->u.fn.kind != F_BUILTIN ||
-        f->u.fn.arity != e->u.app.n)
-      return 0;
-    double x[2];
-    for (int i = 0; i < e->u.app.n; i++)
-      if (!known_num(I, e->u.app.args[i], env, &x[i])) return 0;
-    return builtin_num(f->u.fn.u.bi, e->u.app.n, x, out);
+    return known_builtin_num(I, e, env, f, out);
   }
   case E_NEG:
     if (!known_num(I, e->u.neg, env, out)) return 0;
@@ -389,7 +439,8 @@ static int known_num(Interp *I, Expr *e, Env *env, double *out) {
     if (op != T_PLUS && op != T_MINUS && op != T_STAR && op != T_SLASH &&
         op != T_CARET)
       return 0;
-    if (!known_num(I, e->u.bin.a, env, &a) || !known_num(I, e->u.bin.b, env, &b))
+    if (!known_num_at(I, e->u.bin.a, env, &a) ||
+        !known_num_at(I, e->u.bin.b, env, &b))
       return 0;
     *out = op == T_PLUS ? a + b : op == T_MINUS ? a - b : op == T_STAR ? a * b
          : op == T_SLASH ? a / b : pow(a, b);
@@ -465,7 +516,7 @@ static int known_vec(Interp *I, Expr *e, Env *env, double *out) {
     int n = e->u.tuple.n;
     if (n > VEC_BLOCK_MAX) return 0;
     for (int i = 0; i < n; i++)
-      if (!known_num(I, e->u.tuple.items[i], env, &out[i])) return 0;
+      if (!known_num_at(I, e->u.tuple.items[i], env, &out[i])) return 0;
     return n;
   }
   case E_NEG: { /* as eval's: (-1) * t */
@@ -547,10 +598,32 @@ static __attribute__((noinline)) Value *delay_slow(Interp *I, Expr *e,
     if ((n = known_vec(I, e, env, t)) > 0) return vec_block(n, t);
     break;
   case E_APP: {
-    if (known_num(I, e, env, &x)) return val_num(x);
-    Value *c = known_con(I, e, env);
-    if (c) return c;
-    if ((n = known_vec(I, e, env, t)) > 0) return vec_block(n, t);
+    /* what known_num, known_con and known_vec would each try, with the
+       function looked up once: most arguments that are calls (Shift v a,
+       Union (...) (...)) name a function of several clauses or a
+       constructor, and fail at the first look */
+    Expr *fe = e->u.app.fn;
+    if (fe->kind != E_VAR) break;
+    Value *f = known_var(fe, env);
+    if (!f) { /* a constructor (or a name not defined) */
+      Value *c = known_con(I, e, env);
+      if (c) return c;
+      break;
+    }
+    if (f->kind != V_FUNC) break;
+    if (f->u.fn.kind == F_DEF) {
+      Def *d = f->u.fn.u.def;
+      if (!known_call_may(d, e->u.app.n)) break;
+      /* a body that is a tuple (ShiftPlane's) is no Real, and a literal
+         no tuple: the look that cannot succeed is not taken */
+      ExprKind bk = d->clauses[0]->bodies[0]->kind;
+      if (bk != E_TUPLE && known_call(I, e, env, f, &x, NULL, KNOWN_NUM))
+        return val_num(x);
+      if (bk != E_NUM && (n = known_call(I, e, env, f, t, NULL, KNOWN_VEC)) > 0)
+        return vec_block(n, t);
+    } else if (known_builtin_num(I, e, env, f, &x)) {
+      return val_num(x);
+    }
     break;
   }
   default:
@@ -1732,6 +1805,55 @@ static Value *range(Interp *I, Expr *e, Env *env) {
 
 /* ---- the evaluator ---- */
 
+/* eval of e, an E_APP of a constructor (a global, resolved so) to all its
+   arguments (the prelude's Union (Shift v a) (Shift v b)): what call()
+   makes of it, with the value and its arguments in one block as known_con
+   makes them, and no look-up or call() round. Out of line, to keep eval's
+   own frame as it was for the other cases. */
+static __attribute__((noinline)) Value *eval_con(Interp *I, Expr *e,
+                                                 Env *env) {
+  Expr *fe = e->u.app.fn;
+  int n = e->u.app.n;
+  Value *v = val_small(sizeof(Value) + sizeof(Value *) * (size_t)n);
+  Value **cargs = (Value **)(v + 1);
+  v->kind = V_CON;
+  v->u.con.con = fe->u.var;
+  v->u.con.n = n;
+  v->u.con.args = cargs;
+  v->u.con.pos = NULL;
+  for (int i = 0; i < n; i++) cargs[i] = delay(I, e->u.app.args[i], env);
+  if (e->pos.src) { /* as call() sets it */
+    if (!e->pos.src->prelude) {
+      v->u.con.pos = &e->pos;
+    } else if (I->origin) {
+      v->u.con.pos = I->origin;
+    } else {
+      Pos *p = val_small(sizeof *p);
+      *p = eval_user_pos(I, e->pos);
+      v->u.con.pos = p;
+    }
+  }
+  return v;
+}
+
+/* eval of e, an E_TUPLE: a block of Reals if they are known, else the
+   tuple and its items' array in one block (one allocation, one object for
+   the collector), the items delayed. */
+static __attribute__((noinline)) Value *eval_tuple(Interp *I, Expr *e,
+                                                   Env *env) {
+  double t[VEC_BLOCK_MAX];
+  int n = known_vec(I, e, env, t);
+  if (n > 0) return vec_block(n, t);
+  n = e->u.tuple.n;
+  Value *v = val_small(sizeof(Value) + sizeof(Value *) * (size_t)n);
+  Value **items = (Value **)(v + 1);
+  v->kind = V_TUPLE;
+  v->u.tup.n = n;
+  v->u.tup.items = items;
+  for (int i = 0; i < n; i++) items[i] = delay(I, e->u.tuple.items[i], env);
+  return v;
+}
+
 Value *eval(Interp *I, Expr *e, Env *env) {
   int depth = I->ntrace;
   const Pos *origin = I->origin;
@@ -1756,12 +1878,18 @@ Value *eval(Interp *I, Expr *e, Env *env) {
     case E_WILD:
       qcs_error(e->pos, "'_' stands only in patterns");
     case E_APP: {
+      Expr *fe = e->u.app.fn;
+      int n = e->u.app.n;
+      if (fe->kind == E_VAR && fe->u.vslot == RES_GLOBAL && n > 0 &&
+          fe->u.var->con_arity == n) {
+        result = eval_con(I, e, env);
+        goto done;
+      }
       /* a named function (the common case) without a nested eval: what
          eval's E_VAR does, less its step check, made here for the call */
       Value *f = e->u.app.fn->kind == E_VAR
                      ? force(I, lookup(I, e->u.app.fn, env))
                      : eval(I, e->u.app.fn, env);
-      int n = e->u.app.n;
       Value **args = val_small(sizeof(Value *) * (size_t)n);
       for (int i = 0; i < n; i++) args[i] = delay(I, e->u.app.args[i], env);
       /* A built-in that walks a list (sum, length, foldl) runs long in
@@ -1814,19 +1942,9 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       e = kb ? e->u.cond.t : e->u.cond.f;
       continue;
     }
-    case E_TUPLE: {
-      double t[VEC_BLOCK_MAX];
-      int n = known_vec(I, e, env, t);
-      if (n > 0) {
-        result = vec_block(n, t);
-        goto done;
-      }
-      n = e->u.tuple.n;
-      Value **items = val_array(n);
-      for (int i = 0; i < n; i++) items[i] = delay(I, e->u.tuple.items[i], env);
-      result = val_tuple(n, items);
+    case E_TUPLE:
+      result = eval_tuple(I, e, env);
       goto done;
-    }
     case E_LIST: {
       result = I->v_nil;
       for (int i = e->u.tuple.n - 1; i >= 0; i--)
