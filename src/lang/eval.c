@@ -372,8 +372,9 @@ static inline int known_num_at(Interp *I, Expr *e, Env *env, double *out) {
   }
   return known_num(I, e, env, out);
 }
-static inline int known_vec_at(Interp *I, Expr *e, Env *env, double *out) {
-  if (e->kind == E_VAR) {
+/* known_vec of e, an E_VAR: the Reals of the tuple it is bound to now,
+   if it is one of Reals already evaluated; its size, or 0. */
+static inline int known_var_vec(Expr *e, Env *env, double *out) {
     Value *v = known_var(e, env);
     if (!v || v->kind != V_TUPLE || v->u.tup.n > VEC_BLOCK_MAX) return 0;
     for (int i = 0; i < v->u.tup.n; i++) {
@@ -382,7 +383,9 @@ static inline int known_vec_at(Interp *I, Expr *e, Env *env, double *out) {
       out[i] = x->u.num;
     }
     return v->u.tup.n;
-  }
+}
+static inline int known_vec_at(Interp *I, Expr *e, Env *env, double *out) {
+  if (e->kind == E_VAR) return known_var_vec(e, env, out);
   return known_vec(I, e, env, out);
 }
 
@@ -502,16 +505,8 @@ static int known_vec(Interp *I, Expr *e, Env *env, double *out) {
   char probe;
   if ((size_t)(I->stack_base - &probe) > I->stack_limit / 2) return 0;
   switch (e->kind) {
-  case E_VAR: {
-    Value *v = known_var(e, env);
-    if (!v || v->kind != V_TUPLE || v->u.tup.n > VEC_BLOCK_MAX) return 0;
-    for (int i = 0; i < v->u.tup.n; i++) {
-      Value *x = v->u.tup.items[i];
-      if (x->kind != V_NUM) return 0;
-      out[i] = x->u.num;
-    }
-    return v->u.tup.n;
-  }
+  case E_VAR:
+    return known_var_vec(e, env, out);
   case E_TUPLE: {
     int n = e->u.tuple.n;
     if (n > VEC_BLOCK_MAX) return 0;

@@ -391,21 +391,29 @@ static void thin(const char *name, const char *src, double tol, double thick,
   scene_free(s);
 }
 
-static void thin_parts(void) {
-  double pts[64][3];
+/* 16 points in the middle plane x = 0.315 of a fin 0.03 thick from
+   x = 0.3, on a 4 x 4 grid from height y0 up; their number. */
+static int fin_points(double (*pts)[3], double y0) {
   int n = 0;
-  /* a fin 0.03 thick on a rounded cube, one density tree */
   for (int i = 0; i < 4; i++)
     for (int j = 0; j < 4; j++, n++) {
       pts[n][0] = 0.315;
-      pts[n][1] = 1.1 + 0.1 * i;
+      pts[n][1] = y0 + 0.1 * i;
       pts[n][2] = 0.2 + 0.2 * j;
     }
+  return n;
+}
+
+static void thin_parts(void) {
+  double pts[64][3];
+  int n;
+  /* a fin 0.03 thick on a rounded cube, one density tree */
+  n = fin_points(pts, 1.1);
   thin("thin fin (rounded)", "Rounded 0.01 (DensityUnion UnitCube (Shift (0.3, 1, 0) "
        "(Scale (0.03, 0.5, 1) UnitCube)))", 0.1, 0.03, 2, 1, pts, n);
   /* a rod 0.03 thick beside the block: two components */
   for (n = 0; n < 14; n++) {
-    pts[n][0] = pts[n][1] = 2.015;
+    pts[n][0] = 2.015;
     pts[n][1] = 0.015;
     pts[n][2] = 0.1 * (n + 1);
   }
@@ -435,13 +443,7 @@ static void thin_parts(void) {
   thin("small soft key beside a ball key", "SoftObject 0.5 [Key (0, 0, 0) 1 1, "
        "Key (1.2, 0, 0) 0.05 1]", 0.1, 0.05, 4, 2, pts, n);
   /* a sharp fin 0.03 thick on a rounded cube (sharp CSG with rounded) */
-  n = 0;
-  for (int i = 0; i < 4; i++)
-    for (int j = 0; j < 4; j++, n++) {
-      pts[n][0] = 0.315;
-      pts[n][1] = 1.02 + 0.1 * i;
-      pts[n][2] = 0.2 + 0.2 * j;
-    }
+  n = fin_points(pts, 1.02);
   thin("thin sharp fin on a rounded cube", "Union (Rounded 0.05 UnitCube) (Sharp "
        "(Shift (0.3, 0.9, 0) (Scale (0.03, 0.6, 1) UnitCube)))", 0.1, 0.03, 2, 1, pts, n);
 }
