@@ -377,6 +377,7 @@ Value *render_value(Interp *I, Value *settings, const char *path, Value *obj,
   ImgWriteOptions wo = {0};
   wo.float_pixels = float_pixels;
   wo.alpha = rs.alpha;
+  wo.threads = rs.threads;
   struct timespec w0, w1;
   clock_gettime(CLOCK_MONOTONIC, &w0);
   int wr = img_write(im, path, &wo, err, sizeof err);

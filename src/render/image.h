@@ -1,9 +1,10 @@
 /* image.h: the renderer's picture and its way to disk. An Image holds
  * linear floating-point RGBA (premultiplied by alpha, as OpenEXR expects)
  * and optional AOV planes (distance Z, normal N, root-finder cost); the
- * writers turn it into OpenEXR (OpenEXR C library), PNG (libpng) or PPM,
- * chosen by the file name's extension, and the readers bring EXR and PNG
- * back for tests and reference-image comparison.
+ * writers turn it into OpenEXR (OpenEXR C library), PNG (libpng's chunks,
+ * the pixels compressed by ISA-L's igzip on threads) or PPM, chosen by the
+ * file name's extension, and the readers bring EXR and PNG back for tests
+ * and reference-image comparison.
  *
  * Every write goes to a temporary file in the target's directory (created
  * with O_EXCL), is flushed and fsync'ed, and is renamed over the target
@@ -77,6 +78,8 @@ typedef struct {
   int float_pixels;    /* EXR: RGBA as 32-bit float (default half) */
   int no_compression;  /* EXR: no compression (default ZIP) */
   int alpha;           /* PNG: write RGBA (default RGB) */
+  int threads;         /* PNG: threads that compress (0: all cores); the
+                          file is the same on any number */
 } ImgWriteOptions;
 
 enum { IMG_FMT_EXR = 1, IMG_FMT_PNG, IMG_FMT_PPM };
@@ -132,6 +135,10 @@ int img_compare(const Image *a, const Image *b, double *rms,
  * to an 8-bit code, clamped to [0, 1] (NaN to 0) and rounded to nearest;
  * and a code value in [0, 1] back to linear. */
 unsigned char img_srgb8(float v);
+/* A row of n pixels of RGBA to 8-bit sRGB codes: RGB (3 bytes a pixel), or
+ * with alpha RGBA (4 bytes), the colour divided by alpha (PNG's is not
+ * premultiplied) and alpha clamped to [0, 1] (NaN to 0) and rounded. */
+void img_srgb8_row(const float *rgba, int n, int alpha, unsigned char *out);
 /* The same by its formula (a pow per call), for the test of img_srgb8. */
 unsigned char img_srgb8_exact(float v);
 double img_srgb_decode(double s);

@@ -25,6 +25,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
 static char dir[64];
 
@@ -694,6 +695,280 @@ static void test_exr_zip_no_gain(void) {
   CHECK("EXR: small ZIP float images come back bit for bit", bad == 0);
 }
 
+/* ---- the PNG writer against libpng's own --------------------------------
+ *
+ * img_write_png compresses the rows itself (igzip, in pieces on threads)
+ * and has libpng write only the chunks before them. The reference here is
+ * the writer it replaced: libpng writing every row (its own filters and
+ * zlib), the codes from img_srgb8_exact (the formula, not the table). The
+ * two files must decode, by libpng with every warning an error, to the
+ * same bytes, and carry the same chunks but IDAT, byte for byte; the
+ * IDATs joined must be one zlib stream (zlib inflates it to its end, with
+ * nothing left over, into exactly the filtered rows); and the bytes must
+ * not depend on the number of threads. */
+
+static void png_strict_warning(png_structp png, png_const_charp msg) {
+  printf("  libpng warning: %s\n", msg);
+  png_error(png, msg);
+}
+
+/* A PNG's 8-bit rows as libpng decodes them, warnings failing too. */
+static unsigned char *png_decode_strict(const unsigned char *data, size_t len,
+                                        int *w, int *h, int *nc) {
+  FILE *f = fmemopen((void *)data, len, "rb");
+  if (!f) return NULL;
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL,
+                                           png_strict_warning);
+  png_infop info = png_create_info_struct(png);
+  unsigned char *volatile out = NULL;
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, NULL);
+    fclose(f);
+    free(out);
+    return NULL;
+  }
+  png_init_io(png, f);
+  png_read_info(png, info);
+  *w = (int)png_get_image_width(png, info);
+  *h = (int)png_get_image_height(png, info);
+  *nc = png_get_channels(png, info);
+  if (png_get_bit_depth(png, info) != 8) png_error(png, "not 8 bits");
+  size_t rb = png_get_rowbytes(png, info);
+  out = malloc(rb * (size_t)*h);
+  for (int y = 0; y < *h; y++) png_read_row(png, out + rb * (size_t)y, NULL);
+  png_read_end(png, info);
+  png_destroy_read_struct(&png, &info, NULL);
+  fclose(f);
+  return out;
+}
+
+typedef struct {
+  unsigned char *p;
+  size_t n;
+} Buf;
+
+static void ref_png_data(png_structp png, png_bytep d, size_t n) {
+  Buf *b = png_get_io_ptr(png);
+  b->p = realloc(b->p, b->n + n);
+  memcpy(b->p + b->n, d, n);
+  b->n += n;
+}
+
+/* The replaced writer: libpng from signature to IEND. */
+static Buf ref_png_write(const Image *im, int alpha) {
+  Buf b = {0};
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL,
+                                            NULL, NULL);
+  png_infop info = png_create_info_struct(png);
+  int nc = alpha ? 4 : 3;
+  unsigned char *row = malloc((size_t)im->width * 4);
+  png_set_write_fn(png, &b, ref_png_data, NULL);
+  png_set_IHDR(png, info, (png_uint_32)im->width, (png_uint_32)im->height, 8,
+               alpha ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  png_text text[IMG_MAX_ATTRS + 1];
+  char window[64];
+  int nt = 0;
+  for (int i = 0; i < im->nattrs; i++)
+    text[nt++] = (png_text){.compression = PNG_TEXT_COMPRESSION_NONE,
+                            .key = im->attr_name[i],
+                            .text = im->attr_value[i]};
+  if (im->x0 || im->y0 || im->full_width != im->width ||
+      im->full_height != im->height) {
+    snprintf(window, sizeof window, "%d %d %d %d", im->x0, im->y0,
+             im->full_width, im->full_height);
+    text[nt++] = (png_text){.compression = PNG_TEXT_COMPRESSION_NONE,
+                            .key = "qcs.window", .text = window};
+  }
+  if (nt) png_set_text(png, info, text, nt);
+  png_write_info(png, info);
+  for (int y = 0; y < im->height; y++) {
+    const float *p = im->rgba + 4 * img_index(im, 0, y);
+    for (int x = 0; x < im->width; x++, p += 4) {
+      float a = p[3], k = 1.0f;
+      if (alpha && a > 0.0f && a < 1.0f) k = 1.0f / a;
+      for (int c = 0; c < 3; c++)
+        row[nc * x + c] = img_srgb8_exact(p[c] * k);
+      if (alpha) {
+        float ac = a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f;
+        row[nc * x + 3] = (unsigned char)(ac * 255.0f + 0.5f);
+      }
+    }
+    png_write_row(png, row);
+  }
+  png_write_end(png, info);
+  png_destroy_write_struct(&png, &info);
+  free(row);
+  return b;
+}
+
+/* The chunks but IDAT, concatenated whole (length, type, data, CRC), and
+ * the IDATs' data joined; -1 if the framing is broken or a CRC wrong. */
+static int png_split(const Buf *b, Buf *meta, Buf *idat) {
+  static const unsigned char sig[8] = {137, 80, 78, 71, 13, 10, 26, 10};
+  if (b->n < 8 || memcmp(b->p, sig, 8)) return -1;
+  size_t i = 8;
+  int ended = 0;
+  while (i + 12 <= b->n && !ended) {
+    const unsigned char *c = b->p + i;
+    size_t len = (size_t)c[0] << 24 | (size_t)c[1] << 16 | (size_t)c[2] << 8 |
+                 c[3];
+    if (i + 12 + len > b->n) return -1;
+    uLong crc = crc32(0L, c + 4, (uInt)(4 + len));
+    if ((((uLong)c[8 + len] << 24) | ((uLong)c[9 + len] << 16) |
+         ((uLong)c[10 + len] << 8) | c[11 + len]) != crc)
+      return -1;
+    Buf *to = memcmp(c + 4, "IDAT", 4) ? meta : idat;
+    const unsigned char *from = to == idat ? c + 8 : c;
+    size_t n = to == idat ? len : len + 12;
+    to->p = realloc(to->p, to->n + n + 1);
+    memcpy(to->p + to->n, from, n);
+    to->n += n;
+    ended = !memcmp(c + 4, "IEND", 4);
+    i += 12 + len;
+  }
+  return ended && i == b->n ? 0 : -1;
+}
+
+/* zlib inflates the joined IDATs to Z_STREAM_END using all of them, into
+ * exactly `want` bytes. */
+static int zlib_stream_ok(const Buf *idat, size_t want) {
+  z_stream z = {0};
+  if (inflateInit(&z) != Z_OK) return 0;
+  unsigned char *out = malloc(want + 16);
+  z.next_in = idat->p;
+  z.avail_in = (uInt)idat->n;
+  z.next_out = out;
+  z.avail_out = (uInt)(want + 16);
+  int rc = inflate(&z, Z_FINISH);
+  int ok = rc == Z_STREAM_END && z.avail_in == 0 && z.total_out == want;
+  inflateEnd(&z);
+  free(out);
+  return ok;
+}
+
+static Buf png_in_memory(const Image *im, int alpha, int threads) {
+  Buf b = {0};
+  FILE *f = open_memstream((char **)&b.p, &b.n);
+  ImgWriteOptions opt = {.alpha = alpha, .threads = threads};
+  char err[200];
+  int rc = img_write_png(im, f, &opt, "mem.png", err, sizeof err);
+  fclose(f);
+  if (rc) {
+    free(b.p);
+    b.p = NULL;
+    b.n = 0;
+  }
+  return b;
+}
+
+static uint64_t rng_state = 0x9e3779b97f4a7c15u;
+static double rng01(void) { /* xorshift64* */
+  rng_state ^= rng_state >> 12;
+  rng_state ^= rng_state << 25;
+  rng_state ^= rng_state >> 27;
+  return (double)((rng_state * 2685821657736338717u) >> 11) * 0x1p-53;
+}
+
+/* A picture to compress: smooth shading (long matches), noise (none),
+   flat runs, out-of-range values and NaN, and alpha 0, 1 and between. */
+static Image *writer_picture(int w, int h) {
+  Image *im = img_new(w, h, 0);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float *p = im->rgba + 4 * img_index(im, x, y);
+      int kind = (x / 37 + y / 23) % 4;
+      double r = rng01();
+      for (int c = 0; c < 3; c++)
+        p[c] = kind == 0   ? (float)((x + 3 * y + 50 * c) % 400) / 399.0f
+               : kind == 1 ? (float)(rng01() * 1.3 - 0.15)
+               : kind == 2 ? 0.2f * (float)c
+                           : (float)(0.5 + 0.5 * sin(0.01 * x * (c + 1) + y));
+      if (r < 0.002) p[(x + y) % 3] = NAN;
+      else if (r < 0.004) p[(x + y) % 3] = INFINITY;
+      p[3] = kind == 1 ? (float)rng01() : kind == 2 ? 0.0f : 1.0f;
+      if (p[3] < 1.0f)
+        for (int c = 0; c < 3; c++) p[c] *= p[3];
+    }
+  return im;
+}
+
+static void test_png_writer(void) {
+  static const int sizes[][2] = {{1, 1},    {2, 1},    {1, 2},   {3, 7},
+                                 {31, 17},  {257, 300}, {600, 380},
+                                 {4000, 1}, {4000, 40}, {1, 3000},
+                                 {1021, 129}};
+  int n = (int)(sizeof sizes / sizeof *sizes), decoded = 0, meta = 0,
+      stream = 0, threads_same = 0, cases = 0;
+  for (int s = 0; s < n; s++)
+    for (int alpha = 0; alpha < 2; alpha++) {
+      int w = sizes[s][0], h = sizes[s][1];
+      Image *im = writer_picture(w, h);
+      img_set_attr(im, "qcs.render", "1");
+      img_set_attr(im, "qcs.size", "a b  c");
+      if (s % 3 == 1) {  /* a part of a larger picture: qcs.window */
+        im->x0 = 5;
+        im->full_width = w + 9;
+        im->full_height = h + 2;
+      }
+      cases++;
+      Buf ours = png_in_memory(im, alpha, 1), ref = ref_png_write(im, alpha);
+      int wa = 0, ha = 0, na = 0, wb = 0, hb = 0, nb = 0;
+      unsigned char *a = ours.p ? png_decode_strict(ours.p, ours.n, &wa, &ha,
+                                                    &na)
+                                : NULL;
+      unsigned char *b = png_decode_strict(ref.p, ref.n, &wb, &hb, &nb);
+      size_t bytes = (size_t)w * (size_t)h * (alpha ? 4 : 3);
+      if (a && b && wa == w && ha == h && wb == w && hb == h && na == nb &&
+          na == (alpha ? 4 : 3) && !memcmp(a, b, bytes))
+        decoded++;
+      else
+        printf("  %dx%d alpha %d: decoded pixels differ\n", w, h, alpha);
+      Buf ma = {0}, ia = {0}, mb = {0}, ib = {0};
+      if (ours.p && png_split(&ours, &ma, &ia) == 0 &&
+          png_split(&ref, &mb, &ib) == 0 && ma.n == mb.n &&
+          !memcmp(ma.p, mb.p, ma.n))
+        meta++;
+      else
+        printf("  %dx%d alpha %d: chunks other than IDAT differ\n", w, h,
+               alpha);
+      if (ia.p && zlib_stream_ok(&ia, (size_t)h * (1 + (size_t)w *
+                                                       (alpha ? 4 : 3))))
+        stream++;
+      else
+        printf("  %dx%d alpha %d: IDAT is not one zlib stream of the rows\n",
+               w, h, alpha);
+      int same = 1;
+      static const int tc[] = {2, 3, 7, 64, 0};
+      for (int t = 0; t < 5; t++) {
+        Buf other = png_in_memory(im, alpha, tc[t]);
+        same &= other.n == ours.n && ours.p && !memcmp(other.p, ours.p, ours.n);
+        free(other.p);
+      }
+      if (same) threads_same++;
+      else printf("  %dx%d alpha %d: bytes depend on threads\n", w, h, alpha);
+      free(a);
+      free(b);
+      free(ours.p);
+      free(ref.p);
+      free(ma.p);
+      free(ia.p);
+      free(mb.p);
+      free(ib.p);
+      img_free(im);
+    }
+  printf("# PNG writer: %d pictures, 1x1 to 4000 wide, RGB and RGBA\n", cases);
+  CHECK("PNG decodes (libpng, warnings as errors) to the pixels libpng's "
+        "own writer wrote", decoded == cases);
+  CHECK("PNG chunks but IDAT byte for byte as libpng wrote them", meta == cases);
+  CHECK("PNG IDATs are one zlib stream of exactly the filtered rows",
+        stream == cases);
+  CHECK("PNG bytes the same on 1, 2, 3, 7, 64 and all cores' threads",
+        threads_same == cases);
+}
+
 /* img_srgb8 (a table of where each code starts) against img_srgb8_exact
    (the formula, a pow per call): every 61st float of (0, 1), the 8 floats
    each side of every code's start, and the edges. (Every float of (0, 1),
@@ -743,6 +1018,7 @@ static void test_srgb8_table(void) {
 int main(void) {
   check_prefix = "image";
   test_srgb8_table();
+  test_png_writer();
   snprintf(dir, sizeof dir, "/tmp/qcs-image-XXXXXX");
   if (!mkdtemp(dir)) {
     printf("FAIL image: mkdtemp: %s\n", strerror(errno));
