@@ -271,15 +271,17 @@ sanitize: deps
 	@QCS=build-san/qcs QCS_UNIT_DIR=build-san/tests \
 	  ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 sh tests/run-all.sh
 
-# tsan: the multi-threaded parts under ThreadSanitizer (clang): the render
-# and fast-path unit tests, every rendering example on 4 threads and the
-# REPL suite (tests/tsan.sh); any report fails it (halt_on_error=1).
+# tsan: the multi-threaded parts under ThreadSanitizer (clang): the render,
+# fast-path and image (the PNG writer's threads) unit tests, every
+# rendering example on 4 threads and the REPL suite (tests/tsan.sh); any
+# report fails it (halt_on_error=1).
 TSAN_FLAGS := -g -fsanitize=thread
 .PHONY: tsan
 tsan: deps
 	@$(MAKE) -s BUILD=build-tsan BIN=build-tsan/qcs CC=clang \
 	  OPT="-O1 -fno-omit-frame-pointer" CFLAGS="$(TSAN_FLAGS)" \
-	  build-tsan/qcs build-tsan/tests/test_render build-tsan/tests/test_fastpaths
+	  build-tsan/qcs build-tsan/tests/test_render build-tsan/tests/test_fastpaths \
+	  build-tsan/tests/test_image
 	@QCS=build-tsan/qcs QCS_UNIT_DIR=build-tsan/tests sh tests/tsan.sh
 
 # fuzz: the libFuzzer targets of fuzz/ (clang, ASan + UBSan), each run for

@@ -13,7 +13,7 @@ TSAN_OPTIONS="halt_on_error=1 exitcode=66 second_deadlock_stack=1 ${TSAN_OPTIONS
 export TSAN_OPTIONS
 log=$(mktemp); tmp=$(mktemp -d); trap 'rm -rf "$log" "$tmp"' EXIT
 
-for t in test_render test_fastpaths; do
+for t in test_render test_fastpaths test_image; do
   if "$UNIT_DIR/$t" >"$tmp/$t.out" 2>&1; then echo "ok tsan/$t" >>"$log"
   else echo "FAIL tsan/$t: status $?: $(grep -m3 -E 'WARNING: ThreadSanitizer|FAIL|SUMMARY' "$tmp/$t.out" | tr '\n' ' ')" >>"$log"; fi
 done
@@ -23,6 +23,11 @@ for f in examples/*.qcs; do
   if timeout 600 "$QCS" --threads 4 --size 120x76 -o "$tmp/$n.exr" "$f" >/dev/null 2>"$tmp/$n.err" </dev/null &&
      ! grep -q ThreadSanitizer "$tmp/$n.err"; then echo "ok tsan/example-$n" >>"$log"
   else echo "FAIL tsan/example-$n: $(grep -m3 -E 'ThreadSanitizer|error' "$tmp/$n.err" | tr '\n' ' ')" >>"$log"; fi
+done
+for a in "" --alpha; do
+  if timeout 600 "$QCS" --threads 4 --size 300x190 $a -o "$tmp/png$a.png" examples/figure12.qcs >/dev/null 2>"$tmp/png.err" </dev/null &&
+     ! grep -q ThreadSanitizer "$tmp/png.err"; then echo "ok tsan/png$a" >>"$log"
+  else echo "FAIL tsan/png$a: $(grep -m3 -E 'ThreadSanitizer|error' "$tmp/png.err" | tr '\n' ' ')" >>"$log"; fi
 done
 for s in tests/suite-repl.sh tests/suite-preview.sh tests/suite-view.sh; do QCS_TSAN=1 sh "$s" 2>&1 | sed 's/^\(ok\|FAIL\|skip\) /\1 tsan\//' >>"$log"; done
 
