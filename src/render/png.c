@@ -60,8 +60,9 @@ static void png_flush_data(png_structp png) {
  * pictures) into raw deflate blocks ending on a byte boundary, the last
  * piece's block final: one after another they are one deflate stream, as
  * pigz joins its pieces. The Adler-32s of the pieces are joined with
- * zlib's adler32_combine. Threads take the pieces from a counter, so the
- * file is the same bytes on any number of threads. Each piece is one IDAT
+ * zlib's adler32_combine. Threads take the pieces from a counter, and a
+ * piece's bytes depend on the piece alone, so the file is the same bytes
+ * on any number of threads. Each piece is one IDAT
  * chunk (the first with the zlib header, the last with the Adler-32). */
 
 #ifndef PNG_PIECE_BYTES
@@ -76,15 +77,30 @@ typedef struct {
   uint32_t adler;      /* their Adler-32 */
 } Piece;
 
+/* The work shared by the calling thread and its helpers. The helpers are
+ * detached: the caller never waits for one that the machine's load keeps
+ * off a core. It takes pieces from the counter as they do, then does
+ * itself every piece still unfinished (a helper's piece: whichever
+ * finishes first publishes it, the other drops its copy, and a caller
+ * working on a piece stops as soon as it is published). Before it
+ * returns it raises `cancel` and takes `reading` for writing: a helper
+ * reads the image only holding `reading` for reading, one row at a time,
+ * and stops when it sees `cancel`, so none touches the image after. The
+ * last thread out (refs) frees this. */
 typedef struct {
-  const Image *im;
-  int alpha;
+  const float *rgba;  /* the image's pixels, read under `reading` */
+  int width, height, alpha;
   size_t pix_bytes;   /* width * channels */
   int piece_rows, npieces;
-  Piece *pieces;
+  _Atomic(Piece *) *done; /* published pieces; `taken` once the caller
+                             has them */
   atomic_int next;    /* the next piece to take */
-  atomic_int failed;  /* out of memory somewhere */
+  atomic_int cancel;  /* the caller has every piece: helpers stop */
+  atomic_int refs;    /* the caller and the running helpers */
+  pthread_rwlock_t reading;
 } Idat;
+
+static Piece taken; /* the mark of a piece the caller has taken over */
 
 typedef struct {
   unsigned char *in, *prev, *cur, *level_buf;
@@ -112,33 +128,51 @@ static void filter_up(unsigned char *restrict dst,
   for (; i < n; i++) dst[1 + i] = (unsigned char)(cur[i] - prev[i]);
 }
 
-static int compress_piece(Idat *d, int k, Scratch *s) {
-  Piece *p = &d->pieces[k];
+/* Row y's codes into out; a helper holds `reading` while it reads the
+ * image. 0, or -1 if the piece is no longer wanted (the caller cancelled,
+ * or, for the caller, the piece was published meanwhile). */
+static int encode_row(Idat *d, int k, int y, int helper, unsigned char *out) {
+  if (helper) {
+    pthread_rwlock_rdlock(&d->reading);
+    if (atomic_load(&d->cancel)) {
+      pthread_rwlock_unlock(&d->reading);
+      return -1;
+    }
+  } else if (atomic_load(&d->done[k])) {
+    return -1;
+  }
+  img_srgb8_row(d->rgba + 4 * (size_t)y * (size_t)d->width, d->width,
+                d->alpha, out);
+  if (helper) pthread_rwlock_unlock(&d->reading);
+  return 0;
+}
+
+/* Piece k filtered and compressed, and published unless another thread
+ * published it first. 0, 1 if not wanted any more, -1 out of memory. */
+static int compress_piece(Idat *d, int k, int helper, Scratch *s) {
   int y0 = k * d->piece_rows;
-  int y1 = y0 + d->piece_rows < d->im->height ? y0 + d->piece_rows
-                                              : d->im->height;
+  int y1 = y0 + d->piece_rows < d->height ? y0 + d->piece_rows : d->height;
   size_t rb = d->pix_bytes + 1;
-  if (y0 > 0)
-    img_srgb8_row(d->im->rgba + 4 * img_index(d->im, 0, y0 - 1),
-                  d->im->width, d->alpha, s->prev);
-  else
-    memset(s->prev, 0, d->pix_bytes);
+  if (y0 == 0) memset(s->prev, 0, d->pix_bytes);
+  else if (encode_row(d, k, y0 - 1, helper, s->prev)) return 1;
   for (int y = y0; y < y1; y++) {
-    img_srgb8_row(d->im->rgba + 4 * img_index(d->im, 0, y), d->im->width,
-                  d->alpha, s->cur);
+    if (encode_row(d, k, y, helper, s->cur)) return 1;
     filter_up(s->in + rb * (size_t)(y - y0), s->cur, s->prev, d->pix_bytes);
     unsigned char *t = s->prev;
     s->prev = s->cur;
     s->cur = t;
   }
-  p->in_len = rb * (size_t)(y1 - y0);
-  p->adler = isal_adler32(1, s->in, p->in_len);
+  size_t in_len = rb * (size_t)(y1 - y0);
   int first = k == 0, last = k == d->npieces - 1;
   size_t head = first ? 2 : 0, tail = last ? 4 : 0;
   /* room for the input in stored blocks, igzip's worst case */
-  size_t cap = p->in_len + 5 * (p->in_len / 65535 + 1) + 64 + head + tail;
-  p->out = malloc(cap);
-  if (!p->out) return -1;
+  size_t cap = in_len + 5 * (in_len / 65535 + 1) + 64 + head + tail;
+  Piece *p = malloc(sizeof *p);
+  unsigned char *out = p ? malloc(cap) : NULL;
+  if (!out) {
+    free(p);
+    return -1;
+  }
   struct isal_zstream z;
   isal_deflate_stateless_init(&z);
   z.level = 1;
@@ -148,33 +182,65 @@ static int compress_piece(Idat *d, int k, Scratch *s) {
   z.end_of_stream = (uint16_t)last;
   z.flush = last ? NO_FLUSH : FULL_FLUSH; /* to a byte boundary */
   z.next_in = s->in;
-  z.avail_in = (uint32_t)p->in_len;
-  z.next_out = p->out + head;
+  z.avail_in = (uint32_t)in_len;
+  z.next_out = out + head;
   z.avail_out = (uint32_t)(cap - head - tail);
-  if (isal_deflate_stateless(&z) != COMP_OK) return -1;
-  p->len = head + z.total_out + tail;
+  if (isal_deflate_stateless(&z) != COMP_OK) {
+    free(out);
+    free(p);
+    return -1;
+  }
+  *p = (Piece){.out = out, .len = head + z.total_out + tail,
+               .in_len = in_len, .adler = isal_adler32(1, s->in, in_len)};
+  Piece *none = NULL;
+  if (!atomic_compare_exchange_strong(&d->done[k], &none, p)) {
+    free(out); /* another thread's copy came first: the same bytes */
+    free(p);
+  }
   return 0;
 }
 
-static void *idat_worker(void *arg) {
-  Idat *d = arg;
-  Scratch s = {.in = malloc((d->pix_bytes + 1) * (size_t)d->piece_rows),
-               .prev = malloc(d->pix_bytes),
-               .cur = malloc(d->pix_bytes),
-               .level_buf = malloc(ISAL_DEF_LVL1_DEFAULT)};
-  int ok = s.in && s.prev && s.cur && s.level_buf;
-  for (;;) {
-    int k = atomic_fetch_add(&d->next, 1);
-    if (k >= d->npieces) break;
-    if (!ok || atomic_load(&d->failed) || compress_piece(d, k, &s) != 0) {
-      atomic_store(&d->failed, 1);
-      break;
+static void idat_release(Idat *d) {
+  if (atomic_fetch_sub(&d->refs, 1) != 1) return;
+  for (int k = 0; k < d->npieces; k++) {
+    Piece *p = atomic_load(&d->done[k]);
+    if (p && p != &taken) {
+      free(p->out);
+      free(p);
     }
   }
-  free(s.in);
-  free(s.prev);
-  free(s.cur);
-  free(s.level_buf);
+  pthread_rwlock_destroy(&d->reading);
+  free(d->done);
+  free(d);
+}
+
+static int scratch_new(Scratch *s, const Idat *d) {
+  *s = (Scratch){.in = malloc((d->pix_bytes + 1) * (size_t)d->piece_rows),
+                 .prev = malloc(d->pix_bytes),
+                 .cur = malloc(d->pix_bytes),
+                 .level_buf = malloc(ISAL_DEF_LVL1_DEFAULT)};
+  return s->in && s->prev && s->cur && s->level_buf ? 0 : -1;
+}
+
+static void scratch_free(Scratch *s) {
+  free(s->in);
+  free(s->prev);
+  free(s->cur);
+  free(s->level_buf);
+}
+
+static void *idat_helper(void *arg) {
+  Idat *d = arg;
+  Scratch s;
+  if (scratch_new(&s, d) == 0)
+    for (;;) { /* a helper out of memory leaves its pieces to the caller */
+      int k = atomic_fetch_add(&d->next, 1);
+      if (k >= d->npieces || atomic_load(&d->cancel) ||
+          compress_piece(d, k, 1, &s) != 0)
+        break;
+    }
+  scratch_free(&s);
+  idat_release(d);
   return NULL;
 }
 
@@ -187,38 +253,73 @@ static void free_pieces(Piece *pc, int n) {
  * a core); NULL if memory runs out. Sets *npieces. */
 static Piece *compress_idat(const Image *im, int alpha, int threads,
                             int *npieces) {
-  Idat d = {.im = im, .alpha = alpha};
-  d.pix_bytes = (size_t)im->width * (alpha ? 4 : 3);
-  size_t rows = PNG_PIECE_BYTES / (d.pix_bytes + 1);
-  d.piece_rows = rows < 1 ? 1
-                 : rows > (size_t)im->height ? im->height
-                                             : (int)rows;
-  d.npieces = (im->height + d.piece_rows - 1) / d.piece_rows;
-  d.pieces = calloc((size_t)d.npieces, sizeof *d.pieces);
-  if (!d.pieces) return NULL;
-  atomic_init(&d.next, 0);
-  atomic_init(&d.failed, 0);
+  Idat *d = calloc(1, sizeof *d);
+  if (!d) return NULL;
+  *d = (Idat){.rgba = im->rgba, .width = im->width, .height = im->height,
+              .alpha = alpha};
+  d->pix_bytes = (size_t)im->width * (alpha ? 4 : 3);
+  size_t rows = PNG_PIECE_BYTES / (d->pix_bytes + 1);
+  d->piece_rows = rows < 1 ? 1
+                  : rows > (size_t)im->height ? im->height
+                                              : (int)rows;
+  d->npieces = (im->height + d->piece_rows - 1) / d->piece_rows;
+  d->done = calloc((size_t)d->npieces, sizeof *d->done);
+  Piece *pieces = calloc((size_t)d->npieces, sizeof *pieces);
+  Scratch s;
+  int ok = d->done && pieces && scratch_new(&s, d) == 0 &&
+           pthread_rwlock_init(&d->reading, NULL) == 0;
+  if (!ok) {
+    if (d->done && pieces) scratch_free(&s);
+    free(d->done);
+    free(d);
+    free(pieces);
+    return NULL;
+  }
+  for (int k = 0; k < d->npieces; k++) atomic_init(&d->done[k], NULL);
+  atomic_init(&d->next, 0);
+  atomic_init(&d->cancel, 0);
+  atomic_init(&d->refs, 1);
   if (threads <= 0) {
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     threads = n < 1 ? 1 : n > PNG_MAX_THREADS ? PNG_MAX_THREADS : (int)n;
   }
   if (threads > PNG_MAX_THREADS) threads = PNG_MAX_THREADS;
-  if (threads > d.npieces) threads = d.npieces;
-  /* the calling thread is one of them; a thread that cannot be started
-     leaves its pieces to the others */
-  pthread_t tid[PNG_MAX_THREADS];
-  int started = 0;
-  while (started < threads - 1 &&
-         pthread_create(&tid[started], NULL, idat_worker, &d) == 0)
-    started++;
-  idat_worker(&d);
-  for (int i = 0; i < started; i++) pthread_join(tid[i], NULL);
-  if (atomic_load(&d.failed)) {
-    free_pieces(d.pieces, d.npieces);
+  if (threads > d->npieces) threads = d->npieces;
+  pthread_attr_t attr;
+  if (threads > 1 && pthread_attr_init(&attr) == 0) {
+    pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
+    for (int i = 1; i < threads; i++) {
+      pthread_t t;
+      atomic_fetch_add(&d->refs, 1);
+      if (pthread_create(&t, &attr, idat_helper, d) != 0) {
+        atomic_fetch_sub(&d->refs, 1); /* the caller does its share */
+        break;
+      }
+    }
+    pthread_attr_destroy(&attr);
+  }
+  /* the counter's pieces, then any still unpublished (a helper's) */
+  for (int k; ok && (k = atomic_fetch_add(&d->next, 1)) < d->npieces;)
+    ok = compress_piece(d, k, 0, &s) >= 0;
+  for (int k = 0; ok && k < d->npieces; k++)
+    if (!atomic_load(&d->done[k])) ok = compress_piece(d, k, 0, &s) >= 0;
+  scratch_free(&s);
+  atomic_store(&d->cancel, 1);
+  pthread_rwlock_wrlock(&d->reading); /* no helper is reading a row now */
+  pthread_rwlock_unlock(&d->reading);
+  for (int k = 0; ok && k < d->npieces; k++) {
+    Piece *p = atomic_exchange(&d->done[k], &taken);
+    pieces[k] = *p;
+    free(p);
+  }
+  int n = d->npieces;
+  idat_release(d);
+  if (!ok) {
+    free_pieces(pieces, 0);
     return NULL;
   }
-  *npieces = d.npieces;
-  return d.pieces;
+  *npieces = n;
+  return pieces;
 }
 
 static void put32(unsigned char *b, uint32_t v) {
