@@ -304,13 +304,20 @@ static void test_exr(void) {
 
 /* ---- PNG and PPM ------------------------------------------------------------ */
 
-/* Read a PNG's 8-bit rows with libpng directly: w * h * channels bytes. */
-static unsigned char *png_bytes(const char *path, int *w, int *h, int *nc,
-                                int *srgb) {
-  FILE *f = fopen(path, "rb");
+static void png_strict_warning(png_structp png, png_const_charp msg) {
+  printf("  libpng warning: %s\n", msg);
+  png_error(png, msg);
+}
+
+/* A PNG's 8-bit rows as libpng decodes them, read with libpng directly,
+ * warnings failing too: w * h * channels bytes; *srgb (unless NULL) says
+ * whether it has an sRGB chunk. */
+static unsigned char *png_decode_strict(const unsigned char *data, size_t len,
+                                        int *w, int *h, int *nc, int *srgb) {
+  FILE *f = fmemopen((void *)data, len, "rb");
   if (!f) return NULL;
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL,
-                                           NULL);
+                                           png_strict_warning);
   png_infop info = png_create_info_struct(png);
   unsigned char *volatile out = NULL;
   if (setjmp(png_jmpbuf(png))) {
@@ -325,14 +332,30 @@ static unsigned char *png_bytes(const char *path, int *w, int *h, int *nc,
   *h = (int)png_get_image_height(png, info);
   *nc = png_get_channels(png, info);
   int srgb_intent = -1;
-  *srgb = png_get_sRGB(png, info, &srgb_intent) != 0;
+  if (srgb) *srgb = png_get_sRGB(png, info, &srgb_intent) != 0;
   if (png_get_bit_depth(png, info) != 8) png_error(png, "not 8 bits");
   size_t rb = png_get_rowbytes(png, info);
   out = malloc(rb * (size_t)*h);
   for (int y = 0; y < *h; y++) png_read_row(png, out + rb * (size_t)y, NULL);
-  png_read_end(png, NULL);
+  png_read_end(png, info);
   png_destroy_read_struct(&png, &info, NULL);
   fclose(f);
+  return out;
+}
+
+/* The same of a file. */
+static unsigned char *png_bytes(const char *path, int *w, int *h, int *nc,
+                                int *srgb) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  long len = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+  unsigned char *data = len > 0 ? malloc((size_t)len) : NULL;
+  int read = data && fseek(f, 0, SEEK_SET) == 0 &&
+             fread(data, 1, (size_t)len, f) == (size_t)len;
+  fclose(f);
+  unsigned char *out =
+      read ? png_decode_strict(data, (size_t)len, w, h, nc, srgb) : NULL;
+  free(data);
   return out;
 }
 
@@ -707,41 +730,6 @@ static void test_exr_zip_no_gain(void) {
  * nothing left over, into exactly the filtered rows); and the bytes must
  * not depend on the number of threads. */
 
-static void png_strict_warning(png_structp png, png_const_charp msg) {
-  printf("  libpng warning: %s\n", msg);
-  png_error(png, msg);
-}
-
-/* A PNG's 8-bit rows as libpng decodes them, warnings failing too. */
-static unsigned char *png_decode_strict(const unsigned char *data, size_t len,
-                                        int *w, int *h, int *nc) {
-  FILE *f = fmemopen((void *)data, len, "rb");
-  if (!f) return NULL;
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL,
-                                           png_strict_warning);
-  png_infop info = png_create_info_struct(png);
-  unsigned char *volatile out = NULL;
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_read_struct(&png, &info, NULL);
-    fclose(f);
-    free(out);
-    return NULL;
-  }
-  png_init_io(png, f);
-  png_read_info(png, info);
-  *w = (int)png_get_image_width(png, info);
-  *h = (int)png_get_image_height(png, info);
-  *nc = png_get_channels(png, info);
-  if (png_get_bit_depth(png, info) != 8) png_error(png, "not 8 bits");
-  size_t rb = png_get_rowbytes(png, info);
-  out = malloc(rb * (size_t)*h);
-  for (int y = 0; y < *h; y++) png_read_row(png, out + rb * (size_t)y, NULL);
-  png_read_end(png, info);
-  png_destroy_read_struct(&png, &info, NULL);
-  fclose(f);
-  return out;
-}
-
 typedef struct {
   unsigned char *p;
   size_t n;
@@ -754,6 +742,13 @@ static void ref_png_data(png_structp png, png_bytep d, size_t n) {
   b->n += n;
 }
 
+/* One tEXt chunk more. */
+static void ref_text(png_structp png, png_infop info, char *key, char *text) {
+  png_text t = {.compression = PNG_TEXT_COMPRESSION_NONE, .key = key,
+                .text = text};
+  png_set_text(png, info, &t, 1);
+}
+
 /* The replaced writer: libpng from signature to IEND. */
 static Buf ref_png_write(const Image *im, int alpha) {
   Buf b = {0};
@@ -763,26 +758,19 @@ static Buf ref_png_write(const Image *im, int alpha) {
   int nc = alpha ? 4 : 3;
   unsigned char *row = malloc((size_t)im->width * 4);
   png_set_write_fn(png, &b, ref_png_data, NULL);
-  png_set_IHDR(png, info, (png_uint_32)im->width, (png_uint_32)im->height, 8,
-               alpha ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
+  int type = alpha ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB;
   png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-  png_text text[IMG_MAX_ATTRS + 1];
-  char window[64];
-  int nt = 0;
+  png_set_IHDR(png, info, (png_uint_32)im->width, (png_uint_32)im->height, 8,
+               type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
   for (int i = 0; i < im->nattrs; i++)
-    text[nt++] = (png_text){.compression = PNG_TEXT_COMPRESSION_NONE,
-                            .key = im->attr_name[i],
-                            .text = im->attr_value[i]};
-  if (im->x0 || im->y0 || im->full_width != im->width ||
-      im->full_height != im->height) {
-    snprintf(window, sizeof window, "%d %d %d %d", im->x0, im->y0,
-             im->full_width, im->full_height);
-    text[nt++] = (png_text){.compression = PNG_TEXT_COMPRESSION_NONE,
-                            .key = "qcs.window", .text = window};
-  }
-  if (nt) png_set_text(png, info, text, nt);
+    ref_text(png, info, im->attr_name[i], im->attr_value[i]);
+  int whole = !im->x0 && !im->y0 && im->full_width == im->width &&
+              im->full_height == im->height;
+  char window[64];
+  snprintf(window, sizeof window, "%d %d %d %d", im->x0, im->y0,
+           im->full_width, im->full_height);
+  if (!whole) ref_text(png, info, "qcs.window", window);
   png_write_info(png, info);
   for (int y = 0; y < im->height; y++) {
     const float *p = im->rgba + 4 * img_index(im, 0, y);
@@ -917,9 +905,9 @@ static void test_png_writer(void) {
       Buf ours = png_in_memory(im, alpha, 1), ref = ref_png_write(im, alpha);
       int wa = 0, ha = 0, na = 0, wb = 0, hb = 0, nb = 0;
       unsigned char *a = ours.p ? png_decode_strict(ours.p, ours.n, &wa, &ha,
-                                                    &na)
+                                                    &na, NULL)
                                 : NULL;
-      unsigned char *b = png_decode_strict(ref.p, ref.n, &wb, &hb, &nb);
+      unsigned char *b = png_decode_strict(ref.p, ref.n, &wb, &hb, &nb, NULL);
       size_t bytes = (size_t)w * (size_t)h * (alpha ? 4 : 3);
       if (a && b && wa == w && ha == h && wb == w && hb == h && na == nb &&
           na == (alpha ? 4 : 3) && !memcmp(a, b, bytes))
