@@ -565,6 +565,8 @@ typedef struct {
   unsigned char level, kind;
   unsigned char plain;     /* its faces are plain (cell, set by the first
                               pass) */
+  unsigned char two;       /* two surfaces in it, each one sheet, not
+                              proven one sheet together (settled: 2) */
   int pl0, npl;            /* LEAF_EXACT: its planes, pls[pl0 .. + npl) */
   double w, gmin;          /* LEAF_SMOOTH: the gradient bound */
 } Leaf;
@@ -609,6 +611,8 @@ typedef struct {
   const Leaf *cur;         /* the leaf being meshed */
   int sharp;               /* make LEAF_EXACT cells */
   int uniform;             /* no leaf above the finest level */
+  int refining;            /* walk splits cells where settled gives 2
+                              (refine_two) */
   int *pls;                /* the planes of the sharp cells (node indices) */
   size_t npls, cappls;
   int *plmap;              /* per node of the subtree: 2 (plane) + flip */
@@ -951,16 +955,12 @@ static int settled(Mesher *m, int c, int one, const double lo[3],
   return whole == 0 ? 2 : 1;
 }
 
-/* A cell [lo, hi] where two surfaces are not proven one sheet together
-   (settled gave 2) is split only when that settles it within k more
+/* A dry run: splitting the cell [lo, hi], where two surfaces are not
+   proven one sheet together (settled gave 2), settles it within k more
    levels: every part of it then proven decided, one sheet, or left to
    the other rules (one node alone not one sheet, sharp halfspaces),
-   none with two surfaces unproven. Else it is meshed as it is, the
-   failure counted (MeshReport.two): splitting a cell where two surfaces
-   touch (one rounded box resting on another: the groove along the edge
-   of the contact narrows to nothing) would only move the place where the
-   mesh closes the groove, and could leave a bubble of it behind. 1 split,
-   0 not. Uses m->st and m->one (walk's classes are spent by then). */
+   none with two surfaces unproven. 1 yes, 0 no. Uses m->st and m->one
+   (walk's classes are spent by then). */
 static int resolvable(Mesher *m, const double lo[3], const double hi[3],
                       int k) {
   if (k <= 0) return 0;
@@ -1008,7 +1008,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     m->rep->full++;
     return 0;
   }
-  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0};
+  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0, 0};
   int leaf = m->uniform && level == m->fine;
   int sheet = 0;           /* the surface in the cell is proven one sheet */
   if (c == T_ONE && clip_in && !m->uniform) {
@@ -1083,9 +1083,9 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
        where the cell is meshed and counted (MeshReport.two) */
     int st = sheet ? 1 : settled(m, c, one, lo, hi);
     if (st == 1) leaf = 1;
-    else if (st == 2 && !resolvable(m, lo, hi, m->fine + TWO_LEVELS - level)) {
-      leaf = 1;
-      if (!m->rep->two++) memcpy(m->rep->two_at, lo, sizeof lo);
+    else if (st == 2 && (!m->refining || level >= m->fine + TWO_LEVELS)) {
+      leaf = 1; /* refine_two decides */
+      lf.two = 1;
     } else if (level == m->depth) {
       memcpy(m->bad, lo, sizeof lo);
       memcpy(m->bad + 3, hi, sizeof hi);
@@ -1119,6 +1119,97 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
              2 * k + (uint32_t)(c8 >> 2 & 1), level + 1) < 0)
       return -1;
   return 0;
+}
+
+/* The leaves where settled gave 2 (Leaf.two), in clusters of cells of one
+   level sharing faces: a cluster is split (walked again, its cells split
+   down to TWO_LEVELS below the finest) only when every cell of it
+   settles so (resolvable); else all of it stays as it is. Where two
+   surfaces touch (a box resting flush on another: the groove under its
+   edge narrows to nothing) no cell at the touch settles, and splitting
+   the cells beside it while those stay would close the groove at two
+   places and leave a bubble of it between; a thin part or gap that does
+   not touch settles everywhere. Then counts the leaves left with two
+   surfaces (MeshReport.two, two_at). 0, or -1 (m->err). */
+static int find(int *p, int x);
+
+static int refine_two(Mesher *m) {
+  size_t n = 0, *ix = NULL;
+  int *par = NULL, rc = -1;
+  hmap at = {0};
+  for (size_t l = 0; l < m->nleaves; l++) n += m->leaves[l].two;
+  if (n && (!(ix = malloc(n * sizeof *ix)) || !(par = malloc(2 * n * sizeof *par)))) {
+    m->err = MESH_ENOMEM;
+    goto done;
+  }
+  n = 0;
+  for (size_t l = 0; l < m->nleaves; l++)
+    if (m->leaves[l].two) {
+      const Leaf *lf = &m->leaves[l];
+      par[n] = (int)n;
+      ix[n] = l;
+      if (hput(&at, ckey(lf->level, lf->q[0], lf->q[1], lf->q[2]), (int)n++) < 0) {
+        m->err = MESH_ENOMEM;
+        goto done;
+      }
+    }
+  for (size_t t = 0; t < n; t++) { /* union the face neighbours */
+    const Leaf *lf = &m->leaves[ix[t]];
+    for (int f = 0; f < 6; f++) {
+      int64_t q[3] = {lf->q[0], lf->q[1], lf->q[2]};
+      q[f >> 1] += f & 1 ? 1 : -1;
+      if (q[f >> 1] < 0) continue;
+      int u = hget(&at, ckey(lf->level, (uint64_t)q[0], (uint64_t)q[1], (uint64_t)q[2]));
+      if (u < 0) continue;
+      int a = find(par, (int)t), b = find(par, u);
+      if (a != b) par[a] = b;
+    }
+  }
+  int *ok = par + n; /* per root: -1 unknown, 0 stays, 1 split */
+  for (size_t t = 0; t < n; t++) ok[t] = -1;
+  for (size_t t = 0; t < n; t++) {
+    int r = find(par, (int)t);
+    if (ok[r] == 0) continue;
+    const Leaf *lf = &m->leaves[ix[t]];
+    double side = ldexp(m->h, m->depth - lf->level), lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+      lo[a] = m->org[a] + side * lf->q[a];
+      hi[a] = lo[a] + side;
+    }
+    ok[r] = resolvable(m, lo, hi, m->fine + TWO_LEVELS - lf->level);
+  }
+  m->refining = 1;
+  for (size_t t = 0; t < n; t++) {
+    if (!ok[find(par, (int)t)]) continue;
+    Leaf lf = m->leaves[ix[t]];
+    m->leaves[ix[t]].level = 0xff; /* gone */
+    m->rep->thin++;
+    if (hput(&m->split, ckey(lf.level, lf.q[0], lf.q[1], lf.q[2]), 1) < 0) {
+      m->err = MESH_ENOMEM;
+      goto done;
+    }
+    for (int c8 = 0; c8 < 8; c8++)
+      if (walk(m, 2 * lf.q[0] + (uint32_t)(c8 & 1), 2 * lf.q[1] + (uint32_t)(c8 >> 1 & 1),
+               2 * lf.q[2] + (uint32_t)(c8 >> 2 & 1), lf.level + 1) < 0)
+        goto done;
+  }
+  size_t w = 0;
+  for (size_t l = 0; l < m->nleaves; l++) {
+    Leaf *lf = &m->leaves[l];
+    if (lf->level == 0xff) continue;
+    if (lf->two && !m->rep->two++) {
+      double side = ldexp(m->h, m->depth - lf->level);
+      for (int a = 0; a < 3; a++) m->rep->two_at[a] = m->org[a] + side * lf->q[a];
+    }
+    m->leaves[w++] = *lf;
+  }
+  m->nleaves = w;
+  rc = 0;
+done:
+  free(ix);
+  free(par);
+  hfree(&at);
+  return rc;
 }
 
 /* Inside at o + t d (the clipped solid). */
@@ -2246,7 +2337,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_ENOMEM;
     goto done;
   }
-  if (walk(&m, 0, 0, 0, 0) < 0) {
+  if (walk(&m, 0, 0, 0, 0) < 0 || refine_two(&m) < 0) {
     rc = m.err;
     if (rc == MESH_ELIMIT)
       snprintf(err, errlen, "the mesh needs more than %zu surface octree "

@@ -24,8 +24,8 @@
  * in it; else it splits again (a part thinner than the cell), down to
  * depth 19, where MESH_ETHIN refuses naming the place and the node. A
  * cell where only the solid is not proven one sheet splits at most
- * TWO_LEVELS more, when that settles it, and is counted
- * (MeshReport.two) where it does not.
+ * TWO_LEVELS more when that settles it and every such cell beside it
+ * (refine_two), and is counted (MeshReport.two) where it does not.
  *
  * The leaves of all sizes are cut into tetrahedra that meet face to face
  * (the Kuhn split where a cell's faces are plain, else a centre point and
