@@ -1138,7 +1138,8 @@ static int refine_two(Mesher *m) {
   int *par = NULL, rc = -1;
   hmap at = {0};
   for (size_t l = 0; l < m->nleaves; l++) n += m->leaves[l].two;
-  if (n && (!(ix = malloc(n * sizeof *ix)) || !(par = malloc(2 * n * sizeof *par)))) {
+  if (!n) return 0;
+  if (!(ix = malloc(n * sizeof *ix)) || !(par = malloc(2 * n * sizeof *par))) {
     m->err = MESH_ENOMEM;
     goto done;
   }
