@@ -28,8 +28,16 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           r->h);
   if (r->thin)
     fprintf(f, "  thin parts: %ld cells split below the finest level (a "
-            "surface in them not proven one sheet), down to depth %d (cell "
+            "surface in them, or the solid where surfaces meet, not proven "
+            "one sheet), down to depth %d (cell "
             "%.4g)\n", r->thin, r->deepest, ldexp(r->h, r->depth - r->deepest));
+  if (r->two)
+    fprintf(f, "  two surfaces: %ld cells (side %.4g, 1/%.0f of the finest) "
+            "hold two surfaces, each one sheet, not proven one sheet "
+            "together: a part or gap between them thinner than the cell may "
+            "be lost or closed there (the first at (%.6g, %.6g, %.6g))\n",
+            r->two, r->two_side, r->h / r->two_side, r->two_at[0],
+            r->two_at[1], r->two_at[2]);
   if (r->sharp_off)
     fprintf(f, "  sharp cells given up: two of them decided a degenerate "
             "case apart; the mesh was made again without them\n");

@@ -681,13 +681,16 @@ int dt_prune_class(const dt_tape *t, const signed char *cls, dt_instr *buf,
   return n;
 }
 
-void dt_range_box(const dt_tape *t, const double lo[3], const double hi[3],
-                  double *dl, double *dh) {
+void dt_range_box_fix(const dt_tape *t, const double lo[3], const double hi[3],
+                      int fix, double v, double *dl, double *dh) {
   double sl[DT_STACK_MAX], sh[DT_STACK_MAX];
   int sp = 0;
   for (int i = 0; i < t->ncode; i++) {
     const dt_instr *in = &t->code[i];
-    if (in->op == DT_LEAF) {
+    if (in->op == DT_LEAF && in->arg == fix) {
+      sl[sp] = sh[sp] = v;
+      sp++;
+    } else if (in->op == DT_LEAF) {
       const dt_leaf *lf = &t->leaves[in->arg];
       double rl, rh;
       vec3_plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
@@ -710,7 +713,15 @@ void dt_range_box(const dt_tape *t, const double lo[3], const double hi[3],
       sh[sp - 1] = h;
     }
   }
-  double m = 1e-12 * (fabs(sl[0]) + fabs(sh[0]) + 1);
-  *dl = sl[0] - m;
-  *dh = sh[0] + m;
+  *dl = sl[0];
+  *dh = sh[0];
+}
+
+void dt_range_box(const dt_tape *t, const double lo[3], const double hi[3],
+                  double *dl, double *dh) {
+  double l, h;
+  dt_range_box_fix(t, lo, hi, -1, 0, &l, &h);
+  double m = 1e-12 * (fabs(l) + fabs(h) + 1);
+  *dl = l - m;
+  *dh = h + m;
 }

@@ -182,6 +182,10 @@ double dt_displacement(double r, double level);
    interval rules (dt_range_op), widened by a relative 1e-12. */
 void dt_range_box(const dt_tape *t, const double lo[3], const double hi[3],
                   double *dl, double *dh);
+/* The same range, not widened, with leaf fix (an index into t->leaves, or
+   -1 for none) taken as the value v over the whole box. */
+void dt_range_box_fix(const dt_tape *t, const double lo[3], const double hi[3],
+                      int fix, double v, double *dl, double *dh);
 
 /* M: the largest density the tape can take (Section 3.4.1), assuming each
  * leaf lies in [0,1]; > 1 flags an ill-formed tree (paper Figure 15b). */

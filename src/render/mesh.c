@@ -18,6 +18,9 @@
 #include "scene/ray.h"
 
 #define MAX_DEPTH 19       /* grid coordinates fit 20 bits */
+/* Cells where two surfaces, each one sheet, are not proven one sheet
+   together split this many levels below the finest at most (walk). */
+#define TWO_LEVELS 2
 
 /* ---- a hash map from 64-bit keys to ints ------------------------------ */
 
@@ -181,11 +184,72 @@ static int same_surface(const Scene *s, int a, int b) {
   return (same && x->d == y->d) || (opp && x->d == -y->d);
 }
 
+/* Node x's surface over [lo, hi] is one plane, (*n, *d) with the solid on
+   one side (n . p < d, or > d): a halfspace's, or a rounded node's whose
+   tape has one live leaf over the box (r > 0), met once in the tape, and
+   whose density with that leaf at 0.5 (the others are 0 or 1 over the
+   box) is exactly 0.5. The density is then affine in that leaf's value
+   (every operation has a constant operand), not constant (the node is
+   undecided), so its 0.5 level is where the leaf is 0.5: its plane. */
+static int node_plane(const Scene *s, int x, const double lo[3],
+                      const double hi[3], const double **n, double *d) {
+  const ScNode *nd = &s->nodes[x];
+  if (nd->kind == SC_HALFSPACE) {
+    *n = nd->n;
+    *d = nd->d;
+    return 1;
+  }
+  if (nd->kind != SC_ROUNDED) return 0;
+  const dt_tape *t = nd->tape;
+  int live = -1, seen = 0;
+  for (int i = 0; i < t->nleaves; i++) { /* leaves whose filter meets the box */
+    const dt_leaf *lf = &t->leaves[i];
+    double rl, rh;
+    vec3_plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
+    if (lf->r <= 0 ? rl <= 0 && rh >= 0 : rl < lf->r && rh > -lf->r) {
+      if (live >= 0 || lf->r <= 0) return 0;
+      live = i;
+    }
+  }
+  if (live < 0) return 0;
+  for (int i = 0; i < t->ncode; i++)
+    seen += t->code[i].op == DT_LEAF && t->code[i].arg == live;
+  double vl, vh;
+  dt_range_box_fix(t, lo, hi, live, 0.5, &vl, &vh);
+  if (seen != 1 || vl != 0.5 || vh != 0.5) return 0;
+  *n = t->leaves[live].n;
+  *d = t->leaves[live].d;
+  return 1;
+}
+
+/* Nodes a and b (not both halfspaces: same_surface has them) have one
+   plane for their surface over [lo, hi] (node_plane), either side. */
+static int same_plane_box(const Scene *s, int a, int b, const double lo[3],
+                          const double hi[3]) {
+  const double *na, *nb;
+  double da, db;
+  if (s->nodes[a].kind == SC_HALFSPACE && s->nodes[b].kind == SC_HALFSPACE)
+    return 0;
+  if (!node_plane(s, a, lo, hi, &na, &da) || !node_plane(s, b, lo, hi, &nb, &db))
+    return 0;
+  int same = 1, opp = 1;
+  for (int i = 0; i < 3; i++) {
+    same &= na[i] == nb[i];
+    opp &= na[i] == -nb[i];
+  }
+  return (same && da == db) || (opp && da == -db);
+}
+
 /* A set operation on classes. T_ONE (undecided, but the solid in the box
    is decided by one node's inside test, so the surface there is that
-   node's) carries its node in *o. */
+   node's) carries its node in *o. With flush set, two
+   nodes whose surfaces over the box [lo, hi] are one plane
+   (same_plane_box: a rounded node with one live leaf, a halfspace) count
+   as the same surface, as two halfspaces on one plane do: a rounded box
+   resting flush on another is then one surface there (none, or the
+   plane), not two sheets facing each other. */
 static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
-                  int *o) {
+                  int *o, const double *lo, const double *hi, int flush) {
   int ra, rb; /* the classes that decide alone */
   switch (k) {
   case SC_UNION:
@@ -213,7 +277,8 @@ static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
     *o = ob;
     return b;
   }
-  if (a == T_ONE && b == T_ONE && same_surface(s, oa, ob)) {
+  if (a == T_ONE && b == T_ONE &&
+      (same_surface(s, oa, ob) || (flush && same_plane_box(s, oa, ob, lo, hi)))) {
     *o = oa;
     return T_ONE;
   }
@@ -224,10 +289,10 @@ static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
 }
 
 /* The node over the box, children first (st and one have room for the
-   subtree); *onep is the node deciding a T_ONE result. */
-static int scene_box(const Scene *s, int node, const double lo[3],
-                     const double hi[3], unsigned char *st, int *one,
-                     int *onep) {
+   subtree); *onep is the node deciding a T_ONE result. flush as set_op's. */
+static int scene_box_g(const Scene *s, int node, const double lo[3],
+                       const double hi[3], unsigned char *st, int *one,
+                       int *onep, int flush) {
   int f = s->nodes[node].first;
   for (int i = f; i <= node; i++) {
     const ScNode *nd = &s->nodes[i];
@@ -237,7 +302,7 @@ static int scene_box(const Scene *s, int node, const double lo[3],
     case SC_INTER:
     case SC_DIFF:
       r = set_op(s, nd->kind, st[nd->a - f], one[nd->a - f], st[nd->b - f],
-                 one[nd->b - f], &o);
+                 one[nd->b - f], &o, lo, hi, flush);
       break;
     default: r = leaf_box(nd, lo, hi); break;
     }
@@ -246,6 +311,12 @@ static int scene_box(const Scene *s, int node, const double lo[3],
   }
   *onep = one[node - f];
   return st[node - f];
+}
+
+static int scene_box(const Scene *s, int node, const double lo[3],
+                     const double hi[3], unsigned char *st, int *one,
+                     int *onep) {
+  return scene_box_g(s, node, lo, hi, st, one, onep, 0);
 }
 
 /* ---- the gradient of a density tape over a box -------------------------- */
@@ -494,6 +565,8 @@ typedef struct {
   unsigned char level, kind;
   unsigned char plain;     /* its faces are plain (cell, set by the first
                               pass) */
+  unsigned char two;       /* two surfaces in it, each one sheet, not
+                              proven one sheet together (settled: 2) */
   int pl0, npl;            /* LEAF_EXACT: its planes, pls[pl0 .. + npl) */
   double w, gmin;          /* LEAF_SMOOTH: the gradient bound */
 } Leaf;
@@ -515,6 +588,8 @@ typedef struct {
                               side of an odd number of differences) */
   unsigned char *st;       /* scene_box scratch: classes */
   int *one;                /* scene_box scratch: T_ONE's node */
+  unsigned char *st2, *rel;/* solid_along scratch: classes, live nodes */
+  int *one2;
   GrIv *gst;               /* grad_box scratch */
   Leaf *leaves;
   size_t nleaves, capleaves;
@@ -536,6 +611,8 @@ typedef struct {
   const Leaf *cur;         /* the leaf being meshed */
   int sharp;               /* make LEAF_EXACT cells */
   int uniform;             /* no leaf above the finest level */
+  int refining;            /* walk splits cells where settled gives 2
+                              (refine_two) */
   int *pls;                /* the planes of the sharp cells (node indices) */
   size_t npls, cappls;
   int *plmap;              /* per node of the subtree: 2 (plane) + flip */
@@ -650,6 +727,16 @@ static int grad_dir(Mesher *m, int x, const double lo[3], const double hi[3],
   return -1;
 }
 
+/* Eighth c of the box [lo, hi] (bit a of c: the upper half along axis a). */
+static void eighth(const double lo[3], const double hi[3], int c, double l2[3],
+                   double h2[3]) {
+  for (int a = 0; a < 3; a++) {
+    double mid = 0.5 * (lo[a] + hi[a]);
+    l2[a] = c >> a & 1 ? mid : lo[a];
+    h2[a] = c >> a & 1 ? hi[a] : mid;
+  }
+}
+
 /* Every line along u meets node x's surface in [lo, hi] at most once when
    each part of the box (the box, or its eighths down to k more levels)
    is proven inside or outside x, or has grad . u > 0 over it: along such
@@ -664,11 +751,7 @@ static int sheet_along(Mesher *m, int x, const double lo[3],
   if (k == 0) return 0;
   for (int c = 0; c < 8; c++) {
     double l2[3], h2[3];
-    for (int a = 0; a < 3; a++) {
-      double mid = 0.5 * (lo[a] + hi[a]);
-      l2[a] = c >> a & 1 ? mid : lo[a];
-      h2[a] = c >> a & 1 ? hi[a] : mid;
-    }
+    eighth(lo, hi, c, l2, h2);
     if (!sheet_along(m, x, l2, h2, u, k - 1)) return 0;
   }
   return 1;
@@ -726,12 +809,129 @@ static int planes_face(const Mesher *m, int x, int y, const double lo[3],
   return t0 > t1;
 }
 
+/* ---- the solid as one sheet where several surfaces cross a cell ------- */
+
+/* The most surfaces solid_along follows in a box. */
+#define SH_MAX 16
+
+/* The surfaces the solid over a box depends on, from scene_box's classes
+   st and one: the undecided leaves reached from the root through
+   undecided nodes, a node decided by one child (T_ONE) passing only to
+   that child's leaf. Into xs; their number, or -1 when there are more
+   than SH_MAX, or when two surfaces were taken as one plane (same_surface,
+   same_plane_box), whose side of it the classes do not give. */
+static int live_surfaces(const Mesher *m, const unsigned char *st,
+                         const int *one, int *xs) {
+  const Scene *s = m->s;
+  int f = s->nodes[m->node].first, n = 0;
+  memset(m->rel, 0, (size_t)(m->node - f + 1));
+  m->rel[m->node - f] = st[m->node - f] != T_IN && st[m->node - f] != T_OUT;
+  for (int x = m->node; x >= f; x--) { /* parents before children */
+    if (!m->rel[x - f]) continue;
+    const ScNode *nd = &s->nodes[x];
+    if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF) {
+      int a = nd->a - f, b = nd->b - f;
+      if (st[x - f] == T_ONE) {
+        if (st[a] == T_ONE && st[b] == T_ONE) return -1;
+        m->rel[one[x - f] - f] = 1;
+      } else {
+        m->rel[a] = st[a] != T_IN && st[a] != T_OUT;
+        m->rel[b] = st[b] != T_IN && st[b] != T_OUT;
+      }
+    } else {
+      if (n == SH_MAX) return -1;
+      xs[n++] = x;
+    }
+  }
+  return n;
+}
+
+/* The inside of node x, taken complemented when it enters the object
+   so (flip), does not shrink along u anywhere in [lo, hi], where x is
+   undecided: a halfspace whose normal n has n . u <= 0 (n . u = 0: the
+   lines along u do not cross it), a rounded or soft field whose
+   gradient's bound has grad . u > 0. */
+static int rising(Mesher *m, int x, const double lo[3], const double hi[3],
+                  const double u[3]) {
+  const ScNode *nd = &m->s->nodes[x];
+  double v[3], g;
+  int f = m->s->nodes[m->node].first;
+  for (int q = 0; q < 3; q++) v[q] = m->flip[x - f] ? -u[q] : u[q];
+  if (nd->kind == SC_HALFSPACE) return vec3_dot(nd->n, v) <= 0;
+  return grad_dir(m, x, lo, hi, NULL, v, &g) == 0 && g > 0;
+}
+
+/* Every line along u meets the boundary of the solid in [lo, hi] at most
+   once when in each part of the box (the box, or its eighths down to k
+   more levels) the solid is proven inside or outside, or every surface
+   it depends on there (live_surfaces) is rising along u. The object is a
+   union, intersection and difference of its nodes: with each node
+   complemented where it enters through the right side of a difference,
+   it grows with each of them, so along a line where each only grows (its
+   inside a half-line, or all or none) so does the object: its inside
+   there is a half-line. In a part of the box proven inside or outside it
+   is constant, and the parts are closed boxes sharing their faces, so
+   along the whole line it only grows: it is crossed once. xs (n of them)
+   are the surfaces live in the box holding this one: when they all rise
+   the box is not classified again. */
+static int solid_along(Mesher *m, const double lo[3], const double hi[3],
+                       const double u[3], int k, const int *xs, int n) {
+  int ok = 1, one, ys[SH_MAX];
+  for (int i = 0; i < n && ok; i++) ok = rising(m, xs[i], lo, hi, u);
+  if (ok) return 1;
+  int c = scene_box_g(m->s, m->node, lo, hi, m->st2, m->one2, &one, 0);
+  if (c == T_IN || c == T_OUT) return 1;
+  int ny = live_surfaces(m, m->st2, m->one2, ys);
+  if (ny < 0) return 0;
+  ok = 1;
+  for (int i = 0; i < ny && ok; i++) ok = rising(m, ys[i], lo, hi, u);
+  if (ok) return 1;
+  if (k == 0) return 0;
+  for (int c8 = 0; c8 < 8; c8++) {
+    double l2[3], h2[3];
+    eighth(lo, hi, c8, l2, h2);
+    if (!solid_along(m, l2, h2, u, k - 1, ys, ny)) return 0;
+  }
+  return 1;
+}
+
+/* The solid's boundary in the box is one sheet (solid_along) along the
+   mean u of the surfaces' directions there (the midpoints of their
+   gradients' bounds, each unit and turned by the node's flip; a
+   halfspace's -n). 1 proven, 0 not, -1 when fewer than two surfaces
+   cross the box, or only planes (the sharp rules have them). */
+static int solid_sheet(Mesher *m, const double lo[3], const double hi[3]) {
+  int xs[SH_MAX], n = live_surfaces(m, m->st, m->one, xs), curved = 0;
+  if (n < 0) return 0;
+  double u[3] = {0, 0, 0};
+  int f = m->s->nodes[m->node].first;
+  for (int i = 0; i < n; i++) {
+    const ScNode *nd = &m->s->nodes[xs[i]];
+    double g[3], len;
+    if (nd->kind == SC_HALFSPACE)
+      for (int q = 0; q < 3; q++) g[q] = -nd->n[q];
+    else if (grad_dir(m, xs[i], lo, hi, g, NULL, NULL) < 0) return 0;
+    else curved = 1;
+    len = sqrt(vec3_dot(g, g)) * (m->flip[xs[i] - f] ? -1 : 1);
+    if (!(fabs(len) > 0) || !isfinite(len)) return 0;
+    for (int q = 0; q < 3; q++) u[q] += g[q] / len;
+  }
+  if (n < 2 || !curved) return -1;
+  double len = sqrt(vec3_dot(u, u));
+  if (!(len > 1e-9 * n) || !isfinite(len)) return 0;
+  for (int q = 0; q < 3; q++) u[q] /= len;
+  return solid_along(m, lo, hi, u, 2, xs, n);
+}
+
 /* An undecided cell at or below the finest level is settled (meshed by
-   marching tetrahedra from its corners' signs) when each surface that
-   may cross it is one sheet there (one_sheet): the node deciding the
-   solid in the cell, or else every undecided leaf; and no two undecided
-   sharp halfspaces face each other across it (planes_face). Two sides
-   of a thin part of one node are never one sheet. 1 settled, 0 not. */
+   marching tetrahedra from its corners' signs) when the solid's boundary
+   in it is proven one sheet: the surface of the node deciding the solid
+   in the cell (one_sheet), or where several surfaces may cross it, the
+   solid's own (solid_sheet); and no two undecided sharp halfspaces face
+   each other across it (planes_face). 1 settled; 0 not, a surface alone
+   not proven one sheet (two sides of a thin part of one node); 2 not,
+   but each surface alone is one sheet: two of them may bound a part, or
+   a gap, thinner than the cell. */
 static int settled(Mesher *m, int c, int one, const double lo[3],
                    const double hi[3]) {
   m->badnode = -1;
@@ -739,17 +939,39 @@ static int settled(Mesher *m, int c, int one, const double lo[3],
     return one_sheet(m, one, lo, hi) ? 1 : ((void)(m->badnode = one), 0);
   int f = m->s->nodes[m->node].first;
   for (int x = f; x <= m->node; x++) {
+    if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+    for (int y = f; y < x; y++)
+      if (m->s->nodes[y].kind == SC_HALFSPACE && m->st[y - f] == T_ONE &&
+          !same_surface(m->s, x, y) && planes_face(m, x, y, lo, hi))
+        return (void)(m->badnode = x), 0;
+  }
+  int whole = solid_sheet(m, lo, hi);
+  if (whole == 1) return 1;
+  for (int x = f; x <= m->node; x++) {
     ScKind k = m->s->nodes[x].kind;
-    if (m->st[x - f] != T_ONE) continue;
-    if (k == SC_HALFSPACE) {
-      for (int y = f; y < x; y++)
-        if (m->s->nodes[y].kind == SC_HALFSPACE && m->st[y - f] == T_ONE &&
-            !same_surface(m->s, x, y) && planes_face(m, x, y, lo, hi))
-          return (void)(m->badnode = x), 0;
-      continue;
-    }
-    if (k != SC_ROUNDED && k != SC_SOFT) continue;
+    if (m->st[x - f] != T_ONE || (k != SC_ROUNDED && k != SC_SOFT)) continue;
     if (!one_sheet(m, x, lo, hi)) return (void)(m->badnode = x), 0;
+  }
+  return whole == 0 ? 2 : 1;
+}
+
+/* A dry run: splitting the cell [lo, hi], where two surfaces are not
+   proven one sheet together (settled gave 2), settles it within k more
+   levels: every part of it then proven decided, one sheet, or left to
+   the other rules (one node alone not one sheet, sharp halfspaces),
+   none with two surfaces unproven. 1 yes, 0 no. Uses m->st and m->one
+   (walk's classes are spent by then). */
+static int resolvable(Mesher *m, const double lo[3], const double hi[3],
+                      int k) {
+  if (k <= 0) return 0;
+  for (int c8 = 0; c8 < 8; c8++) {
+    double l2[3], h2[3];
+    int one;
+    eighth(lo, hi, c8, l2, h2);
+    int c = scene_box_g(m->s, m->node, l2, h2, m->st, m->one, &one, 1);
+    if (c != T_MIX) continue;
+    if (settled(m, c, one, l2, h2) == 2 && !resolvable(m, l2, h2, k - 1))
+      return 0;
   }
   return 1;
 }
@@ -775,7 +997,8 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     if (lo[a] <= m->clo[a] || hi[a] >= m->chi[a]) clip_in = 0;
   }
   int one = -1;
-  int c = clip_out ? T_OUT : scene_box(m->s, m->node, lo, hi, m->st, m->one, &one);
+  int c = clip_out ? T_OUT
+                   : scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one, 1);
   if (c == T_IN && !clip_in) c = T_MIX;
   if (c == T_OUT) {
     m->rep->empty++;
@@ -785,7 +1008,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
     m->rep->full++;
     return 0;
   }
-  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0};
+  Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0, 0};
   int leaf = m->uniform && level == m->fine;
   int sheet = 0;           /* the surface in the cell is proven one sheet */
   if (c == T_ONE && clip_in && !m->uniform) {
@@ -855,9 +1078,15 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   if (!leaf && level >= m->fine && !m->uniform) {
     /* the finest level, or below it: a thin part of the object (two of
        its sides in one cell) or a fold splits the cell further, down to
-       the octree's limit */
-    if (sheet || settled(m, c, one, lo, hi)) leaf = 1;
-    else if (level == m->depth) {
+       the octree's limit; two surfaces each one sheet but not proven one
+       sheet together split it down to TWO_LEVELS below the finest level,
+       where the cell is meshed and counted (MeshReport.two) */
+    int st = sheet ? 1 : settled(m, c, one, lo, hi);
+    if (st == 1) leaf = 1;
+    else if (st == 2 && (!m->refining || level >= m->fine + TWO_LEVELS)) {
+      leaf = 1; /* refine_two decides */
+      lf.two = 1;
+    } else if (level == m->depth) {
       memcpy(m->bad, lo, sizeof lo);
       memcpy(m->bad + 3, hi, sizeof hi);
       m->err = MESH_ETHIN;
@@ -890,6 +1119,98 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
              2 * k + (uint32_t)(c8 >> 2 & 1), level + 1) < 0)
       return -1;
   return 0;
+}
+
+/* The leaves where settled gave 2 (Leaf.two), in clusters of cells of one
+   level sharing faces: a cluster is split (walked again, its cells split
+   down to TWO_LEVELS below the finest) only when every cell of it
+   settles so (resolvable); else all of it stays as it is. Where two
+   surfaces touch (a box resting flush on another: the groove under its
+   edge narrows to nothing) no cell at the touch settles, and splitting
+   the cells beside it while those stay would close the groove at two
+   places and leave a bubble of it between; a thin part or gap that does
+   not touch settles everywhere. Then counts the leaves left with two
+   surfaces (MeshReport.two, two_at). 0, or -1 (m->err). */
+static int find(int *p, int x);
+
+static int refine_two(Mesher *m) {
+  size_t n = 0, *ix = NULL;
+  int *par = NULL, rc = -1;
+  hmap at = {0};
+  for (size_t l = 0; l < m->nleaves; l++) n += m->leaves[l].two;
+  if (!n) return 0;
+  if (!(ix = malloc(n * sizeof *ix)) || !(par = malloc(2 * n * sizeof *par))) {
+    m->err = MESH_ENOMEM;
+    goto done;
+  }
+  n = 0;
+  for (size_t l = 0; l < m->nleaves; l++)
+    if (m->leaves[l].two) {
+      const Leaf *lf = &m->leaves[l];
+      par[n] = (int)n;
+      ix[n] = l;
+      if (hput(&at, ckey(lf->level, lf->q[0], lf->q[1], lf->q[2]), (int)n++) < 0) {
+        m->err = MESH_ENOMEM;
+        goto done;
+      }
+    }
+  for (size_t t = 0; t < n; t++) { /* union the face neighbours */
+    const Leaf *lf = &m->leaves[ix[t]];
+    for (int f = 0; f < 6; f++) {
+      int64_t q[3] = {lf->q[0], lf->q[1], lf->q[2]};
+      q[f >> 1] += f & 1 ? 1 : -1;
+      if (q[f >> 1] < 0) continue;
+      int u = hget(&at, ckey(lf->level, (uint64_t)q[0], (uint64_t)q[1], (uint64_t)q[2]));
+      if (u < 0) continue;
+      int a = find(par, (int)t), b = find(par, u);
+      if (a != b) par[a] = b;
+    }
+  }
+  int *ok = par + n; /* per root: -1 unknown, 0 stays, 1 split */
+  for (size_t t = 0; t < n; t++) ok[t] = -1;
+  for (size_t t = 0; t < n; t++) {
+    int r = find(par, (int)t);
+    if (ok[r] == 0) continue;
+    const Leaf *lf = &m->leaves[ix[t]];
+    double side = ldexp(m->h, m->depth - lf->level), lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+      lo[a] = m->org[a] + side * lf->q[a];
+      hi[a] = lo[a] + side;
+    }
+    ok[r] = resolvable(m, lo, hi, m->fine + TWO_LEVELS - lf->level);
+  }
+  m->refining = 1;
+  for (size_t t = 0; t < n; t++) {
+    if (!ok[find(par, (int)t)]) continue;
+    Leaf lf = m->leaves[ix[t]];
+    m->leaves[ix[t]].level = 0xff; /* gone */
+    m->rep->thin++;
+    if (hput(&m->split, ckey(lf.level, lf.q[0], lf.q[1], lf.q[2]), 1) < 0) {
+      m->err = MESH_ENOMEM;
+      goto done;
+    }
+    for (int c8 = 0; c8 < 8; c8++)
+      if (walk(m, 2 * lf.q[0] + (uint32_t)(c8 & 1), 2 * lf.q[1] + (uint32_t)(c8 >> 1 & 1),
+               2 * lf.q[2] + (uint32_t)(c8 >> 2 & 1), lf.level + 1) < 0)
+        goto done;
+  }
+  size_t w = 0;
+  for (size_t l = 0; l < m->nleaves; l++) {
+    Leaf *lf = &m->leaves[l];
+    if (lf->level == 0xff) continue;
+    if (lf->two && !m->rep->two++) {
+      double side = ldexp(m->h, m->depth - lf->level);
+      for (int a = 0; a < 3; a++) m->rep->two_at[a] = m->org[a] + side * lf->q[a];
+    }
+    m->leaves[w++] = *lf;
+  }
+  m->nleaves = w;
+  rc = 0;
+done:
+  free(ix);
+  free(par);
+  hfree(&at);
+  return rc;
 }
 
 /* Inside at o + t d (the clipped solid). */
@@ -1986,6 +2307,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   rep->depth = depth;
   rep->h = L / ldexp(1, depth);
   rep->deepest = depth;
+  rep->two_side = ldexp(rep->h, -TWO_LEVELS);
   rep->vtol = vtol;
   int nsub = node - s->nodes[node].first + 1;
   m.st = malloc((size_t)nsub);
@@ -1994,6 +2316,9 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.plmap = malloc((size_t)nsub * sizeof *m.plmap);
   m.pv = malloc((size_t)nsub);
   m.flip = malloc((size_t)nsub);
+  m.st2 = malloc((size_t)nsub);
+  m.rel = malloc((size_t)nsub);
+  m.one2 = malloc((size_t)nsub * sizeof *m.one2);
   if (m.flip) { /* the subtree is contiguous, children before parents */
     int f = s->nodes[node].first;
     m.flip[nsub - 1] = 0;
@@ -2008,11 +2333,12 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.ex = malloc(sizeof *m.ex);
   m.ray = ray_ctx_new(s, vtol);
   int rc = MESH_OK;
-  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.flip || !m.ex || !m.ray) {
+  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.flip || !m.st2 || !m.rel || !m.one2 || !m.ex ||
+      !m.ray) {
     rc = MESH_ENOMEM;
     goto done;
   }
-  if (walk(&m, 0, 0, 0, 0) < 0) {
+  if (walk(&m, 0, 0, 0, 0) < 0 || refine_two(&m) < 0) {
     rc = m.err;
     if (rc == MESH_ELIMIT)
       snprintf(err, errlen, "the mesh needs more than %zu surface octree "
@@ -2156,6 +2482,9 @@ done:
   free(m.plmap);
   free(m.pv);
   free(m.flip);
+  free(m.st2);
+  free(m.rel);
+  free(m.one2);
   free(m.ex);
   free(m.pls);
   free(m.vert2.k);

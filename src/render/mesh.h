@@ -17,10 +17,15 @@
  * else it is split, down to the finest level whose side the tolerance
  * fixes. There, and below it, a cell is kept only when each surface in
  * it is proven one sheet (mesh.c, settled: every line along one
- * direction meets it once, after Plantinga and Vegter) and no two
- * undecided planes cross it without meeting in it; else it splits again
- * (a part thinner than the cell), down to depth 19, where MESH_ETHIN
- * refuses naming the place and the node.
+ * direction meets it once, after Plantinga and Vegter), where two or
+ * more surfaces cross it the solid's own boundary is (solid_sheet: every
+ * node, complemented where a difference complements it, growing along
+ * one direction), and no two undecided planes cross it without meeting
+ * in it; else it splits again (a part thinner than the cell), down to
+ * depth 19, where MESH_ETHIN refuses naming the place and the node. A
+ * cell where only the solid is not proven one sheet splits at most
+ * TWO_LEVELS more when that settles it and every such cell beside it
+ * (refine_two), and is counted (MeshReport.two) where it does not.
  *
  * The leaves of all sizes are cut into tetrahedra that meet face to face
  * (the Kuhn split where a cell's faces are plain, else a centre point and
@@ -89,6 +94,11 @@ typedef struct MeshReport {
                               because a surface in them was not proven
                               one sheet (a part thinner than the cell) */
   int deepest;             /* the deepest level of a surface cell */
+  long two;                /* cells meshed with two surfaces in them, each
+                              one sheet, not proven one sheet together
+                              (mesh.c, TWO_LEVELS below the finest) */
+  double two_side;         /* their side */
+  double two_at[3];        /* the lowest corner of the first */
   double vtol;             /* the vertices' distance bound */
   double certified;        /* the proven bound, see above */
   double measured;         /* the largest distance along the normal from
