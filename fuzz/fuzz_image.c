@@ -53,7 +53,10 @@ static Image *roundtrip(const Image *im, Writer w, const ImgWriteOptions *o,
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (size < 4) return 0;
   int w = data[0] % 64 + 1, h = data[1] % 64 + 1, flags = data[2] & 7;
-  ImgWriteOptions o = {data[3] & 1, (data[3] >> 1) & 1, (data[3] >> 2) & 1};
+  ImgWriteOptions o = {.float_pixels = data[3] & 1,
+                       .no_compression = (data[3] >> 1) & 1,
+                       .alpha = (data[3] >> 2) & 1,
+                       .threads = 1 + ((data[3] >> 3) & 3)};
   data += 4;
   size -= 4;
   Image *im = img_new(w, h, flags);
