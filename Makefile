@@ -70,8 +70,10 @@ BIN ?= qcs
 
 all: $(BIN)
 
+# qcs itself is linked without libzip: src/app/zipload.c loads it when a
+# 3MF file is first written (the tests, without app/, link it).
 $(BIN): $(APP_OBJS) $(LAYER_LIBS) $(BUILD)/layers.ok
-	$(CC) $(ALL_CFLAGS) -o $@ $(APP_OBJS) $(LAYER_LIBS) $(LIBS) $(APP_LIBS)
+	$(CC) $(ALL_CFLAGS) -o $@ $(APP_OBJS) $(LAYER_LIBS) $(filter-out -lzip,$(LIBS)) $(APP_LIBS)
 
 $(APP_OBJS): ALL_CFLAGS += $(APP_CFLAGS)
 
