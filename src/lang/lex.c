@@ -44,6 +44,10 @@ static Token *push(Lexer *L, TokKind k, Pos pos, const char *start) {
     L->cap = L->cap ? 2 * L->cap : 256;
     Token *t = GC_MALLOC(sizeof(Token) * (size_t)L->cap);
     if (L->n) memcpy(t, L->toks, sizeof(Token) * (size_t)L->n);
+    /* the old array goes back to the collector at once: its pages are
+       used again instead of new ones (the prelude's arrays grow to 4096
+       tokens) */
+    if (L->toks) GC_FREE(L->toks);
     L->toks = t;
   }
   Token *t = &L->toks[L->n++];
@@ -299,3 +303,5 @@ Token *lex_all(const Src *src, int *ntokens) {
   *ntokens = L.n;
   return L.toks;
 }
+
+void lex_free(Token *toks) { GC_FREE(toks); }

@@ -43,16 +43,20 @@ typedef enum {
 
 typedef struct Token {
   TokKind kind;
-  Pos pos;
   int bol;           /* first token on its line */
+  Pos pos;
   const char *start; /* into the source text */
   int len;
-  double num;        /* T_NUM */
-  const char *str;   /* T_STR: the decoded string (NUL-terminated) */
-} Token;
+  union {
+    double num;      /* T_NUM */
+    const char *str; /* T_STR: the decoded string (NUL-terminated) */
+  };
+} Token;             /* 48 bytes: the prelude and the kit are 6500 */
 
-/* Tokenise src->text. Returns the array, ending with a T_EOF token. */
+/* Tokenise src->text. Returns the array, ending with a T_EOF token; the
+   caller may hand it back with lex_free once nothing points into it. */
 Token *lex_all(const Src *src, int *ntokens);
+void lex_free(Token *toks);
 
 /* "'('", "name", ... for error messages. */
 const char *tok_kind_name(TokKind k);

@@ -1328,6 +1328,7 @@ Item **parse_program(Interp *I, const Src *src, RunMode mode, int *nitems) {
                    describe(&P));
   }
   *nitems = items.n;
+  lex_free(P.toks); /* nothing made points into the tokens */
   return (Item **)items.items;
 }
 
@@ -1338,5 +1339,6 @@ Expr *parse_expression(Interp *I, const Src *src) {
   if (peek(&P) == T_SEMI) next(&P);
   if (peek(&P) != T_EOF)
     error_at_token(&P, "unexpected %s after the expression", describe(&P));
+  lex_free(P.toks);
   return e;
 }
