@@ -22,6 +22,7 @@ typedef struct Lexer {
   int bol;
   Token *toks;
   int n, cap;
+  const char *end; /* no token starts here or after (NULL: the text's end) */
 } Lexer;
 
 static Pos here(Lexer *L) { return (Pos){L->src, L->line, L->col}; }
@@ -236,13 +237,19 @@ static const struct {
 };
 
 Token *lex_all(const Src *src, int *ntokens) {
-  Lexer L = {src, src->text, 1, 1, 1, NULL, 0, 0};
+  return lex_range(src, 0, 0, 1, ntokens);
+}
+
+Token *lex_range(const Src *src, size_t start_at, size_t end_at, int line,
+                 int *ntokens) {
+  Lexer L = {src, src->text + start_at, line, 1, 1, NULL, 0, 0,
+             end_at ? src->text + end_at : NULL};
   for (;;) {
     skip_space(&L);
     Pos pos = here(&L);
     const char *start = L.p;
     unsigned char c = (unsigned char)*L.p;
-    if (c == 0) {
+    if (c == 0 || (L.end && L.p >= L.end)) {
       push(&L, T_EOF, pos, start);
       break;
     }

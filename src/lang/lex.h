@@ -12,6 +12,8 @@
 #ifndef QCS_LEX_H
 #define QCS_LEX_H
 
+#include <stddef.h>
+
 #include "lang/error.h"
 
 #define TOKENS(X)                                                      \
@@ -56,6 +58,12 @@ typedef struct Token {
 /* Tokenise src->text. Returns the array, ending with a T_EOF token; the
    caller may hand it back with lex_free once nothing points into it. */
 Token *lex_all(const Src *src, int *ntokens);
+/* The tokens of src->text from byte start_at, which begins line `line`
+   (column 1), to byte end_at (0: the text's end), which must be where a
+   line begins outside any comment or string: the prelude's definitions,
+   each read when first used (interp.c). */
+Token *lex_range(const Src *src, size_t start_at, size_t end_at, int line,
+                 int *ntokens);
 void lex_free(Token *toks);
 
 /* "'('", "name", ... for error messages. */
