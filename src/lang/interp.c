@@ -1531,20 +1531,26 @@ static __attribute__((noinline)) int scan_items(const char *text,
         items[n++] = (ScanItem){type, p, nlen, (size_t)(p - text), line};
       }
     }
-    /* the rest of the line: comments (nested) and strings */
-    while (*p && *p != '\n') {
+    /* the rest of the line: comments (nested) and strings, looked into
+       only if the line holds a '/' (or, outside comments, a '"') */
+    const char *nl = strchr(p, '\n');
+    if (!nl) nl = p + strlen(p);
+    if (!memchr(p, '/', (size_t)(nl - p)) &&
+        (depth > 0 || !memchr(p, '"', (size_t)(nl - p))))
+      p = nl;
+    while (p < nl) {
       if (depth > 0) {
         if (p[0] == '/' && p[1] == '*') depth++, p += 2;
         else if (p[0] == '*' && p[1] == '/') depth--, p += 2;
         else p++;
       } else if (p[0] == '/' && p[1] == '/') {
-        while (*p && *p != '\n') p++;
+        p = nl;
       } else if (p[0] == '/' && p[1] == '*') {
         depth++, p += 2;
       } else if (*p == '"') {
-        for (p++; *p && *p != '"' && *p != '\n'; p++)
-          if (*p == '\\' && p[1] && p[1] != '\n') p++;
-        if (*p == '"') p++;
+        for (p++; p < nl && *p != '"'; p++)
+          if (*p == '\\' && p + 1 < nl) p++;
+        if (p < nl) p++;
       } else {
         p++;
       }
