@@ -244,6 +244,11 @@ Token *lex_range(const Src *src, size_t start_at, size_t end_at, int line,
                  int *ntokens) {
   Lexer L = {src, src->text + start_at, line, 1, 1, NULL, 0, 0,
              end_at ? src->text + end_at : NULL};
+  /* about one token per 6 bytes of qcs: an array that rarely grows, and
+     no 256-token one for a 200-byte definition */
+  size_t bytes = end_at ? end_at - start_at : strlen(L.p);
+  L.cap = bytes / 5 + 8 < 1 << 20 ? (int)(bytes / 5 + 8) : 1 << 20;
+  L.toks = GC_MALLOC(sizeof(Token) * (size_t)L.cap);
   for (;;) {
     skip_space(&L);
     Pos pos = here(&L);
