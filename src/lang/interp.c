@@ -1466,10 +1466,19 @@ void interp_materialize(Interp *I, Sym *s) {
     if (items[i]->kind == ITEM_DEF) snapshot_prelude(items[i]->def->name);
 }
 
-/* Every definition not read yet, read (:browse! lists them all). */
+/* Every definition not read yet, read (:browse! lists them all). Reading
+   one may intern names and so grow and rehash the table being walked:
+   walked again until a walk reads nothing. */
 static void materialize_all(Interp *I) {
-  for (size_t h = 0; h < I->symcap; h++)
-    for (Sym *s = I->symtab[h]; s; s = s->next) interp_materialize(I, s);
+  for (int again = 1; again;) {
+    again = 0;
+    for (size_t h = 0; h < I->symcap; h++)
+      for (Sym *s = I->symtab[h]; s; s = s->next)
+        if (s->lazy && !s->lazy->busy) {
+          interp_materialize(I, s);
+          again = 1;
+        }
+  }
 }
 
 static int name_start(char c) {
