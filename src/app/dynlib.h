@@ -26,4 +26,22 @@
 int dynlib_load(const char *const *sonames, const char *package,
                 const char *const *names, void **fns, size_t n, char *err,
                 size_t errlen);
+
+/* A table of pointers named by an X-macro LIST (X(f) for each name),
+   declared as a struct of `__typeof__(f) *f;` (functions in the types of
+   the library's header, pointers to its variables), filled from the
+   first of sonames that loads: DYNLIB_LOAD(tab, LIST, sonames, package,
+   what) is 0, or -1 after "qcs: WHAT: why" on stderr. The pointers are
+   copied in as bytes, so each member keeps its declared type; a table
+   that is not one pointer per name is refused. */
+#define DYNLIB_NAME(f) #f,
+#define DYNLIB_LOAD(tab, LIST, sonames, package, what)                      \
+  dynlib_load_table(sonames, package,                                       \
+                    (const char *const[]){LIST(DYNLIB_NAME)},               \
+                    sizeof((const char *const[]){LIST(DYNLIB_NAME)}) /      \
+                        sizeof(const char *),                               \
+                    &(tab), sizeof(tab), what)
+int dynlib_load_table(const char *const *sonames, const char *package,
+                      const char *const *names, size_t n, void *table,
+                      size_t table_size, const char *what);
 #endif

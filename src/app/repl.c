@@ -54,6 +54,7 @@
   X(rl_callback_handler_install) X(rl_resize_terminal)                    \
   X(rl_deprep_terminal) X(rl_prep_terminal) X(rl_forced_update_display)   \
   X(rl_callback_read_char)
+#define RL_ALL(X) RL_FUNCS(X) RL_VARS(X)
 #define RL_VARS(X)                                                         \
   X(history_length) X(history_base) X(rl_line_buffer)                     \
   X(rl_attempted_completion_over) X(rl_outstream) X(rl_point) X(rl_end)   \
@@ -75,23 +76,7 @@ static struct {
 static int readline_load(void) {
   static const char *const sonames[] = {"libreadline.so.8", "libreadline.so",
                                         NULL};
-  static const char *const names[] = {
-#define X(f) #f,
-      RL_FUNCS(X) RL_VARS(X)
-#undef X
-  };
-  void *p[sizeof names / sizeof *names];
-  char err[300];
-  if (dynlib_load(sonames, "libreadline8", names, p,
-                  sizeof names / sizeof *names, err, sizeof err)) {
-    fprintf(stderr, "qcs: no line editing: %s\n", err);
-    return -1;
-  }
-  size_t k = 0;
-#define X(f) memcpy(&rl.f, &p[k++], sizeof rl.f);
-  RL_FUNCS(X) RL_VARS(X)
-#undef X
-  return 0;
+  return DYNLIB_LOAD(rl, RL_ALL, sonames, "libreadline8", "no line editing");
 }
 #define using_history (rl.using_history)
 #define stifle_history (rl.stifle_history)

@@ -40,19 +40,7 @@ static int zip_loaded; /* 1 once loaded, -1 if it cannot be */
 static void zip_load_once(void) {
   static const char *const sonames[] = {"libzip.so.4", "libzip.so.5",
                                         "libzip.so", NULL};
-  static const char *const names[] = {
-#define X(f) #f,
-      ZIP_FNS(X)
-#undef X
-  };
-  char err[256];
-  if (dynlib_load(sonames, "libzip4", names, (void **)&zf,
-                  sizeof names / sizeof *names, err, sizeof err)) {
-    fprintf(stderr, "qcs: error: %s\n", err);
-    zip_loaded = -1;
-    return;
-  }
-  zip_loaded = 1;
+  zip_loaded = DYNLIB_LOAD(zf, ZIP_FNS, sonames, "libzip4", "error") ? -1 : 1;
 }
 
 static int zip_load(void) {
