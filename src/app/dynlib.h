@@ -6,15 +6,17 @@
  * friends) are loaded by dlopen the first time a picture is drawn or a
  * viewer starts: a script, a farm task or an animation frame does not pay
  * for their thirteen libraries (about 4 million instructions of dynamic
- * linking a process).
+ * linking a process). So are libzip (3MF meshes, app/zipload.c: with
+ * libcrypto and libbz2, about 0.8 ms a process) and GNU readline (the
+ * prompt on a terminal, app/repl.c: with libtinfo, 3600 relocations).
  *
- * A module that uses such a library lists the functions it calls in an
- * X-macro and declares, after the library's own header, a table of
- * pointers of the functions' own types (__typeof__), so every call keeps
- * the header's prototype. dynlib_load fills the table.
+ * A module that uses such a library lists the functions (and variables)
+ * it uses in an X-macro and declares, after the library's own header, a
+ * table of pointers of their own types (__typeof__), so every call keeps
+ * the header's prototype. DYNLIB_LOAD fills the table.
  *
- * Threads: call dynlib_load from one thread before others use the table
- * (the REPL's thread, the viewer's start). */
+ * Threads: load from one thread before others use the table (the REPL's
+ * thread, the viewer's start; zipload.c loads under pthread_once). */
 #ifndef QCS_DYNLIB_H
 #define QCS_DYNLIB_H
 
