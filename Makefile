@@ -71,8 +71,12 @@ BIN ?= qcs
 
 all: $(BIN)
 
+# qcs itself is linked without libzip and readline: src/app/zipload.c
+# loads libzip when a 3MF file is first written, src/app/repl.c readline
+# when the prompt first runs on a terminal (the tests, without app/, link
+# both as the layers' users would).
 $(BIN): $(APP_OBJS) $(LAYER_LIBS) $(BUILD)/layers.ok
-	$(CC) $(ALL_CFLAGS) -o $@ $(APP_OBJS) $(LAYER_LIBS) $(LIBS) $(APP_LIBS)
+	$(CC) $(ALL_CFLAGS) -o $@ $(APP_OBJS) $(LAYER_LIBS) $(filter-out -lzip -lreadline,$(LIBS)) $(APP_LIBS)
 
 $(APP_OBJS): ALL_CFLAGS += $(APP_CFLAGS)
 

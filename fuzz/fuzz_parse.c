@@ -26,7 +26,7 @@ static void parse_as(const Src *src, RunMode mode, int expr) {
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (!I) I = bind_interp_new();
   FUZZ_STACK(I);
-  Src src = {"<fuzz>", fuzz_text(data, size), 0};
+  Src src = {"<fuzz>", fuzz_text(data, size), 0, NULL, 0};
   parse_as(&src, MODE_SCRIPT, 0);
   parse_as(&src, MODE_REPL, 0);
   parse_as(&src, MODE_REPL, 1);

@@ -3,6 +3,8 @@
 
 #include <dlfcn.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 int dynlib_load(const char *const *sonames, const char *package,
                 const char *const *names, void **fns, size_t n, char *err,
@@ -27,4 +29,23 @@ int dynlib_load(const char *const *sonames, const char *package,
     }
   }
   return 0;
+}
+
+int dynlib_load_table(const char *const *sonames, const char *package,
+                      const char *const *names, size_t n, void *table,
+                      size_t table_size, const char *what) {
+  char err[300];
+  void **fns = NULL;
+  int rc = -1;
+  if (table_size != n * sizeof *fns)
+    snprintf(err, sizeof err, "the table for %s is not %zu pointers",
+             sonames[0], n);
+  else if (!(fns = malloc(n * sizeof *fns)))
+    snprintf(err, sizeof err, "out of memory loading %s", sonames[0]);
+  else
+    rc = dynlib_load(sonames, package, names, fns, n, err, sizeof err);
+  if (rc == 0) memcpy(table, fns, n * sizeof *fns);
+  else fprintf(stderr, "qcs: %s: %s\n", what, err);
+  free(fns);
+  return rc;
 }

@@ -41,23 +41,10 @@ static int cf_state; /* 0: not tried, 1: loaded, -1: failed */
 static int chafa_load(void) {
   if (cf_state) return cf_state > 0 ? 0 : -1;
   static const char *const sonames[] = {"libchafa.so.0", "libchafa.so", NULL};
-  static const char *const names[] = {
-#define X(f) #f,
-      CHAFA_FUNCS(X)
-#undef X
-  };
-  void *fns[sizeof names / sizeof *names];
-  char err[300];
-  if (dynlib_load(sonames, "libchafa0", names, fns,
-                  sizeof names / sizeof *names, err, sizeof err)) {
-    fprintf(stderr, "qcs: no pictures: %s\n", err);
+  if (DYNLIB_LOAD(cf, CHAFA_FUNCS, sonames, "libchafa0", "no pictures")) {
     cf_state = -1;
     return -1;
   }
-  size_t k = 0;
-#define X(f) memcpy(&cf.f, &fns[k++], sizeof cf.f);
-  CHAFA_FUNCS(X)
-#undef X
   cf_state = 1;
   return 0;
 }

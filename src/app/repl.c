@@ -37,6 +37,83 @@
 #include <readline/history.h>
 #include <readline/readline.h>
 
+#include "app/dynlib.h"
+
+/* GNU readline (and the terminfo library it brings) is loaded when the
+   prompt first runs on a terminal (app/dynlib.h), not linked: scripts,
+   -e and piped input, which never use it, do not pay for its dynamic
+   linking at start-up (about 0.2 ms of CPU a run). The functions and
+   variables this file uses, read through a table of pointers of their
+   header's types; the names below stand for them. */
+#define RL_FUNCS(X)                                                        \
+  X(using_history) X(stifle_history) X(read_history) X(append_history)    \
+  X(history_truncate_file) X(history_get) X(add_history)                  \
+  X(rl_completion_matches) X(rl_filename_completion_function)             \
+  X(rl_callback_handler_remove) X(rl_variable_value) X(rl_redisplay)      \
+  X(rl_callback_sigcleanup) X(rl_free_line_state)                         \
+  X(rl_callback_handler_install) X(rl_resize_terminal)                    \
+  X(rl_deprep_terminal) X(rl_prep_terminal) X(rl_forced_update_display)   \
+  X(rl_callback_read_char)
+#define RL_ALL(X) RL_FUNCS(X) RL_VARS(X)
+#define RL_VARS(X)                                                         \
+  X(history_length) X(history_base) X(rl_line_buffer)                     \
+  X(rl_attempted_completion_over) X(rl_outstream) X(rl_point) X(rl_end)   \
+  X(rl_instream) X(rl_readline_name) X(rl_catch_signals)                  \
+  X(rl_catch_sigwinch) X(rl_attempted_completion_function)                \
+  X(rl_completion_word_break_hook) X(rl_basic_word_break_characters)      \
+  X(rl_completer_quote_characters)
+
+static struct {
+#define X(f) __typeof__(f) *f;
+  RL_FUNCS(X)
+#undef X
+#define X(v) __typeof__(v) *v;
+  RL_VARS(X)
+#undef X
+} rl;
+
+/* 0 once readline is loaded; -1 (said on stderr) if it cannot be. */
+static int readline_load(void) {
+  static const char *const sonames[] = {"libreadline.so.8", "libreadline.so",
+                                        NULL};
+  return DYNLIB_LOAD(rl, RL_ALL, sonames, "libreadline8", "no line editing");
+}
+#define using_history (rl.using_history)
+#define stifle_history (rl.stifle_history)
+#define read_history (rl.read_history)
+#define append_history (rl.append_history)
+#define history_truncate_file (rl.history_truncate_file)
+#define history_get (rl.history_get)
+#define add_history (rl.add_history)
+#define rl_completion_matches (rl.rl_completion_matches)
+#define rl_filename_completion_function (rl.rl_filename_completion_function)
+#define rl_callback_handler_remove (rl.rl_callback_handler_remove)
+#define rl_variable_value (rl.rl_variable_value)
+#define rl_redisplay (rl.rl_redisplay)
+#define rl_callback_sigcleanup (rl.rl_callback_sigcleanup)
+#define rl_free_line_state (rl.rl_free_line_state)
+#define rl_callback_handler_install (rl.rl_callback_handler_install)
+#define rl_resize_terminal (rl.rl_resize_terminal)
+#define rl_deprep_terminal (rl.rl_deprep_terminal)
+#define rl_prep_terminal (rl.rl_prep_terminal)
+#define rl_forced_update_display (rl.rl_forced_update_display)
+#define rl_callback_read_char (rl.rl_callback_read_char)
+#define history_length (*rl.history_length)
+#define history_base (*rl.history_base)
+#define rl_line_buffer (*rl.rl_line_buffer)
+#define rl_attempted_completion_over (*rl.rl_attempted_completion_over)
+#define rl_outstream (*rl.rl_outstream)
+#define rl_point (*rl.rl_point)
+#define rl_end (*rl.rl_end)
+#define rl_instream (*rl.rl_instream)
+#define rl_readline_name (*rl.rl_readline_name)
+#define rl_catch_signals (*rl.rl_catch_signals)
+#define rl_catch_sigwinch (*rl.rl_catch_sigwinch)
+#define rl_attempted_completion_function (*rl.rl_attempted_completion_function)
+#define rl_completion_word_break_hook (*rl.rl_completion_word_break_hook)
+#define rl_basic_word_break_characters (*rl.rl_basic_word_break_characters)
+#define rl_completer_quote_characters (*rl.rl_completer_quote_characters)
+
 #define PROMPT      "qcs> "
 #define PROMPT_MORE "...> "
 #define HISTORY_FILE "/.qcs_history"
@@ -1345,7 +1422,9 @@ int repl_run(Interp *I) {
   R.preview = PREVIEW_AUTO;
   interp_set_show(I, repl_show, &R);
   interp_set_warn_shadow(I, 1);
-  int status = R.interactive ? run_terminal(&R) : run_plain(&R);
+  /* without readline, a terminal is read as piped input is */
+  int status = R.interactive && readline_load() == 0 ? run_terminal(&R)
+                                                      : run_plain(&R);
   interp_set_show(I, NULL, NULL);
   interp_set_warn_shadow(I, 0);
   for (size_t i = 0; i < R.nfiles; i++) free(R.files[i]);

@@ -68,22 +68,8 @@ static int mhd_loaded;
 static int mhd_load(void) {
   static const char *const sonames[] = {"libmicrohttpd.so.12",
                                         "libmicrohttpd.so", NULL};
-  static const char *const names[] = {
-#define X(f) #f,
-      MHD_FUNCS(X)
-#undef X
-  };
-  void *fns[sizeof names / sizeof *names];
-  char err[300];
-  if (dynlib_load(sonames, "libmicrohttpd12", names, fns,
-                  sizeof names / sizeof *names, err, sizeof err)) {
-    fprintf(stderr, "qcs: error: view: %s\n", err);
+  if (DYNLIB_LOAD(mhd, MHD_FUNCS, sonames, "libmicrohttpd12", "error: view"))
     return -1;
-  }
-  size_t k = 0;
-#define X(f) memcpy(&mhd.f, &fns[k++], sizeof mhd.f);
-  MHD_FUNCS(X)
-#undef X
   mhd_loaded = 1;
   return 0;
 }

@@ -33,6 +33,9 @@ typedef struct Src {
   const char *name;
   const char *text;
   int prelude;  /* one of the prelude's sources (stdlib/prelude.qcs, kit.qcs) */
+  const char **lines; /* where each line starts, made when first asked
+                         (interp.c's doc comments), or NULL */
+  int nlines;
 } Src;
 
 typedef struct Pos {

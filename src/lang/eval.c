@@ -189,6 +189,10 @@ static __attribute__((noinline)) Value *lookup_global(Interp *I, Expr *e,
   if (e->pos.src && e->pos.src->prelude && s->prelude_value)
     return s->prelude_value;
   if (s->global) return s->global;
+  if (s->lazy) { /* the prelude's, not read yet (code never resolved) */
+    interp_materialize(I, s);
+    if (!s->lazy) return lookup_global(I, e, env);
+  }
   unknown_name(I, s, env, e->pos);
 }
 

@@ -29,6 +29,7 @@
 #endif
 
 static int run_counter;
+static void materialize_all(Interp *I);
 
 /* ---- error display ---- */
 
@@ -153,15 +154,11 @@ static char *gc_strndup(const char *s, size_t n) {
   return p;
 }
 
-/* The start of each line of the source last asked about (the items of a
-   run come from one source, in order): found once per source instead of
-   once per definition. The static pointers are roots for the collector. */
-static const Src *lines_src;
-static const char **lines_at;
-static int lines_n;
-
+/* The start of each line of src: found once per source (and kept in it)
+   instead of once per definition; the prelude's definitions, read one by
+   one as they are needed, come from two sources in turn. */
 static const char *line_at(const Src *src, int line) {
-  if (src != lines_src) {
+  if (!src->lines) {
     int n = 1;
     for (const char *p = src->text; *p; p++) n += *p == '\n';
     const char **at = GC_MALLOC(sizeof(char *) * (size_t)(n + 1));
@@ -169,11 +166,11 @@ static const char *line_at(const Src *src, int line) {
     at[k++] = src->text;
     for (const char *p = src->text; *p; p++)
       if (*p == '\n') at[k++] = p + 1;
-    lines_src = src;
-    lines_at = at;
-    lines_n = k;
+    Src *w = (Src *)src; /* a cache: the text it describes is unchanged */
+    w->lines = at;
+    w->nlines = k;
   }
-  return line >= 1 && line <= lines_n ? lines_at[line - 1] : NULL;
+  return line >= 1 && line <= src->nlines ? src->lines[line - 1] : NULL;
 }
 
 static void read_doc(Sym *s, Pos pos) {
@@ -578,6 +575,19 @@ static RunStatus run_items(Interp *I, Item **items, int n, RunMode mode,
   int runid = ++run_counter;
   for (int i = 0; i < n; i++)
     if (items[i]->kind == ITEM_IMPORT) run_import(I, items[i], runname);
+  /* A name the user defines, declares or signs that the prelude defines
+     too: the prelude's definition is read first (its code keeps it). */
+  if (!I->loading_prelude)
+    for (int i = 0; i < n; i++) {
+      Item *it = items[i];
+      if (it->kind == ITEM_DEF && it->def->name)
+        interp_materialize(I, it->def->name);
+      else if (it->kind == ITEM_SIG)
+        interp_materialize(I, it->signame);
+      else if (it->kind == ITEM_TYPE)
+        for (int k = 0; k < it->ncons; k++)
+          interp_materialize(I, it->cons[k].name);
+    }
   /* Duplicate definitions within one script are mistakes. */
   for (int i = 0; i < n; i++) {
     if (items[i]->kind != ITEM_DEF) continue;
@@ -905,6 +915,7 @@ RunStatus interp_set_override(Interp *I, const char *name, const char *expr) {
     Expr *e = parse_expression(I, src);
     resolve_expr(I, e);
     Sym *s = sym_intern(I, name, (int)strlen(name));
+    interp_materialize(I, s);
     if (s->con_arity >= 0)
       qcs_error(pos_none, "--set cannot replace the constructor %s", name);
     if (!s->overridden) {
@@ -1123,7 +1134,7 @@ void interp_complete(Interp *I, const char *prefix,
   size_t len = strlen(prefix);
   for (size_t h = 0; h < I->symcap; h++)
     for (Sym *s = I->symtab[h]; s; s = s->next)
-      if ((s->global || s->con_arity >= 0) && s->name[0] != '%' &&
+      if ((s->global || s->lazy || s->con_arity >= 0) && s->name[0] != '%' &&
           !strncmp(s->name, prefix, len))
         emit(s->name, ud);
 }
@@ -1133,6 +1144,7 @@ static int cmp_sym(const void *a, const void *b) {
 }
 
 void interp_browse(Interp *I, FILE *out, int all) {
+  if (all) materialize_all(I);
   Sym **list = GC_MALLOC(sizeof(Sym *) * (I->nsyms + 1));
   size_t n = 0;
   for (size_t h = 0; h < I->symcap; h++)
@@ -1192,6 +1204,7 @@ int interp_unload(Interp *I, const char *file) {
 /* The symbol of a global or constructor called name, or NULL. */
 static Sym *known_sym(Interp *I, const char *name) {
   Sym *s = sym_intern(I, name, (int)strlen(name));
+  interp_materialize(I, s);
   return s->global || s->con_arity >= 0 ? s : NULL;
 }
 
@@ -1209,7 +1222,7 @@ static void no_such_name(Interp *I, const char *name) {
   int best_d = 3;
   for (size_t h = 0; h < I->symcap; h++)
     for (Sym *s = I->symtab[h]; s; s = s->next)
-      if ((s->global || s->con_arity >= 0) && s->name[0] != '%') {
+      if ((s->global || s->lazy || s->con_arity >= 0) && s->name[0] != '%') {
         int d = edit_distance(name, s->name);
         if (d < best_d && (size_t)d < strlen(name)) best = s->name, best_d = d;
       }
@@ -1357,11 +1370,254 @@ void interp_set_warn_shadow(Interp *I, int on) { I->warn_shadow = on; }
 
 int interp_has_global(Interp *I, const char *name) {
   Sym *s = sym_intern(I, name, (int)strlen(name));
+  interp_materialize(I, s);
   return s->global != NULL;
 }
 
 void interp_request_interrupt(void) { qcs_interrupted = 1; }
 void interp_clear_interrupt(void) { qcs_interrupted = 0; }
+
+/* ---- the prelude, read a definition at a time ----
+ *
+ * The prelude and the kit are 900 lines; a scene uses a few dozen of
+ * their definitions. At start-up a scan finds where each of their items
+ * begins: a line whose first character (column 1), outside comments and
+ * strings, starts a name or `::`. Type declarations are read and
+ * installed at once (every pattern may need their constructors); each
+ * definition, its signature and clauses (adjacent lines starting with
+ * its name), is only noted in its Sym (Sym.lazy, the text it is in).
+ * interp_materialize reads and installs it as loading the whole source
+ * would have (the prelude's code, its doc comments, Sym.prelude_*) when
+ * the name is first needed: when code naming it is resolved, before a
+ * user's definition, type, signature or --set of the name is installed,
+ * and for the commands that show names (:info, :doc, :browse!). A source
+ * with an item of another form (an expression, a pattern binding, an
+ * import, :set) is read whole at start-up, as is everything when
+ * QCS_EAGER_PRELUDE=1 is set (to compare the two). */
+typedef struct LazyDef {
+  const Src *src;
+  size_t start, end;     /* the bytes of the text it is read from */
+  int line;              /* the line start begins */
+  struct LazyDef *next;  /* another range of the same source naming it */
+  int busy;              /* being read */
+} LazyDef;
+
+int interp_lazy_pending(const Sym *s) { return s->lazy != NULL; }
+
+typedef struct LazyState {
+  Interp *I;
+  LazyDef *z;
+  int loading, nrename;
+  const Pos *origin;
+  Sym *qual;
+} LazyState;
+
+static void lazy_restore(void *arg) {
+  LazyState *st = arg;
+  st->I->loading_prelude = st->loading;
+  st->I->nrename = st->nrename;
+  st->I->origin = st->origin;
+  st->I->cur_qual = st->qual;
+  st->z->busy = 0;
+}
+
+static void snapshot_prelude(Sym *s) {
+  s->prelude_value = s->global;
+  s->prelude_def = s->def;
+  s->prelude_sig = s->sig;
+  s->prelude_doc = s->doc;
+  s->prelude_example = s->example;
+  s->prelude_pos = s->def_pos;
+}
+
+void interp_materialize(Interp *I, Sym *s) {
+  LazyDef *z = s->lazy;
+  if (!z || z->busy) return;
+  z->busy = 1;
+  LazyState st = {I, z, I->loading_prelude, I->nrename, I->origin,
+                  I->cur_qual};
+  ErrCleanup c;
+  err_defer(&c, lazy_restore, &st);
+  /* as the prelude's own run: no import's renaming, no user's call */
+  I->loading_prelude = 1;
+  I->nrename = 0;
+  I->origin = NULL;
+  I->cur_qual = NULL;
+  Item **items = NULL;
+  int n = 0;
+  for (LazyDef *r = z; r; r = r->next) {
+    int k;
+    Item **part = parse_range(I, r->src, r->start, r->end, r->line, &k);
+    if (!items) {
+      items = part;
+    } else if (k) {
+      Item **all = GC_MALLOC(sizeof(Item *) * (size_t)(n + k));
+      memcpy(all, items, sizeof(Item *) * (size_t)n);
+      memcpy(all + n, part, sizeof(Item *) * (size_t)k);
+      items = all;
+    }
+    n += k;
+  }
+  run_items(I, items, n, MODE_SCRIPT, z->src->name, 0);
+  err_release(&c);
+  lazy_restore(&st);
+  s->lazy = NULL;
+  for (int i = 0; i < n; i++)
+    if (items[i]->kind == ITEM_DEF) snapshot_prelude(items[i]->def->name);
+}
+
+/* Every definition not read yet, read (:browse! lists them all). Reading
+   one may intern names and so grow and rehash the table being walked:
+   walked again until a walk reads nothing. */
+static void materialize_all(Interp *I) {
+  for (int again = 1; again;) {
+    again = 0;
+    for (size_t h = 0; h < I->symcap; h++)
+      for (Sym *s = I->symtab[h]; s; s = s->next)
+        if (s->lazy && !s->lazy->busy) {
+          interp_materialize(I, s);
+          again = 1;
+        }
+  }
+}
+
+static int name_start(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+}
+
+/* One item found by the scan: a type declaration, or a name's lines. */
+typedef struct ScanItem {
+  int type;            /* `::` (else a definition) */
+  const char *name;    /* into the text */
+  int nlen;
+  size_t start;
+  int line;
+} ScanItem;
+
+/* The items of text, in order, into *out (malloc'd); their number, or
+   -1 if one has a form the scan does not take (read the text whole). */
+static __attribute__((noinline)) int scan_items(const char *text,
+                                                ScanItem **out) {
+  static const char *const cont[] = {"where", NULL};
+  static const char *const whole[] = {"let", "in", "if", "then", "else",
+                                      "case", "of", "and", "or", "True",
+                                      "False", "param", "import", NULL};
+  ScanItem *items = NULL;
+  int n = 0, cap = 0, depth = 0, line = 1;
+  for (const char *p = text; *p; line++) {
+    if (depth == 0) {
+      char c = *p;
+      int begins = 0, type = 0, nlen = 0;
+      if (name_start(c)) {
+        while (name_start(p[nlen]) || (p[nlen] >= '0' && p[nlen] <= '9') ||
+               p[nlen] == '\'')
+          nlen++;
+        if (p[nlen] == '.') goto fail; /* a qualified name */
+        int kw = 0;
+        for (int k = 0; cont[k]; k++)
+          if ((int)strlen(cont[k]) == nlen && !strncmp(p, cont[k], (size_t)nlen))
+            kw = 1;
+        for (int k = 0; whole[k]; k++)
+          if ((int)strlen(whole[k]) == nlen && !strncmp(p, whole[k], (size_t)nlen))
+            goto fail;
+        begins = !kw;
+      } else if (c == ':' && p[1] == ':') {
+        begins = type = 1;
+      } else if (!(c == ' ' || c == '\t' || c == '\r' || c == '\n' ||
+                   c == '\f' || c == '|' || c == '=' ||
+                   (c == '/' && (p[1] == '/' || p[1] == '*')))) {
+        goto fail; /* an expression, a pattern binding, :set */
+      }
+      if (begins &&
+          (type || !n || items[n - 1].type || items[n - 1].nlen != nlen ||
+           strncmp(items[n - 1].name, p, (size_t)nlen))) {
+        if (n == cap) {
+          cap = cap ? 2 * cap : 256;
+          ScanItem *m = realloc(items, sizeof *items * (size_t)cap);
+          if (!m) goto fail;
+          items = m;
+        }
+        items[n++] = (ScanItem){type, p, nlen, (size_t)(p - text), line};
+      }
+    }
+    /* the rest of the line: comments (nested) and strings, looked into
+       only if the line holds a '/' (or, outside comments, a '"') */
+    const char *nl = strchr(p, '\n');
+    if (!nl) nl = p + strlen(p);
+    if (!memchr(p, '/', (size_t)(nl - p)) &&
+        (depth > 0 || !memchr(p, '"', (size_t)(nl - p))))
+      p = nl;
+    while (p < nl) {
+      if (depth > 0) {
+        if (p[0] == '/' && p[1] == '*') depth++, p += 2;
+        else if (p[0] == '*' && p[1] == '/') depth--, p += 2;
+        else p++;
+      } else if (p[0] == '/' && p[1] == '/') {
+        p = nl;
+      } else if (p[0] == '/' && p[1] == '*') {
+        depth++, p += 2;
+      } else if (*p == '"') {
+        for (p++; p < nl && *p != '"'; p++)
+          if (*p == '\\' && p + 1 < nl) p++;
+        if (p < nl) p++;
+      } else {
+        p++;
+      }
+    }
+    if (*p == '\n') p++;
+  }
+  *out = items;
+  return n;
+fail:
+  free(items);
+  return -1;
+}
+
+/* Loads one of the prelude's sources: its type declarations now, its
+   definitions when needed (see above); 0, or -1 if it must be read whole. */
+static RunStatus load_lazily(Interp *I, const char *name, const char *text) {
+  ScanItem *found;
+  int nfound = getenv("QCS_EAGER_PRELUDE") ? -1 : scan_items(text, &found);
+  if (nfound < 0) return interp_run_string(I, name, text, MODE_SCRIPT);
+  ScanItem *volatile it = found; /* (kept over the error handler's setjmp) */
+  volatile int n = nfound;
+  Src *src = GC_MALLOC(sizeof *src);
+  src->name = name;
+  src->text = text; /* the binary's own copy: it outlives every run */
+  src->prelude = 1;
+  size_t len = strlen(text);
+  RunStatus st = RUN_OK;
+  ErrFrame f;
+  if (ERR_TRY(f)) {
+    for (int i = 0; i < n; i++) {
+      size_t end = i + 1 < n ? it[i + 1].start : len;
+      if (it[i].type) {
+        int k;
+        Item **items = parse_range(I, src, it[i].start, end, it[i].line, &k);
+        run_items(I, items, k, MODE_SCRIPT, name, 0);
+        continue;
+      }
+      Sym *s = sym_intern(I, it[i].name, it[i].nlen);
+      LazyDef *z = GC_MALLOC(sizeof *z);
+      *z = (LazyDef){src, it[i].start, end, it[i].line, NULL, 0};
+      if (s->lazy && s->lazy->src == src) { /* the name's lines again */
+        LazyDef *r = s->lazy;
+        while (r->next) r = r->next;
+        r->next = z;
+      } else {
+        s->lazy = z; /* a later source's definition replaces it */
+      }
+    }
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    report_error(I);
+    unwind(I, I->nforcing);
+    st = RUN_ERROR;
+  }
+  free(it);
+  return st;
+}
 
 /* ---- start-up ---- */
 
@@ -1430,24 +1686,15 @@ Interp *interp_new(void (*install)(Interp *I)) {
   I->loading_prelude = 1;
   /* The prelude proper, then the modeller's kit (stdlib/kit.qcs) written
      on it: both are the prelude's code, reported at the user's calls. */
-  RunStatus st = interp_run_string(I, "<prelude>", qcs_prelude_source,
-                                   MODE_SCRIPT);
-  if (st == RUN_OK)
-    st = interp_run_string(I, "<kit>", qcs_kit_source, MODE_SCRIPT);
+  RunStatus st = load_lazily(I, "<prelude>", qcs_prelude_source);
+  if (st == RUN_OK) st = load_lazily(I, "<kit>", qcs_kit_source);
   I->loading_prelude = 0;
   if (st != RUN_OK) {
     fprintf(stderr, "qcs: internal error: the prelude does not load\n");
     exit(2);
   }
   for (size_t h = 0; h < I->symcap; h++)
-    for (Sym *s = I->symtab[h]; s; s = s->next) {
-      s->prelude_value = s->global;
-      s->prelude_def = s->def;
-      s->prelude_sig = s->sig;
-      s->prelude_doc = s->doc;
-      s->prelude_example = s->example;
-      s->prelude_pos = s->def_pos;
-    }
+    for (Sym *s = I->symtab[h]; s; s = s->next) snapshot_prelude(s);
   return I;
 }
 

@@ -22,6 +22,7 @@ typedef struct Lexer {
   int bol;
   Token *toks;
   int n, cap;
+  const char *end; /* no token starts here or after (NULL: the text's end) */
 } Lexer;
 
 static Pos here(Lexer *L) { return (Pos){L->src, L->line, L->col}; }
@@ -44,6 +45,10 @@ static Token *push(Lexer *L, TokKind k, Pos pos, const char *start) {
     L->cap = L->cap ? 2 * L->cap : 256;
     Token *t = GC_MALLOC(sizeof(Token) * (size_t)L->cap);
     if (L->n) memcpy(t, L->toks, sizeof(Token) * (size_t)L->n);
+    /* the old array goes back to the collector at once: its pages are
+       used again instead of new ones (the prelude's arrays grow to 4096
+       tokens) */
+    if (L->toks) GC_FREE(L->toks);
     L->toks = t;
   }
   Token *t = &L->toks[L->n++];
@@ -232,13 +237,24 @@ static const struct {
 };
 
 Token *lex_all(const Src *src, int *ntokens) {
-  Lexer L = {src, src->text, 1, 1, 1, NULL, 0, 0};
+  return lex_range(src, 0, 0, 1, ntokens);
+}
+
+Token *lex_range(const Src *src, size_t start_at, size_t end_at, int line,
+                 int *ntokens) {
+  Lexer L = {src, src->text + start_at, line, 1, 1, NULL, 0, 0,
+             end_at ? src->text + end_at : NULL};
+  /* about one token per 6 bytes of qcs: an array that rarely grows, and
+     no 256-token one for a 200-byte definition */
+  size_t bytes = end_at ? end_at - start_at : strlen(L.p);
+  L.cap = bytes / 5 + 8 < 1 << 20 ? (int)(bytes / 5 + 8) : 1 << 20;
+  L.toks = GC_MALLOC(sizeof(Token) * (size_t)L.cap);
   for (;;) {
     skip_space(&L);
     Pos pos = here(&L);
     const char *start = L.p;
     unsigned char c = (unsigned char)*L.p;
-    if (c == 0) {
+    if (c == 0 || (L.end && L.p >= L.end)) {
       push(&L, T_EOF, pos, start);
       break;
     }
@@ -299,3 +315,5 @@ Token *lex_all(const Src *src, int *ntokens) {
   *ntokens = L.n;
   return L.toks;
 }
+
+void lex_free(Token *toks) { GC_FREE(toks); }

@@ -12,6 +12,8 @@
 #ifndef QCS_LEX_H
 #define QCS_LEX_H
 
+#include <stddef.h>
+
 #include "lang/error.h"
 
 #define TOKENS(X)                                                      \
@@ -43,16 +45,26 @@ typedef enum {
 
 typedef struct Token {
   TokKind kind;
-  Pos pos;
   int bol;           /* first token on its line */
+  Pos pos;
   const char *start; /* into the source text */
   int len;
-  double num;        /* T_NUM */
-  const char *str;   /* T_STR: the decoded string (NUL-terminated) */
-} Token;
+  union {
+    double num;      /* T_NUM */
+    const char *str; /* T_STR: the decoded string (NUL-terminated) */
+  };
+} Token;             /* 48 bytes: the prelude and the kit are 6500 */
 
-/* Tokenise src->text. Returns the array, ending with a T_EOF token. */
+/* Tokenise src->text. Returns the array, ending with a T_EOF token; the
+   caller may hand it back with lex_free once nothing points into it. */
 Token *lex_all(const Src *src, int *ntokens);
+/* The tokens of src->text from byte start_at, which begins line `line`
+   (column 1), to byte end_at (0: the text's end), which must be where a
+   line begins outside any comment or string: the prelude's definitions,
+   each read when first used (interp.c). */
+Token *lex_range(const Src *src, size_t start_at, size_t end_at, int line,
+                 int *ntokens);
+void lex_free(Token *toks);
 
 /* "'('", "name", ... for error messages. */
 const char *tok_kind_name(TokKind k);

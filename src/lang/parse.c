@@ -1293,21 +1293,36 @@ static void parser_init(Parser *P, Interp *I, const Src *src, RunMode mode) {
   P->sep_used = -1;
   P->max_depth = (int)(I->stack_limit >> 13 < 1000000000 ? I->stack_limit >> 13
                                                          : 1000000000);
-  P->toks = lex_all(src, &P->ntoks);
 }
+
+static Item **parse_items(Parser *P, int *nitems);
 
 Item **parse_program(Interp *I, const Src *src, RunMode mode, int *nitems) {
   Parser P;
   parser_init(&P, I, src, mode);
-  if (mode == MODE_SCRIPT) layout_push(&P, 1);
+  P.toks = lex_all(src, &P.ntoks);
+  return parse_items(&P, nitems);
+}
+
+Item **parse_range(Interp *I, const Src *src, size_t start, size_t end,
+                   int line, int *nitems) {
+  Parser P;
+  parser_init(&P, I, src, MODE_SCRIPT);
+  P.toks = lex_range(src, start, end, line, &P.ntoks);
+  return parse_items(&P, nitems);
+}
+
+static Item **parse_items(Parser *P, int *nitems) {
+  RunMode mode = P->mode;
+  if (mode == MODE_SCRIPT) layout_push(P, 1);
   Vec items = {0};
   for (;;) {
-    while (peek(&P) == T_SEMI || peek(&P) == T_VSEP) {
-      if (peek(&P) == T_VSEP) use_sep(&P);
-      else next(&P);
+    while (peek(P) == T_SEMI || peek(P) == T_VSEP) {
+      if (peek(P) == T_VSEP) use_sep(P);
+      else next(P);
     }
-    if (peek(&P) == T_EOF) break;
-    Item *it = item(&P);
+    if (peek(P) == T_EOF) break;
+    Item *it = item(P);
     /* Clauses of one function on adjacent items form one definition. */
     if (it->kind == ITEM_DEF && !it->param && items.n > 0) {
       Item *last = items.items[items.n - 1];
@@ -1318,25 +1333,28 @@ Item **parse_program(Interp *I, const Src *src, RunMode mode, int *nitems) {
     }
     vec_push(&items, it);
   ended:;
-    TokKind k = peek(&P);
+    TokKind k = peek(P);
     if (k == T_SEMI || k == T_VSEP || k == T_EOF) continue;
     if (k == T_RPAREN || k == T_RBRACK)
-      error_at_token(&P, "unbalanced %s: nothing here to close",
+      error_at_token(P, "unbalanced %s: nothing here to close",
                      tok_kind_name(k));
-    error_at_token(&P, "expected ';' or a new line after this %s, found %s",
+    error_at_token(P, "expected ';' or a new line after this %s, found %s",
                    it->kind == ITEM_EXPR ? "expression" : "definition",
-                   describe(&P));
+                   describe(P));
   }
   *nitems = items.n;
+  lex_free(P->toks); /* nothing made points into the tokens */
   return (Item **)items.items;
 }
 
 Expr *parse_expression(Interp *I, const Src *src) {
   Parser P;
   parser_init(&P, I, src, MODE_REPL);
+  P.toks = lex_all(src, &P.ntoks);
   Expr *e = expr(&P);
   if (peek(&P) == T_SEMI) next(&P);
   if (peek(&P) != T_EOF)
     error_at_token(&P, "unexpected %s after the expression", describe(&P));
+  lex_free(P.toks);
   return e;
 }

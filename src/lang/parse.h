@@ -30,6 +30,12 @@
 /* Parse all items of src. */
 Item **parse_program(Interp *I, const Src *src, RunMode mode, int *nitems);
 
+/* Parse the items of src's text from byte start, which begins line
+   `line`, to byte end, where a line begins outside any comment or
+   string (MODE_SCRIPT): one of the prelude's definitions (interp.c). */
+Item **parse_range(Interp *I, const Src *src, size_t start, size_t end,
+                   int line, int *nitems);
+
 /* Parse src as a single expression (for -e and --set). */
 Expr *parse_expression(Interp *I, const Src *src);
 

@@ -161,7 +161,7 @@ void resolve_unknown_name(Interp *I, Sym *s, const char *best, int bestd,
                           Pos pos) {
   for (size_t h = 0; h < I->symcap; h++)
     for (Sym *g = I->symtab[h]; g; g = g->next)
-      if ((g->global || g->con_arity >= 0) && g->name[0] != '%') {
+      if ((g->global || g->lazy || g->con_arity >= 0) && g->name[0] != '%') {
         int d = edit_distance(s->name, g->name);
         if (d < bestd) bestd = d, best = g->name;
       }
@@ -208,13 +208,25 @@ static void resolve_var(Resolver *R, Expr *e, Scope *sc) {
           if (y->owner) y->owner->closed = 2;
         return;
       }
+  /* a global of the prelude's not read yet: read now (one being read,
+     a recursion, is defined already) */
+  if (s->lazy) {
+    interp_materialize(R->I, s);
+    if (interp_lazy_pending(s)) {
+      note_use(R, s);
+      set_var(e, 0, RES_GLOBAL);
+      return;
+    }
+  }
   /* an import's own name that another import took: its qualified one */
   for (int i = 0; i < R->I->nrename; i++)
     if (R->I->rename_from[i] == s) {
       e->u.var = s = R->I->rename_to[i];
       break;
     }
-  if (s->ambiguous && !defined_in_batch(R, s))
+  /* (the prelude's code, read when first used, is resolved as it was
+     at start-up, before any import could make a name ambiguous) */
+  if (s->ambiguous && !R->I->loading_prelude && !defined_in_batch(R, s))
     qcs_error(e->pos, "'%s' is defined by two imports, %s: write which",
               s->name, s->ambiguous);
   if (s->alias_of) e->u.var = s = s->alias_of;

@@ -67,6 +67,9 @@ struct Sym {
                           error that lists them */
   Sym *alias_of;       /* Parts.x: the Sym holding that import's x (the
                           resolver puts it in the code's place) */
+  struct LazyDef *lazy;/* a definition of the prelude's not read yet: the
+                          text it is in (interp.c reads it when the name
+                          is first needed: interp_materialize) */
 };
 
 typedef enum {
@@ -230,6 +233,14 @@ struct Interp {
 extern atomic_int qcs_interrupted;
 
 Sym *sym_intern(Interp *I, const char *name, int len);
+
+/* The prelude's definitions are read when first needed: the parser and
+   the resolver see one only once it is. interp_materialize(I, s) reads
+   s's (and installs it as the prelude would have) if s->lazy is set and
+   its reading has not begun; a no-op otherwise. interp_lazy_pending(s):
+   s is the prelude's, read or not (the resolver counts it as defined). */
+void interp_materialize(Interp *I, Sym *s);
+int interp_lazy_pending(const Sym *s);
 
 Value *val_num(double x);
 Value *val_bool(Interp *I, int b);

@@ -18,7 +18,7 @@
 
 static Interp *I;
 
-static Src mksrc(const char *text) { return (Src){"<test>", text, 0}; }
+static Src mksrc(const char *text) { return (Src){"<test>", text, 0, NULL, 0}; }
 
 /* Lexes text; returns the token count or -1 on a lexical error. */
 static int lex(const char *text, Token **toks) {
@@ -389,6 +389,100 @@ static void test_set_param(void) {
   interp_free(J);
 }
 
+/* The prelude and the kit read one definition at a time, as needed
+   (interp.c), against both read whole at start-up (QCS_EAGER_PRELUDE=1,
+   the way they were always loaded): every definition, once needed, is
+   the same (where, arity, clauses, signature, doc, example), and so are
+   :browse! and the prelude's own view of a name the user redefines. */
+static char *browse_all(Interp *J) {
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&buf, &len);
+  if (!f) return NULL;
+  interp_browse(J, f, 1);
+  fclose(f);
+  return buf;
+}
+
+static int same_str(const char *a, const char *b) {
+  return a == b || (a && b && !strcmp(a, b));
+}
+
+static void test_lazy_prelude(void) {
+  setenv("QCS_EAGER_PRELUDE", "1", 1);
+  Interp *E = bind_interp_new();
+  unsetenv("QCS_EAGER_PRELUDE");
+  Interp *L = bind_interp_new();
+  int pending = 0, defs = 0, same = 0, cons = 0, same_cons = 0;
+  for (size_t h = 0; h < L->symcap; h++)
+    for (Sym *s = L->symtab[h]; s; s = s->next) pending += s->lazy != NULL;
+  int eager_pending = 0;
+  for (size_t h = 0; h < E->symcap; h++)
+    for (Sym *s = E->symtab[h]; s; s = s->next) eager_pending += s->lazy != NULL;
+  CHECK("lazy prelude: eager load reads everything at start-up",
+        eager_pending == 0);
+  for (size_t h = 0; h < E->symcap; h++)
+    for (Sym *e = E->symtab[h]; e; e = e->next) {
+      Sym *l = sym_intern(L, e->name, (int)strlen(e->name));
+      if (e->con_arity >= 0) {
+        cons++;
+        same_cons += l->con_arity == e->con_arity && l->con_type &&
+                     e->con_type && !strcmp(l->con_type->name, e->con_type->name);
+        continue;
+      }
+      if (!e->def || e->user) continue;
+      defs++;
+      interp_materialize(L, l);
+      same += l->def && !l->lazy && l->def->arity == e->def->arity &&
+              l->def->nclauses == e->def->nclauses &&
+              l->def_pos.line == e->def_pos.line &&
+              l->def_pos.col == e->def_pos.col && l->def_pos.src &&
+              !strcmp(l->def_pos.src->name, e->def_pos.src->name) &&
+              l->def_pos.src->prelude && same_str(l->sig, e->sig) &&
+              same_str(l->doc, e->doc) && same_str(l->example, e->example) &&
+              l->prelude_def == l->def && l->prelude_value == l->global &&
+              l->global && l->global->kind == e->global->kind && !l->user;
+    }
+  CHECK("lazy prelude: the prelude's and the kit's definitions", defs > 100);
+  CHECK("lazy prelude: every one of them waited until needed",
+        pending == defs);
+  CHECK("lazy prelude: each read alike (position, arity, clauses, "
+        "signature, doc, example)", same == defs);
+  CHECK("lazy prelude: constructors installed at start-up", cons > 30 &&
+        same_cons == cons);
+  char *be = browse_all(E), *bl = browse_all(L);
+  CHECK(":browse! the same either way", be && bl && strlen(be) > 5000 &&
+        !strcmp(be, bl));
+  free(be);
+  free(bl);
+  /* The user redefines Shift; the prelude's Box, read after, still
+     moves with the prelude's (Box lo hi = Shift lo (Scale ...)). */
+  Interp *U = bind_interp_new();
+  char probe;
+  interp_set_stack(U, &probe, 4u << 20);
+  int ok = interp_run_string(U, "<test>", "Shift v x = 42;", MODE_SCRIPT) ==
+           RUN_OK;
+  Value *v = NULL, *w = NULL;
+  ErrFrame f;
+  if (ok && ERR_TRY(f)) {
+    v = force(U, interp_eval_expr(U, "<test>", "Box (0, 0, 0) (1, 2, 3)"));
+    w = force(U, interp_eval_expr(U, "<test>", "Shift (1, 0, 0) UnitCube"));
+    err_pop(&f);
+  } else if (ok) {
+    err_pop(&f);
+  }
+  CHECK("lazy prelude: a user's Shift, the prelude's Box read after it",
+        v && v->kind == V_CON && !strcmp(v->u.con.con->name, "Product") &&
+        w && w->kind == V_NUM && w->u.num == 42);
+  Sym *sh = sym_intern(U, "Shift", 5);
+  CHECK("lazy prelude: the prelude's Shift kept for its own code",
+        sh->prelude_def && sh->prelude_def != sh->def && sh->user &&
+        sh->prelude_pos.src && sh->prelude_pos.src->prelude);
+  interp_free(U);
+  interp_free(L);
+  interp_free(E);
+}
+
 int main(void) {
   check_prefix = "lang";
   I = bind_interp_new();
@@ -400,5 +494,6 @@ int main(void) {
   test_print();
   test_files_read();
   test_set_param();
+  test_lazy_prelude();
   CHECK_DONE();
 }
