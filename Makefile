@@ -22,7 +22,7 @@ OPT     ?= -O2
 DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
             libmpfr-dev libgmp-dev tmux clang hugs libchafa-dev libglib2.0-dev \
             libmicrohttpd-dev parallel openexr python3-yaml libzip-dev
-PC_PKGS  := readline bdw-gc libpng OpenEXR libzip
+PC_PKGS  := readline bdw-gc libpng OpenEXR libzip gmp
 
 WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
           -Wmissing-prototypes -Wno-unused-parameter

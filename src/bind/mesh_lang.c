@@ -30,9 +30,15 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
     fprintf(f, "  thin parts: %ld cells split below the finest level (a "
             "surface in them not proven one sheet), down to depth %d (cell "
             "%.4g)\n", r->thin, r->deepest, ldexp(r->h, r->depth - r->deepest));
-  if (r->sharp_off)
+  if (r->sharp_off == 1)
     fprintf(f, "  sharp cells given up: two of them decided a degenerate "
             "case apart; the mesh was made again without them\n");
+  else if (r->sharp_off)
+    fprintf(f, "  sharp cells given up: the mesh made with them intersected "
+            "itself; it was made again without them\n");
+  fprintf(f, "  checked: no self-intersections, %ld triangle pairs tested "
+          "exactly (%ld signs in exact arithmetic) in %.2f s\n", r->pairs,
+          r->pairs_exact, r->check_seconds);
   fprintf(f, "  distance to the surface: certified <= %.4g (requested %.4g; vertices within "
           "%.2g of the surface); measured %.3g (the largest along the normals "
           "from %d points of the triangles)\n", r->certified, e, r->vtol,

@@ -82,7 +82,9 @@ typedef struct MeshReport {
   long sharp;              /* of them meshed exactly: the solid there is a
                               CSG of at most 8 planes (edges and corners
                               kept) */
-  int sharp_off;           /* sharp cells were given up (see mesh.c) */
+  int sharp_off;           /* sharp cells were given up (see mesh.c): 1
+                              closure failed with them, 2 the mesh made
+                              with them intersected itself */
   int depth;               /* finest level (the tolerance's) */
   double h;                /* finest cell side */
   long thin;               /* cells at or below the finest level split
@@ -97,6 +99,10 @@ typedef struct MeshReport {
   int samples;             /* the sample points used */
   long crossings, bisected;/* edge vertices; of them found by bisection */
   size_t vertices, triangles;
+  long pairs;              /* the self-intersection check (mesh_check.h):
+                              triangle pairs tested exactly */
+  long pairs_exact;        /* predicate signs decided in GMP */
+  double check_seconds;    /* its time */
   double seconds;
 } MeshReport;
 
@@ -108,7 +114,9 @@ enum {
   MESH_ETOL,               /* the tolerance is not usable */
   MESH_ELIMIT,             /* max_triangles or max_cells */
   MESH_EINTERNAL,          /* the result failed its own closure check */
-  MESH_ETHIN               /* a part thinner than the deepest cell */
+  MESH_ETHIN,              /* a part thinner than the deepest cell */
+  MESH_ESELF               /* the mesh intersects itself (after the
+                              remake without sharp cells) */
 };
 
 /* Mesh node of s. On failure returns a MESH_E* code with a message in err;
