@@ -4,6 +4,8 @@
 #include <float.h>
 #include <gmp.h>
 #include <limits.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -35,7 +37,7 @@ static const long double o3d_bound_l = (7.0L + 56.0L * EPSL) * EPSL;
    proof (no underflow) holds. */
 static int tame(double d) {
   double a = fabs(d);
-  return a == 0 || (a >= 0x1p-300 && a <= 0x1p300);
+  return (a == 0) | ((a >= 0x1p-300) & (a <= 0x1p300));
 }
 
 /* The least binary exponent of the last mantissa bit over n doubles. */
@@ -124,13 +126,15 @@ static int two_places(const double *a, const double *b, const double *c,
   return 0;
 }
 
-int mesh_orient3d(const double a[3], const double b[3], const double c[3],
-                  const double d[3], long *exact) {
+/* safe: every coordinate is known to be a multiple of 2^-300 and below
+   2^299 in magnitude (safe_coords), so every difference is tame. */
+static int orient3d(const double a[3], const double b[3], const double c[3],
+                    const double d[3], long *exact, int safe) {
   double adx = a[0] - d[0], bdx = b[0] - d[0], cdx = c[0] - d[0];
   double ady = a[1] - d[1], bdy = b[1] - d[1], cdy = c[1] - d[1];
   double adz = a[2] - d[2], bdz = b[2] - d[2], cdz = c[2] - d[2];
-  if (tame(adx) && tame(bdx) && tame(cdx) && tame(ady) && tame(bdy) &&
-      tame(cdy) && tame(adz) && tame(bdz) && tame(cdz)) {
+  if (safe || (tame(adx) & tame(bdx) & tame(cdx) & tame(ady) & tame(bdy) &
+               tame(cdy) & tame(adz) & tame(bdz) & tame(cdz))) {
     double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
     double cdxady = cdx * ady, adxcdy = adx * cdy;
     double adxbdy = adx * bdy, bdxady = bdx * ady;
@@ -170,6 +174,24 @@ int mesh_orient3d(const double a[3], const double b[3], const double c[3],
   return orient3d_exact(a, b, c, d);
 }
 
+int mesh_orient3d(const double a[3], const double b[3], const double c[3],
+                  const double d[3], long *exact) {
+  return orient3d(a, b, c, d, exact, 0);
+}
+
+/* Every coordinate zero or a multiple of 2^-300 (its last mantissa bit
+   at 2^-300 or above), and under 2^299: a nonzero difference of two is
+   then between 2^-300 and 2^300. */
+static int safe_coords(const double *v, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    if (v[i] == 0) continue;
+    int ex;
+    frexp(v[i], &ex);
+    if (ex - 53 < -300 || ex > 299) return 0;
+  }
+  return 1;
+}
+
 int mesh_orient2d(const double a[3], const double b[3], const double c[3],
                   int i, int j, long *exact) {
   double acx = a[i] - c[i], bcx = b[i] - c[i];
@@ -198,11 +220,12 @@ int mesh_orient2d(const double a[3], const double b[3], const double c[3],
 typedef struct {
   long *ex;      /* counts the exact evaluations */
   int i, j;      /* the projection's axes (2-D tests) */
+  int safe;      /* safe_coords holds for the mesh */
 } Ctx;
 
 static int o3(Ctx *c, const double *a, const double *b, const double *p,
               const double *d) {
-  return mesh_orient3d(a, b, p, d, c->ex);
+  return orient3d(a, b, p, d, c->ex, c->safe);
 }
 
 static int o2(Ctx *c, const double *a, const double *b, const double *p) {
@@ -276,11 +299,32 @@ static int seg_tri2(Ctx *c, const double *p, const double *q, const double *a,
          seg_seg2(c, p, q, t, a);
 }
 
-typedef struct {
+/* Closed triangles a and b (neither collinear) of one plane meet, in the
+   projection set in c: no side of either has the other wholly strictly
+   beyond it (the separating axis theorem in the plane). */
+struct Tri;
+static int tri_tri2(Ctx *c, const struct Tri *a, const struct Tri *b);
+
+typedef struct Tri {
   const double *v[3]; /* its vertices */
   int id[3];          /* their indices */
   int k, s;           /* tri_axis; -1: collinear */
 } Tri;
+
+static int tri_tri2(Ctx *c, const Tri *a, const Tri *b) {
+  for (int pass = 0; pass < 2; pass++) {
+    const Tri *x = pass ? b : a, *y = pass ? a : b;
+    /* x's orientation in the projection: inside is where o2 has its sign */
+    int sx = o2(c, x->v[0], x->v[1], x->v[2]);
+    for (int e = 0; e < 3; e++) {
+      int out = 0;
+      for (int q = 0; q < 3; q++)
+        out += o2(c, x->v[e], x->v[(e + 1) % 3], y->v[q]) * sx < 0;
+      if (out == 3) return 0;
+    }
+  }
+  return 1;
+}
 
 /* Closed segment pq meets closed triangle t (not collinear); sp, sq: the
    signs of p and q against t's plane. */
@@ -298,13 +342,19 @@ static int seg_tri3(Ctx *c, const double *p, const double *q, const Tri *t,
   return !((s1 > 0 || s2 > 0 || s3 > 0) && (s1 < 0 || s2 < 0 || s3 < 0));
 }
 
+/* Vertex x = t->v[vi] of t (not collinear), y in t's plane: y - x in t's
+   angle at x. */
+static int into2(Ctx *c, const Tri *t, int vi, const double *y) {
+  const double *x = t->v[vi], *p = t->v[(vi + 1) % 3], *q = t->v[(vi + 2) % 3];
+  set_axis(c, t->k);
+  return o2(c, x, p, y) * t->s >= 0 && o2(c, x, y, q) * t->s >= 0;
+}
+
 /* Vertex x = t->v[vi] of t (not collinear): the segment from x to y goes
    into t beyond x (y in t's plane, and y - x in t's angle at x). */
 static int into(Ctx *c, const Tri *t, int vi, const double *y) {
   const double *x = t->v[vi], *p = t->v[(vi + 1) % 3], *q = t->v[(vi + 2) % 3];
-  if (o3(c, x, p, q, y) != 0) return 0;
-  set_axis(c, t->k);
-  return o2(c, x, p, y) * t->s >= 0 && o2(c, x, y, q) * t->s >= 0;
+  return o3(c, x, p, q, y) == 0 && into2(c, t, vi, y);
 }
 
 static int where(const Tri *t, int id) {
@@ -469,6 +519,10 @@ static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
       na += sa[q] < 0;
     }
     if (pa == 3 || na == 3) return 0;
+    if (!pb && !nb) { /* one plane */
+      set_axis(c, A.k);
+      return tri_tri2(c, &A, &B);
+    }
     for (int e = 0; e < 3; e++)
       if (seg_tri3(c, A.v[e], A.v[(e + 1) % 3], &B, sa[e], sa[(e + 1) % 3]) ||
           seg_tri3(c, B.v[e], B.v[(e + 1) % 3], &A, sb[e], sb[(e + 1) % 3]))
@@ -483,14 +537,19 @@ static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
     /* the edges opposite the shared vertex against the other triangle */
     const double *a1 = A.v[(ia + 1) % 3], *a2 = A.v[(ia + 2) % 3];
     const double *b1 = B.v[(ib + 1) % 3], *b2 = B.v[(ib + 2) % 3];
-    if (seg_tri3(c, a1, a2, &B, o3(c, B.v[0], B.v[1], B.v[2], a1),
-                 o3(c, B.v[0], B.v[1], B.v[2], a2)) ||
-        seg_tri3(c, b1, b2, &A, o3(c, A.v[0], A.v[1], A.v[2], b1),
-                 o3(c, A.v[0], A.v[1], A.v[2], b2)))
+    int s1 = o3(c, A.v[0], A.v[1], A.v[2], b1), s2 = o3(c, A.v[0], A.v[1], A.v[2], b2);
+    if (s1 == 0 && s2 == 0)
+      /* one plane: two angles at v, each under 180 degrees, overlap
+         beyond v exactly when a side of one lies in the other */
+      return into2(c, &B, ib, a1) || into2(c, &B, ib, a2) ||
+             into2(c, &A, ia, b1) || into2(c, &A, ia, b2);
+    int r1 = o3(c, B.v[0], B.v[1], B.v[2], a1), r2 = o3(c, B.v[0], B.v[1], B.v[2], a2);
+    if (seg_tri3(c, a1, a2, &B, r1, r2) || seg_tri3(c, b1, b2, &A, s1, s2))
       return 1;
-    /* the edges at the shared vertex going into the other triangle */
-    return into(c, &B, ib, a1) || into(c, &B, ib, a2) || into(c, &A, ia, b1) ||
-           into(c, &A, ia, b2);
+    /* the edges at the shared vertex going into the other triangle (only
+       an edge in the other's plane can) */
+    return (!r1 && into2(c, &B, ib, a1)) || (!r2 && into2(c, &B, ib, a2)) ||
+           (!s1 && into2(c, &A, ia, b1)) || (!s2 && into2(c, &A, ia, b2));
   }
   /* one shared edge u w: improper only when the planes agree and the
      third vertices lie on one side of it (folded onto each other) */
@@ -506,11 +565,75 @@ static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
 }
 
 int mesh_tri_pair(const Mesh *m, size_t i, size_t j) {
-  Ctx c = {NULL, 0, 1};
+  Ctx c = {NULL, 0, 1, 0};
   return pair(&c, m, i, j);
 }
 
 /* ---- the broad phase: a uniform grid over the triangles' boxes ---------- */
+
+/* The grid's cells are taken in blocks by CHECK_THREADS threads. */
+#define CHECK_THREADS 2
+#define CHECK_BLOCK 256
+
+typedef struct {
+  const Mesh *m;
+  const double *box;       /* per triangle: lo[3], hi[3] */
+  int (*cb)[6];            /* per triangle: its cells' range */
+  const size_t *cnt, *fill;/* cell q's triangles: items[cnt[q] .. fill[q]) */
+  const int *items;
+  int g[3];
+  size_t ncell;
+  atomic_size_t next;      /* the next block of cells */
+  int safe;
+} Scan;
+
+typedef struct {
+  Scan *sc;
+  long pairs, exact, bad;
+  size_t first;            /* the cell of the first intersecting pair */
+  size_t tri[2];
+  double at[3];
+} Part;
+
+static void *scan(void *arg) {
+  Part *pt = arg;
+  Scan *sc = pt->sc;
+  const double *box = sc->box;
+  int (*cb)[6] = sc->cb;
+  Ctx ctx = {&pt->exact, 0, 1, sc->safe};
+  for (;;) {
+    size_t q0 = atomic_fetch_add(&sc->next, CHECK_BLOCK);
+    if (q0 >= sc->ncell) break;
+    size_t q1 = q0 + CHECK_BLOCK < sc->ncell ? q0 + CHECK_BLOCK : sc->ncell;
+    for (size_t q = q0; q < q1; q++) {
+      int cx = (int)(q / ((size_t)sc->g[1] * (size_t)sc->g[2]));
+      int cy = (int)(q / (size_t)sc->g[2] % (size_t)sc->g[1]);
+      int cz = (int)(q % (size_t)sc->g[2]);
+      for (size_t x = sc->cnt[q]; x < sc->fill[q]; x++)
+        for (size_t y = x + 1; y < sc->fill[q]; y++) {
+          size_t i = (size_t)sc->items[x], j = (size_t)sc->items[y];
+          const double *bi = box + 6 * i, *bj = box + 6 * j;
+          if (bi[0] > bj[3] || bj[0] > bi[3] || bi[1] > bj[4] || bj[1] > bi[4] ||
+              bi[2] > bj[5] || bj[2] > bi[5])
+            continue;
+          /* tested in the first cell both reach */
+          if ((cb[i][0] > cb[j][0] ? cb[i][0] : cb[j][0]) != cx ||
+              (cb[i][1] > cb[j][1] ? cb[i][1] : cb[j][1]) != cy ||
+              (cb[i][2] > cb[j][2] ? cb[i][2] : cb[j][2]) != cz)
+            continue;
+          pt->pairs++;
+          if (pair(&ctx, sc->m, i, j) && !pt->bad++) {
+            pt->first = q;
+            pt->tri[0] = i, pt->tri[1] = j;
+            for (int a = 0; a < 3; a++)
+              pt->at[a] = 0.5 * (fmax(bi[a], bj[a]) + fmin(bi[3 + a], bj[3 + a]));
+          }
+        }
+    }
+  }
+  mesh_check_release();
+  return NULL;
+}
 
 int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
   struct timespec t0, t1;
@@ -596,31 +719,32 @@ int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
       memcpy(fill, cnt, (ncell + 1) * sizeof *fill);
     }
   }
-  Ctx ctx = {&c->exact, 0, 1};
-  for (size_t q = 0; q < ncell && c->bad < 64; q++) {
-    int cx = (int)(q / ((size_t)g[1] * (size_t)g[2]));
-    int cy = (int)(q / (size_t)g[2] % (size_t)g[1]), cz = (int)(q % (size_t)g[2]);
-    for (size_t x = cnt[q]; x < fill[q]; x++)
-      for (size_t y = x + 1; y < fill[q]; y++) {
-        size_t i = (size_t)items[x], j = (size_t)items[y];
-        const double *bi = box + 6 * i, *bj = box + 6 * j;
-        if (bi[0] > bj[3] || bj[0] > bi[3] || bi[1] > bj[4] || bj[1] > bi[4] ||
-            bi[2] > bj[5] || bj[2] > bi[5])
-          continue;
-        /* tested in the first cell both reach */
-        if ((cb[i][0] > cb[j][0] ? cb[i][0] : cb[j][0]) != cx ||
-            (cb[i][1] > cb[j][1] ? cb[i][1] : cb[j][1]) != cy ||
-            (cb[i][2] > cb[j][2] ? cb[i][2] : cb[j][2]) != cz)
-          continue;
-        c->pairs++;
-        if (pair(&ctx, m, i, j)) {
-          if (!c->bad++) {
-            c->tri[0] = i, c->tri[1] = j;
-            for (int a = 0; a < 3; a++)
-              c->at[a] = 0.5 * (fmax(bi[a], bj[a]) + fmin(bi[3 + a], bj[3 + a]));
-          }
-        }
-      }
+  Scan sc = {m, box, cb, cnt, fill, items, {g[0], g[1], g[2]}, ncell, 0,
+             safe_coords(m->v, 3 * m->nv)};
+  int nth = nt < 20000 ? 1 : CHECK_THREADS;
+  Part part[CHECK_THREADS];
+  pthread_t th[CHECK_THREADS];
+  memset(part, 0, sizeof part);
+  for (int t = 0; t < nth; t++) {
+    part[t].sc = &sc;
+    part[t].first = SIZE_MAX;
+  }
+  int started = 1;
+  for (int t = 1; t < nth; t++)
+    if (pthread_create(&th[t], NULL, scan, &part[t]) == 0) started++;
+    else break;
+  scan(&part[0]);
+  for (int t = 1; t < started; t++) pthread_join(th[t], NULL);
+  size_t first = SIZE_MAX;
+  for (int t = 0; t < started; t++) {
+    c->pairs += part[t].pairs;
+    c->exact += part[t].exact;
+    c->bad += part[t].bad;
+    if (part[t].bad && part[t].first < first) {
+      first = part[t].first;
+      c->tri[0] = part[t].tri[0], c->tri[1] = part[t].tri[1];
+      memcpy(c->at, part[t].at, sizeof c->at);
+    }
   }
   rc = c->bad > 0;
 out:

@@ -25,8 +25,8 @@ struct Mesh;
 typedef struct MeshSelfCheck {
   long pairs;         /* pairs of triangles whose boxes overlap: tested */
   long exact;         /* predicate signs the filter left to GMP */
-  long bad;           /* intersecting pairs found (the test stops at 64) */
-  size_t tri[2];      /* the first intersecting pair */
+  long bad;           /* intersecting pairs found */
+  size_t tri[2];      /* the first intersecting pair (in the grid's order) */
   double at[3];       /* the centre of the first pair's shared box */
   double seconds;
 } MeshSelfCheck;
