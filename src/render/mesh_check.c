@@ -571,15 +571,41 @@ int mesh_tri_pair(const Mesh *m, size_t i, size_t j) {
 
 /* ---- the broad phase: a uniform grid over the triangles' boxes ---------- */
 
+/* Triangle i's box. */
+static void tri_box(const Mesh *m, size_t i, double l[3], double h[3]) {
+  for (int a = 0; a < 3; a++) {
+    l[a] = INFINITY, h[a] = -INFINITY;
+    for (int k = 0; k < 3; k++) {
+      double x = m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)a];
+      l[a] = fmin(l[a], x);
+      h[a] = fmax(h[a], x);
+    }
+  }
+}
+
+/* x as a float no greater (down) or no less (up) than x. */
+static float down(double x) {
+  if (x > FLT_MAX) return FLT_MAX;
+  float f = (float)x;
+  return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+
+static float up(double x) {
+  if (x < -FLT_MAX) return -FLT_MAX;
+  float f = (float)x;
+  return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
 /* The grid's cells are taken in blocks by CHECK_THREADS threads. */
 #define CHECK_THREADS 2
 #define CHECK_BLOCK 256
 
 typedef struct {
   const Mesh *m;
-  const double *box;       /* per triangle: lo[3], hi[3] */
-  int (*cb)[6];            /* per triangle: its cells' range */
-  const size_t *cnt, *fill;/* cell q's triangles: items[cnt[q] .. fill[q]) */
+  const float *box;        /* per triangle: lo[3], hi[3] (outward) */
+  uint16_t (*cb)[6];       /* per triangle: its cells' range */
+  const size_t *cnt;       /* cell q's triangles: items[cnt[q - 1] ..
+                              cnt[q]) (from 0 for q = 0) */
   const int *items;
   int g[3];
   size_t ncell;
@@ -598,8 +624,8 @@ typedef struct {
 static void *scan(void *arg) {
   Part *pt = arg;
   Scan *sc = pt->sc;
-  const double *box = sc->box;
-  int (*cb)[6] = sc->cb;
+  const float *box = sc->box;
+  uint16_t (*cb)[6] = sc->cb;
   Ctx ctx = {&pt->exact, 0, 1, sc->safe};
   for (;;) {
     size_t q0 = atomic_fetch_add(&sc->next, CHECK_BLOCK);
@@ -609,10 +635,11 @@ static void *scan(void *arg) {
       int cx = (int)(q / ((size_t)sc->g[1] * (size_t)sc->g[2]));
       int cy = (int)(q / (size_t)sc->g[2] % (size_t)sc->g[1]);
       int cz = (int)(q % (size_t)sc->g[2]);
-      for (size_t x = sc->cnt[q]; x < sc->fill[q]; x++)
-        for (size_t y = x + 1; y < sc->fill[q]; y++) {
+      size_t start = q ? sc->cnt[q - 1] : 0, end = sc->cnt[q];
+      for (size_t x = start; x < end; x++)
+        for (size_t y = x + 1; y < end; y++) {
           size_t i = (size_t)sc->items[x], j = (size_t)sc->items[y];
-          const double *bi = box + 6 * i, *bj = box + 6 * j;
+          const float *bi = box + 6 * i, *bj = box + 6 * j;
           if (bi[0] > bj[3] || bj[0] > bi[3] || bi[1] > bj[4] || bj[1] > bi[4] ||
               bi[2] > bj[5] || bj[2] > bi[5])
             continue;
@@ -626,7 +653,7 @@ static void *scan(void *arg) {
             pt->first = q;
             pt->tri[0] = i, pt->tri[1] = j;
             for (int a = 0; a < 3; a++)
-              pt->at[a] = 0.5 * (fmax(bi[a], bj[a]) + fmin(bi[3 + a], bj[3 + a]));
+              pt->at[a] = 0.5 * ((double)fmaxf(bi[a], bj[a]) + (double)fminf(bi[3 + a], bj[3 + a]));
           }
         }
     }
@@ -646,21 +673,14 @@ int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
     if (!isfinite(m->v[i])) return -1;
   if (nt < 2) return 0;
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  double *box = malloc(6 * nt * sizeof *box), mean = 0;
-  if (!box) return -2;
+  double mean = 0;
   for (size_t i = 0; i < nt; i++) {
-    double *b = box + 6 * i, side = 0;
+    double l[3], h[3], side = 0;
+    tri_box(m, i, l, h);
     for (int a = 0; a < 3; a++) {
-      double l = INFINITY, h = -INFINITY;
-      for (int k = 0; k < 3; k++) {
-        double x = m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)a];
-        l = fmin(l, x);
-        h = fmax(h, x);
-      }
-      b[a] = l, b[3 + a] = h;
-      lo[a] = fmin(lo[a], l);
-      hi[a] = fmax(hi[a], h);
-      side = fmax(side, h - l);
+      lo[a] = fmin(lo[a], l[a]);
+      hi[a] = fmax(hi[a], h[a]);
+      side = fmax(side, h[a] - l[a]);
     }
     mean += side;
   }
@@ -672,35 +692,44 @@ int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
     size_t n = 1;
     for (int a = 0; a < 3; a++) {
       double w = (hi[a] - lo[a]) / cs;
-      g[a] = w < 1 ? 1 : w > 1e6 ? 1000000 : (int)ceil(w);
+      g[a] = w < 1 ? 1 : w > 65535 ? 65535 : (int)ceil(w);
       n *= (size_t)g[a];
     }
     if (cs > 0 && n <= 2 * nt + 8) break;
     cs = cs > 0 ? cs * 1.26 : fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2])) + 1;
   }
-  /* a triangle's cells: the monotone map x -> floor((x - lo) / cs),
-     clamped, so two closed boxes that overlap share a cell */
-  int (*cb)[6] = malloc(nt * sizeof *cb);
+  /* a triangle's cells: the monotone map x -> floor((x - lo) / cs) of its
+     exact box, clamped, so two closed boxes that overlap share a cell;
+     the box kept in floats rounded outward (the overlap test is then
+     conservative: it only lets more pairs through to the exact test) */
+  float *box = malloc(6 * nt * sizeof *box);
+  uint16_t (*cb)[6] = malloc(nt * sizeof *cb);
   size_t ncell = (size_t)g[0] * (size_t)g[1] * (size_t)g[2];
-  size_t *cnt = calloc(ncell + 1, sizeof *cnt), *fill = NULL;
+  size_t *cnt = calloc(ncell + 1, sizeof *cnt);
   int *items = NULL, rc = 0;
-  if (!cb || !cnt) {
+  if (!box || !cb || !cnt) {
     rc = -2;
     goto out;
   }
-  for (size_t i = 0; i < nt; i++)
+  for (size_t i = 0; i < nt; i++) {
+    double b[2][3];
+    tri_box(m, i, b[0], b[1]);
     for (int a = 0; a < 3; a++)
       for (int e = 0; e < 2; e++) {
-        double f = floor((box[6 * i + 3 * (size_t)e + (size_t)a] - lo[a]) / cs);
-        cb[i][3 * e + a] = f < 0 ? 0 : f >= g[a] ? g[a] - 1 : (int)f;
+        double f = floor((b[e][a] - lo[a]) / cs);
+        cb[i][3 * e + a] = (uint16_t)(f < 0 ? 0 : f >= g[a] ? g[a] - 1 : (int)f);
+        box[6 * i + 3 * (size_t)e + (size_t)a] = e ? up(b[e][a]) : down(b[e][a]);
       }
+  }
+  /* counting sort of the (cell, triangle) entries: cnt[q] counts cell q's
+     entries, then is made the end of cell q's run as it is filled */
   for (int pass = 0; pass < 2; pass++) {
     for (size_t i = 0; i < nt; i++)
       for (int x = cb[i][0]; x <= cb[i][3]; x++)
         for (int y = cb[i][1]; y <= cb[i][4]; y++)
           for (int z = cb[i][2]; z <= cb[i][5]; z++) {
             size_t q = ((size_t)x * (size_t)g[1] + (size_t)y) * (size_t)g[2] + (size_t)z;
-            if (pass) items[fill[q]++] = (int)i;
+            if (pass) items[cnt[q]++] = (int)i;
             else cnt[q]++;
           }
     if (!pass) {
@@ -711,15 +740,13 @@ int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
         sum += n;
       }
       items = malloc((sum ? sum : 1) * sizeof *items);
-      fill = malloc((ncell + 1) * sizeof *fill);
-      if (!items || !fill) {
+      if (!items) {
         rc = -2;
         goto out;
       }
-      memcpy(fill, cnt, (ncell + 1) * sizeof *fill);
     }
   }
-  Scan sc = {m, box, cb, cnt, fill, items, {g[0], g[1], g[2]}, ncell, 0,
+  Scan sc = {m, box, cb, cnt, items, {g[0], g[1], g[2]}, ncell, 0,
              safe_coords(m->v, 3 * m->nv)};
   int nth = nt < 20000 ? 1 : CHECK_THREADS;
   Part part[CHECK_THREADS];
@@ -752,7 +779,6 @@ out:
   free(box);
   free(cb);
   free(cnt);
-  free(fill);
   free(items);
   clock_gettime(CLOCK_MONOTONIC, &t1);
   c->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
