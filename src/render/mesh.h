@@ -40,9 +40,12 @@
  * in finest cells; the report gives the largest, and a measured error
  * (sample points to the surface along the normals). That every part of
  * the surface is near the mesh is proven in plane and sharp cells only.
- * Closure is checked by edge counting before anything is returned; a
- * failure caused by sharp cells deciding a degenerate case apart remakes
- * the mesh without them (MeshReport.sharp_off).
+ * Closure is checked by edge counting before anything is returned, and
+ * then self-intersection, exactly (mesh_check.h: every pair of triangles
+ * whose boxes overlap, by exact orientation predicates); a failure of
+ * either with sharp cells (two of them deciding a degenerate case apart,
+ * or a crease fan reaching through a neighbour) remakes the mesh without
+ * them (MeshReport.sharp_off), and that mesh is checked again.
  *
  * Memory: mesh_scene mallocs the mesh (mesh_free). Nothing here prints.
  * The scene is only read. */
