@@ -38,9 +38,15 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "be lost or closed there (the first at (%.6g, %.6g, %.6g))\n",
             r->two, r->two_side, r->h / r->two_side, r->two_at[0],
             r->two_at[1], r->two_at[2]);
-  if (r->sharp_off)
+  if (r->sharp_off == 1)
     fprintf(f, "  sharp cells given up: two of them decided a degenerate "
             "case apart; the mesh was made again without them\n");
+  else if (r->sharp_off)
+    fprintf(f, "  sharp cells given up: the mesh made with them intersected "
+            "itself; it was made again without them\n");
+  fprintf(f, "  checked: no self-intersections, %ld triangle pairs tested "
+          "exactly (%ld signs in exact arithmetic) in %.2f s\n", r->pairs,
+          r->pairs_exact, r->check_seconds);
   fprintf(f, "  distance to the surface: certified <= %.4g (requested %.4g; vertices within "
           "%.2g of the surface); measured %.3g (the largest along the normals "
           "from %d points of the triangles)\n", r->certified, e, r->vtol,

@@ -45,9 +45,12 @@
  * in finest cells; the report gives the largest, and a measured error
  * (sample points to the surface along the normals). That every part of
  * the surface is near the mesh is proven in plane and sharp cells only.
- * Closure is checked by edge counting before anything is returned; a
- * failure caused by sharp cells deciding a degenerate case apart remakes
- * the mesh without them (MeshReport.sharp_off).
+ * Closure is checked by edge counting before anything is returned, and
+ * then self-intersection, exactly (mesh_check.h: every pair of triangles
+ * whose boxes overlap, by exact orientation predicates); a failure of
+ * either with sharp cells (two of them deciding a degenerate case apart,
+ * or a crease fan reaching through a neighbour) remakes the mesh without
+ * them (MeshReport.sharp_off), and that mesh is checked again.
  *
  * Memory: mesh_scene mallocs the mesh (mesh_free). Nothing here prints.
  * The scene is only read. */
@@ -87,7 +90,9 @@ typedef struct MeshReport {
   long sharp;              /* of them meshed exactly: the solid there is a
                               CSG of at most 8 planes (edges and corners
                               kept) */
-  int sharp_off;           /* sharp cells were given up (see mesh.c) */
+  int sharp_off;           /* sharp cells were given up (see mesh.c): 1
+                              closure failed with them, 2 the mesh made
+                              with them intersected itself */
   int depth;               /* finest level (the tolerance's) */
   double h;                /* finest cell side */
   long thin;               /* cells at or below the finest level split
@@ -107,6 +112,10 @@ typedef struct MeshReport {
   int samples;             /* the sample points used */
   long crossings, bisected;/* edge vertices; of them found by bisection */
   size_t vertices, triangles;
+  long pairs;              /* the self-intersection check (mesh_check.h):
+                              triangle pairs tested exactly */
+  long pairs_exact;        /* predicate signs decided in GMP */
+  double check_seconds;    /* its time */
   double seconds;
 } MeshReport;
 
@@ -118,7 +127,9 @@ enum {
   MESH_ETOL,               /* the tolerance is not usable */
   MESH_ELIMIT,             /* max_triangles or max_cells */
   MESH_EINTERNAL,          /* the result failed its own closure check */
-  MESH_ETHIN               /* a part thinner than the deepest cell */
+  MESH_ETHIN,              /* a part thinner than the deepest cell */
+  MESH_ESELF               /* the mesh intersects itself (after the
+                              remake without sharp cells) */
 };
 
 /* Mesh node of s. On failure returns a MESH_E* code with a message in err;

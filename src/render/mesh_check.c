@@ -1,0 +1,786 @@
+/* mesh_check.c: exact self-intersection check (see mesh_check.h). */
+#include "render/mesh_check.h"
+
+#include <float.h>
+#include <gmp.h>
+#include <limits.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "render/mesh.h"
+
+/* no fused multiply-adds: the bounds are for rounded products (gcc's
+   -std=c11 already keeps them apart) */
+#ifdef __clang__
+#pragma STDC FP_CONTRACT OFF
+#endif
+
+/* ---- exact predicates ---------------------------------------------------- */
+
+/* Shewchuk's A bounds (epsilon = 2^-53, round to nearest): the computed
+   determinant is within bound * permanent of the true one, when nothing
+   underflows or overflows. */
+#define EPS 0x1p-53
+static const double o3d_bound = (7.0 + 56.0 * EPS) * EPS;
+static const double o2d_bound = (3.0 + 16.0 * EPS) * EPS;
+/* the same bound in long double (epsilon 2^-LDBL_MANT_DIG) */
+#define EPSL (LDBL_EPSILON / 2)
+static const long double o3d_bound_l = (7.0L + 56.0L * EPSL) * EPSL;
+
+/* The filter is trusted when every difference is 0 or within 2^-300 ..
+   2^300: its products of three are then normal numbers, so the bound's
+   proof (no underflow) holds. */
+static int tame(double d) {
+  double a = fabs(d);
+  return (a == 0) | ((a >= 0x1p-300) & (a <= 0x1p300));
+}
+
+/* The least binary exponent of the last mantissa bit over n doubles. */
+static int least_exp(const double *x, int n) {
+  int e0 = INT_MAX;
+  for (int i = 0; i < n; i++)
+    if (x[i] != 0) {
+      int ex;
+      frexp(x[i], &ex);
+      if (ex - 53 < e0) e0 = ex - 53;
+    }
+  return e0 == INT_MAX ? 0 : e0;
+}
+
+/* z = x / 2^e0 exactly (an integer: e0 is at most x's last bit). */
+static void to_mpz(mpz_t z, double x, int e0) {
+  if (x == 0) {
+    mpz_set_ui(z, 0);
+    return;
+  }
+  int ex;
+  double f = frexp(x, &ex);
+  mpz_set_d(z, ldexp(f, 53)); /* |f| 2^53 < 2^53: an exact integer */
+  mpz_mul_2exp(z, z, (mp_bitcnt_t)(ex - 53 - e0));
+}
+
+/* The exact evaluations' integers, kept per thread (their limbs are
+   reused; a thread's are freed by mesh_check_release). */
+static _Thread_local mpz_t pool[15];
+static _Thread_local int pool_ready;
+
+static mpz_t *pool_get(void) {
+  if (!pool_ready) {
+    for (int i = 0; i < 15; i++) mpz_init2(pool[i], 256);
+    pool_ready = 1;
+  }
+  return pool;
+}
+
+void mesh_check_release(void) {
+  if (!pool_ready) return;
+  for (int i = 0; i < 15; i++) mpz_clear(pool[i]);
+  pool_ready = 0;
+}
+
+static int orient3d_exact(const double a[3], const double b[3],
+                          const double c[3], const double d[3]) {
+  double x[12];
+  for (int i = 0; i < 3; i++)
+    x[i] = a[i], x[3 + i] = b[i], x[6 + i] = c[i], x[9 + i] = d[i];
+  int e0 = least_exp(x, 12);
+  mpz_t *z = pool_get(), *u = z + 12, *v = z + 13, *det = z + 14;
+  for (int i = 0; i < 12; i++) to_mpz(z[i], x[i], e0);
+  mpz_set_ui(*det, 0);
+  for (int i = 0; i < 9; i++) mpz_sub(z[i], z[i], z[9 + i % 3]);
+  /* z[0..2] = a - d, z[3..5] = b - d, z[6..8] = c - d; the first row's
+     cofactors */
+  static const int r[3][2] = {{1, 2}, {2, 0}, {0, 1}};
+  for (int k = 0; k < 3; k++) {
+    mpz_mul(*u, z[3 + r[k][0]], z[6 + r[k][1]]);
+    mpz_mul(*v, z[3 + r[k][1]], z[6 + r[k][0]]);
+    mpz_sub(*u, *u, *v);
+    mpz_addmul(*det, z[k], *u);
+  }
+  return mpz_sgn(*det);
+}
+
+static int same2(const double *p, const double *q, int i, int j) {
+  return p[i] == q[i] && p[j] == q[j];
+}
+
+static int two_places(const double *a, const double *b, const double *c,
+                      const double *d) {
+  for (int k = 0; k < 3; k++) {
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    /* a's place, and the first point elsewhere */
+    const double *p[3] = {b, c, d}, *o = NULL;
+    int ok = 1;
+    for (int q = 0; q < 3 && ok; q++) {
+      if (same2(p[q], a, i, j)) continue;
+      if (!o) o = p[q];
+      else if (!same2(p[q], o, i, j)) ok = 0;
+    }
+    if (ok) return 1;
+  }
+  return 0;
+}
+
+/* safe: every coordinate is known to be a multiple of 2^-300 and below
+   2^299 in magnitude (safe_coords), so every difference is tame. */
+static int orient3d(const double a[3], const double b[3], const double c[3],
+                    const double d[3], long *exact, int safe) {
+  double adx = a[0] - d[0], bdx = b[0] - d[0], cdx = c[0] - d[0];
+  double ady = a[1] - d[1], bdy = b[1] - d[1], cdy = c[1] - d[1];
+  double adz = a[2] - d[2], bdz = b[2] - d[2], cdz = c[2] - d[2];
+  if (safe || (tame(adx) & tame(bdx) & tame(cdx) & tame(ady) & tame(bdy) &
+               tame(cdy) & tame(adz) & tame(bdz) & tame(cdz))) {
+    double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
+    double cdxady = cdx * ady, adxcdy = adx * cdy;
+    double adxbdy = adx * bdy, bdxady = bdx * ady;
+    double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) +
+                 cdz * (adxbdy - bdxady);
+    double perm = (fabs(bdxcdy) + fabs(cdxbdy)) * fabs(adz) +
+                  (fabs(cdxady) + fabs(adxcdy)) * fabs(bdz) +
+                  (fabs(adxbdy) + fabs(bdxady)) * fabs(cdz);
+    double bound = o3d_bound * perm;
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+    /* every product zero (none underflows): the determinant is */
+    if (perm == 0) return 0;
+    /* the same in long double, with its own epsilon: the differences of
+       doubles near each other are exact, and the bound shrinks 2^11
+       times where LDBL_MANT_DIG is 64 */
+    long double Adx = (long double)a[0] - d[0], Bdx = (long double)b[0] - d[0],
+                Cdx = (long double)c[0] - d[0], Ady = (long double)a[1] - d[1],
+                Bdy = (long double)b[1] - d[1], Cdy = (long double)c[1] - d[1],
+                Adz = (long double)a[2] - d[2], Bdz = (long double)b[2] - d[2],
+                Cdz = (long double)c[2] - d[2];
+    long double P1 = Bdx * Cdy, P2 = Cdx * Bdy, P3 = Cdx * Ady, P4 = Adx * Cdy,
+                P5 = Adx * Bdy, P6 = Bdx * Ady;
+    long double D = Adz * (P1 - P2) + Bdz * (P3 - P4) + Cdz * (P5 - P6);
+    long double Q = (fabsl(P1) + fabsl(P2)) * fabsl(Adz) +
+                    (fabsl(P3) + fabsl(P4)) * fabsl(Bdz) +
+                    (fabsl(P5) + fabsl(P6)) * fabsl(Cdz);
+    long double B = o3d_bound_l * Q;
+    if (D > B) return 1;
+    if (-D > B) return -1;
+  }
+  /* four points whose projections along an axis take two places at most
+     (marching vertices on the grid's lines: a rounded edge along an
+     axis) lie in a plane along that axis */
+  if (two_places(a, b, c, d)) return 0;
+  if (exact) ++*exact;
+  return orient3d_exact(a, b, c, d);
+}
+
+int mesh_orient3d(const double a[3], const double b[3], const double c[3],
+                  const double d[3], long *exact) {
+  return orient3d(a, b, c, d, exact, 0);
+}
+
+/* Every coordinate zero or a multiple of 2^-300 (its last mantissa bit
+   at 2^-300 or above), and under 2^299: a nonzero difference of two is
+   then between 2^-300 and 2^300. */
+static int safe_coords(const double *v, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    if (v[i] == 0) continue;
+    int ex;
+    frexp(v[i], &ex);
+    if (ex - 53 < -300 || ex > 299) return 0;
+  }
+  return 1;
+}
+
+int mesh_orient2d(const double a[3], const double b[3], const double c[3],
+                  int i, int j, long *exact) {
+  double acx = a[i] - c[i], bcx = b[i] - c[i];
+  double acy = a[j] - c[j], bcy = b[j] - c[j];
+  if (tame(acx) && tame(bcx) && tame(acy) && tame(bcy)) {
+    double l = acx * bcy, r = acy * bcx, det = l - r;
+    double bound = o2d_bound * (fabs(l) + fabs(r));
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+    if (l == 0 && r == 0) return 0;
+  }
+  if (exact) ++*exact;
+  double x[6] = {a[i], a[j], b[i], b[j], c[i], c[j]};
+  int e0 = least_exp(x, 6);
+  mpz_t *z = pool_get(), *u = z + 12, *v = z + 13;
+  for (int k = 0; k < 6; k++) to_mpz(z[k], x[k], e0);
+  for (int k = 0; k < 4; k++) mpz_sub(z[k], z[k], z[4 + k % 2]);
+  mpz_mul(*u, z[0], z[3]);
+  mpz_mul(*v, z[1], z[2]);
+  int s = mpz_cmp(*u, *v);
+  return s > 0 ? 1 : s < 0 ? -1 : 0;
+}
+
+/* ---- the pair test ------------------------------------------------------- */
+
+typedef struct {
+  long *ex;      /* counts the exact evaluations */
+  int i, j;      /* the projection's axes (2-D tests) */
+  int safe;      /* safe_coords holds for the mesh */
+} Ctx;
+
+static int o3(Ctx *c, const double *a, const double *b, const double *p,
+              const double *d) {
+  return orient3d(a, b, p, d, c->ex, c->safe);
+}
+
+static int o2(Ctx *c, const double *a, const double *b, const double *p) {
+  return mesh_orient2d(a, b, p, c->i, c->j, c->ex);
+}
+
+/* The axis k along which triangle abc projects to a triangle of nonzero
+   area (the axes i, j of the projection set in c, the sign of its area
+   in *s), or -1 if a, b, c are collinear. The axis of the largest
+   normal component is tried first. */
+static int tri_axis(Ctx *c, const double *a, const double *b, const double *p,
+                    int *s) {
+  double u[3], v[3], n[3];
+  for (int k = 0; k < 3; k++) u[k] = b[k] - a[k], v[k] = p[k] - a[k];
+  n[0] = fabs(u[1] * v[2] - u[2] * v[1]);
+  n[1] = fabs(u[2] * v[0] - u[0] * v[2]);
+  n[2] = fabs(u[0] * v[1] - u[1] * v[0]);
+  int order[3] = {0, 1, 2};
+  for (int x = 0; x < 3; x++)
+    for (int y = x + 1; y < 3; y++)
+      if (n[order[y]] > n[order[x]]) {
+        int t = order[x];
+        order[x] = order[y];
+        order[y] = t;
+      }
+  for (int q = 0; q < 3; q++) {
+    int k = order[q];
+    c->i = (k + 1) % 3;
+    c->j = (k + 2) % 3;
+    *s = o2(c, a, b, p);
+    if (*s) return k;
+  }
+  return -1;
+}
+
+static void set_axis(Ctx *c, int k) {
+  c->i = (k + 1) % 3;
+  c->j = (k + 2) % 3;
+}
+
+/* Closed segments pq and rs of one plane (the projection in c) meet. */
+static int seg_seg2(Ctx *c, const double *p, const double *q, const double *r,
+                    const double *s) {
+  int d1 = o2(c, p, q, r), d2 = o2(c, p, q, s);
+  if (d1 * d2 > 0) return 0;
+  int d3 = o2(c, r, s, p), d4 = o2(c, r, s, q);
+  if (d3 * d4 > 0) return 0;
+  if ((d1 == 0 && d2 == 0) || (d3 == 0 && d4 == 0)) {
+    /* collinear: they meet where their boxes do */
+    for (int a = 0; a < 2; a++) {
+      int k = a ? c->j : c->i;
+      if (fmax(p[k], q[k]) < fmin(r[k], s[k]) || fmax(r[k], s[k]) < fmin(p[k], q[k]))
+        return 0;
+    }
+  }
+  return 1;
+}
+
+/* Point p in the closed triangle abc of sign s in the projection. */
+static int pt_tri2(Ctx *c, const double *p, const double *a, const double *b,
+                   const double *q, int s) {
+  return o2(c, a, b, p) * s >= 0 && o2(c, b, q, p) * s >= 0 &&
+         o2(c, q, a, p) * s >= 0;
+}
+
+/* Closed segment pq and closed triangle abc (sign s) in one plane. */
+static int seg_tri2(Ctx *c, const double *p, const double *q, const double *a,
+                    const double *b, const double *t, int s) {
+  return pt_tri2(c, p, a, b, t, s) || pt_tri2(c, q, a, b, t, s) ||
+         seg_seg2(c, p, q, a, b) || seg_seg2(c, p, q, b, t) ||
+         seg_seg2(c, p, q, t, a);
+}
+
+/* Closed triangles a and b (neither collinear) of one plane meet, in the
+   projection set in c: no side of either has the other wholly strictly
+   beyond it (the separating axis theorem in the plane). */
+struct Tri;
+static int tri_tri2(Ctx *c, const struct Tri *a, const struct Tri *b);
+
+typedef struct Tri {
+  const double *v[3]; /* its vertices */
+  int id[3];          /* their indices */
+  int k, s;           /* tri_axis; -1: collinear */
+} Tri;
+
+static int tri_tri2(Ctx *c, const Tri *a, const Tri *b) {
+  for (int pass = 0; pass < 2; pass++) {
+    const Tri *x = pass ? b : a, *y = pass ? a : b;
+    /* x's orientation in the projection: inside is where o2 has its sign */
+    int sx = o2(c, x->v[0], x->v[1], x->v[2]);
+    for (int e = 0; e < 3; e++) {
+      int out = 0;
+      for (int q = 0; q < 3; q++)
+        out += o2(c, x->v[e], x->v[(e + 1) % 3], y->v[q]) * sx < 0;
+      if (out == 3) return 0;
+    }
+  }
+  return 1;
+}
+
+/* Closed segment pq meets closed triangle t (not collinear); sp, sq: the
+   signs of p and q against t's plane. */
+static int seg_tri3(Ctx *c, const double *p, const double *q, const Tri *t,
+                    int sp, int sq) {
+  if (sp * sq > 0) return 0;
+  const double *a = t->v[0], *b = t->v[1], *d = t->v[2];
+  if (sp == 0 && sq == 0) {
+    set_axis(c, t->k);
+    return seg_tri2(c, p, q, a, b, d, t->s);
+  }
+  /* the segment crosses the plane at one point: inside the closed
+     triangle when the line passes no edge on the wrong side */
+  int s1 = o3(c, p, q, a, b), s2 = o3(c, p, q, b, d), s3 = o3(c, p, q, d, a);
+  return !((s1 > 0 || s2 > 0 || s3 > 0) && (s1 < 0 || s2 < 0 || s3 < 0));
+}
+
+/* Vertex x = t->v[vi] of t (not collinear), y in t's plane: y - x in t's
+   angle at x. */
+static int into2(Ctx *c, const Tri *t, int vi, const double *y) {
+  const double *x = t->v[vi], *p = t->v[(vi + 1) % 3], *q = t->v[(vi + 2) % 3];
+  set_axis(c, t->k);
+  return o2(c, x, p, y) * t->s >= 0 && o2(c, x, y, q) * t->s >= 0;
+}
+
+/* Vertex x = t->v[vi] of t (not collinear): the segment from x to y goes
+   into t beyond x (y in t's plane, and y - x in t's angle at x). */
+static int into(Ctx *c, const Tri *t, int vi, const double *y) {
+  const double *x = t->v[vi], *p = t->v[(vi + 1) % 3], *q = t->v[(vi + 2) % 3];
+  return o3(c, x, p, q, y) == 0 && into2(c, t, vi, y);
+}
+
+static int where(const Tri *t, int id) {
+  for (int q = 0; q < 3; q++)
+    if (t->id[q] == id) return q;
+  return -1;
+}
+
+/* The two pieces [e0, m], [m, e1] of a collinear triangle (m the middle
+   vertex), as vertex positions in t. */
+static void pieces(const Tri *t, int pc[2][2]) {
+  int d = 0;
+  double spread = -1;
+  for (int k = 0; k < 3; k++) {
+    double lo = fmin(t->v[0][k], fmin(t->v[1][k], t->v[2][k]));
+    double hi = fmax(t->v[0][k], fmax(t->v[1][k], t->v[2][k]));
+    if (hi - lo > spread) spread = hi - lo, d = k;
+  }
+  int o[3] = {0, 1, 2};
+  for (int x = 0; x < 3; x++)
+    for (int y = x + 1; y < 3; y++)
+      if (t->v[o[y]][d] < t->v[o[x]][d]) {
+        int w = o[x];
+        o[x] = o[y];
+        o[y] = w;
+      }
+  pc[0][0] = o[0], pc[0][1] = o[1];
+  pc[1][0] = o[1], pc[1][1] = o[2];
+}
+
+/* Piece [x, y] of collinear triangle a (positions in a) against triangle
+   b (not collinear): they meet outside what a and b share. */
+static int piece_tri(Ctx *c, const Tri *a, int px, int py, const Tri *b) {
+  int x = a->id[px], y = a->id[py], z = a->id[3 - px - py];
+  int bx = where(b, x), by = where(b, y);
+  if (bx >= 0 && by >= 0) return 0; /* an edge of b */
+  if (bx < 0 && by < 0) {
+    const double *p = a->v[px], *q = a->v[py];
+    return seg_tri3(c, p, q, b, o3(c, b->v[0], b->v[1], b->v[2], p),
+                    o3(c, b->v[0], b->v[1], b->v[2], q));
+  }
+  if (by >= 0) { /* the shared end first */
+    int t = px;
+    px = py, py = t;
+    bx = by;
+  }
+  /* [x, y] from a shared vertex: when the third vertex z is shared too
+     and y lies between x and z, the piece is in what they share */
+  if (where(b, z) >= 0) {
+    const double *X = a->v[px], *Y = a->v[py], *Z = a->v[3 - px - py];
+    int between = 1;
+    for (int k = 0; k < 3; k++)
+      if (!(fmin(X[k], Z[k]) <= Y[k] && Y[k] <= fmax(X[k], Z[k]))) between = 0;
+    if (between) return 0;
+  }
+  return into(c, b, bx, a->v[py]);
+}
+
+/* Two collinear triangles: each the union of its two pieces. */
+static int seg_seg3(Ctx *c, const Tri *a, const Tri *b) {
+  int pa[2][2], pb[2][2];
+  pieces(a, pa);
+  pieces(b, pb);
+  /* all four extremes on one line? */
+  const double *x = a->v[pa[0][0]], *y = a->v[pa[1][1]];
+  const double *r = b->v[pb[0][0]], *t = b->v[pb[1][1]];
+  if (o3(c, x, y, r, t) != 0) return 0; /* skew lines */
+  int k = -1;
+  for (int q = 0; q < 3 && k < 0; q++) {
+    set_axis(c, q);
+    if (o2(c, x, y, r) || o2(c, x, y, t)) k = q;
+  }
+  if (k >= 0) { /* two lines of one plane, crossing at one point at most */
+    set_axis(c, k);
+    if (!seg_seg2(c, x, y, r, t)) return 0;
+    /* they meet in one point: allowed when it is a shared vertex, the
+       end of a piece of each */
+    for (int i = 0; i < 3; i++)
+      if (where(b, a->id[i]) >= 0) return 0;
+    return 1;
+  }
+  /* one line: intervals along the axis of the largest spread */
+  int d = 0;
+  double spread = -1;
+  for (int q = 0; q < 3; q++)
+    if (fmax(fabs(y[q] - x[q]), fabs(t[q] - r[q])) > spread)
+      spread = fmax(fabs(y[q] - x[q]), fabs(t[q] - r[q])), d = q;
+  double lo = fmax(fmin(x[d], y[d]), fmin(r[d], t[d]));
+  double hi = fmin(fmax(x[d], y[d]), fmax(r[d], t[d]));
+  if (lo > hi) return 0;
+  double slo = INFINITY, shi = -INFINITY;
+  for (int i = 0; i < 3; i++)
+    if (where(b, a->id[i]) >= 0) {
+      slo = fmin(slo, a->v[i][d]);
+      shi = fmax(shi, a->v[i][d]);
+    }
+  return !(slo <= lo && hi <= shi);
+}
+
+/* The common cases decided by the planes alone (most pairs are
+   neighbours on a curved surface): the vertices of one triangle other
+   than those it shares strictly on one side of the other's plane (a
+   collinear triangle has every point on its "plane": never decided
+   here). */
+static int early_out(Ctx *c, const Tri *A, const Tri *B, int shared) {
+  for (int pass = 0; pass < 2; pass++) {
+    const Tri *a = pass ? B : A, *b = pass ? A : B;
+    int pos = 0, neg = 0, n = 0;
+    for (int q = 0; q < 3; q++) {
+      if (where(a, b->id[q]) >= 0) continue;
+      int s = o3(c, a->v[0], a->v[1], a->v[2], b->v[q]);
+      pos += s > 0, neg += s < 0, n++;
+      if (pos && neg) break;
+      if (!s) break;
+    }
+    if (pos == n || neg == n) return 1;
+    if (shared == 2) return 0; /* the other pass sees the same plane pair */
+  }
+  return 0;
+}
+
+static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
+  Tri A, B;
+  const int *ta = m->t + 3 * i, *tb = m->t + 3 * j;
+  int shared = 0;
+  for (int q = 0; q < 3; q++) {
+    A.id[q] = ta[q];
+    B.id[q] = tb[q];
+    A.v[q] = m->v + 3 * (size_t)ta[q];
+    B.v[q] = m->v + 3 * (size_t)tb[q];
+  }
+  for (int x = 0; x < 3; x++)
+    for (int y = 0; y < 3; y++) {
+      if (A.id[x] == B.id[y]) shared++;
+      else if (A.v[x][0] == B.v[y][0] && A.v[x][1] == B.v[y][1] &&
+               A.v[x][2] == B.v[y][2])
+        return 1; /* two vertices at one place */
+    }
+  if (shared >= 3) return 1; /* the same three vertices twice */
+  if (early_out(c, &A, &B, shared)) return 0;
+  A.k = tri_axis(c, A.v[0], A.v[1], A.v[2], &A.s);
+  B.k = tri_axis(c, B.v[0], B.v[1], B.v[2], &B.s);
+  if (A.k < 0 || B.k < 0) {
+    if (A.k < 0 && B.k < 0) return seg_seg3(c, &A, &B);
+    const Tri *a = A.k < 0 ? &A : &B, *b = A.k < 0 ? &B : &A;
+    int pc[2][2];
+    pieces(a, pc);
+    return piece_tri(c, a, pc[0][0], pc[0][1], b) ||
+           piece_tri(c, a, pc[1][0], pc[1][1], b);
+  }
+  if (shared == 0) {
+    int sa[3], sb[3], pa = 0, na = 0, pb = 0, nb = 0;
+    for (int q = 0; q < 3; q++) {
+      sb[q] = o3(c, A.v[0], A.v[1], A.v[2], B.v[q]);
+      pb += sb[q] > 0;
+      nb += sb[q] < 0;
+    }
+    if (pb == 3 || nb == 3) return 0;
+    for (int q = 0; q < 3; q++) {
+      sa[q] = o3(c, B.v[0], B.v[1], B.v[2], A.v[q]);
+      pa += sa[q] > 0;
+      na += sa[q] < 0;
+    }
+    if (pa == 3 || na == 3) return 0;
+    if (!pb && !nb) { /* one plane */
+      set_axis(c, A.k);
+      return tri_tri2(c, &A, &B);
+    }
+    for (int e = 0; e < 3; e++)
+      if (seg_tri3(c, A.v[e], A.v[(e + 1) % 3], &B, sa[e], sa[(e + 1) % 3]) ||
+          seg_tri3(c, B.v[e], B.v[(e + 1) % 3], &A, sb[e], sb[(e + 1) % 3]))
+        return 1;
+    return 0;
+  }
+  if (shared == 1) {
+    int ia = 0, ib = 0;
+    for (int x = 0; x < 3; x++)
+      for (int y = 0; y < 3; y++)
+        if (A.id[x] == B.id[y]) ia = x, ib = y;
+    /* the edges opposite the shared vertex against the other triangle */
+    const double *a1 = A.v[(ia + 1) % 3], *a2 = A.v[(ia + 2) % 3];
+    const double *b1 = B.v[(ib + 1) % 3], *b2 = B.v[(ib + 2) % 3];
+    int s1 = o3(c, A.v[0], A.v[1], A.v[2], b1), s2 = o3(c, A.v[0], A.v[1], A.v[2], b2);
+    if (s1 == 0 && s2 == 0)
+      /* one plane: two angles at v, each under 180 degrees, overlap
+         beyond v exactly when a side of one lies in the other */
+      return into2(c, &B, ib, a1) || into2(c, &B, ib, a2) ||
+             into2(c, &A, ia, b1) || into2(c, &A, ia, b2);
+    int r1 = o3(c, B.v[0], B.v[1], B.v[2], a1), r2 = o3(c, B.v[0], B.v[1], B.v[2], a2);
+    if (seg_tri3(c, a1, a2, &B, r1, r2) || seg_tri3(c, b1, b2, &A, s1, s2))
+      return 1;
+    /* the edges at the shared vertex going into the other triangle (only
+       an edge in the other's plane can) */
+    return (!r1 && into2(c, &B, ib, a1)) || (!r2 && into2(c, &B, ib, a2)) ||
+           (!s1 && into2(c, &A, ia, b1)) || (!s2 && into2(c, &A, ia, b2));
+  }
+  /* one shared edge u w: improper only when the planes agree and the
+     third vertices lie on one side of it (folded onto each other) */
+  int a3 = 0, b3 = 0;
+  for (int q = 0; q < 3; q++) {
+    if (where(&B, A.id[q]) < 0) a3 = q;
+    if (where(&A, B.id[q]) < 0) b3 = q;
+  }
+  const double *u = A.v[(a3 + 1) % 3], *w = A.v[(a3 + 2) % 3];
+  if (o3(c, u, w, A.v[a3], B.v[b3]) != 0) return 0;
+  set_axis(c, A.k);
+  return o2(c, u, w, A.v[a3]) * o2(c, u, w, B.v[b3]) > 0;
+}
+
+int mesh_tri_pair(const Mesh *m, size_t i, size_t j) {
+  Ctx c = {NULL, 0, 1, 0};
+  return pair(&c, m, i, j);
+}
+
+/* ---- the broad phase: a uniform grid over the triangles' boxes ---------- */
+
+/* Triangle i's box. */
+static void tri_box(const Mesh *m, size_t i, double l[3], double h[3]) {
+  for (int a = 0; a < 3; a++) {
+    l[a] = INFINITY, h[a] = -INFINITY;
+    for (int k = 0; k < 3; k++) {
+      double x = m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)a];
+      l[a] = fmin(l[a], x);
+      h[a] = fmax(h[a], x);
+    }
+  }
+}
+
+/* x as a float no greater (down) or no less (up) than x. */
+static float down(double x) {
+  if (x > FLT_MAX) return FLT_MAX;
+  float f = (float)x;
+  return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+
+static float up(double x) {
+  if (x < -FLT_MAX) return -FLT_MAX;
+  float f = (float)x;
+  return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
+/* The grid's cells are taken in blocks by CHECK_THREADS threads. */
+#define CHECK_THREADS 2
+#define CHECK_BLOCK 256
+
+typedef struct {
+  const Mesh *m;
+  const float *box;        /* per triangle: lo[3], hi[3] (outward) */
+  uint16_t (*cb)[6];       /* per triangle: its cells' range */
+  const size_t *cnt;       /* cell q's triangles: items[cnt[q - 1] ..
+                              cnt[q]) (from 0 for q = 0) */
+  const int *items;
+  int g[3];
+  size_t ncell;
+  atomic_size_t next;      /* the next block of cells */
+  int safe;
+} Scan;
+
+typedef struct {
+  Scan *sc;
+  long pairs, exact, bad;
+  size_t first;            /* the cell of the first intersecting pair */
+  size_t tri[2];
+  double at[3];
+} Part;
+
+static void *scan(void *arg) {
+  Part *pt = arg;
+  Scan *sc = pt->sc;
+  const float *box = sc->box;
+  uint16_t (*cb)[6] = sc->cb;
+  Ctx ctx = {&pt->exact, 0, 1, sc->safe};
+  for (;;) {
+    size_t q0 = atomic_fetch_add(&sc->next, CHECK_BLOCK);
+    if (q0 >= sc->ncell) break;
+    size_t q1 = q0 + CHECK_BLOCK < sc->ncell ? q0 + CHECK_BLOCK : sc->ncell;
+    for (size_t q = q0; q < q1; q++) {
+      int cx = (int)(q / ((size_t)sc->g[1] * (size_t)sc->g[2]));
+      int cy = (int)(q / (size_t)sc->g[2] % (size_t)sc->g[1]);
+      int cz = (int)(q % (size_t)sc->g[2]);
+      size_t start = q ? sc->cnt[q - 1] : 0, end = sc->cnt[q];
+      for (size_t x = start; x < end; x++)
+        for (size_t y = x + 1; y < end; y++) {
+          size_t i = (size_t)sc->items[x], j = (size_t)sc->items[y];
+          const float *bi = box + 6 * i, *bj = box + 6 * j;
+          if (bi[0] > bj[3] || bj[0] > bi[3] || bi[1] > bj[4] || bj[1] > bi[4] ||
+              bi[2] > bj[5] || bj[2] > bi[5])
+            continue;
+          /* tested in the first cell both reach */
+          if ((cb[i][0] > cb[j][0] ? cb[i][0] : cb[j][0]) != cx ||
+              (cb[i][1] > cb[j][1] ? cb[i][1] : cb[j][1]) != cy ||
+              (cb[i][2] > cb[j][2] ? cb[i][2] : cb[j][2]) != cz)
+            continue;
+          pt->pairs++;
+          if (pair(&ctx, sc->m, i, j) && !pt->bad++) {
+            pt->first = q;
+            pt->tri[0] = i, pt->tri[1] = j;
+            for (int a = 0; a < 3; a++)
+              pt->at[a] = 0.5 * ((double)fmaxf(bi[a], bj[a]) + (double)fminf(bi[3 + a], bj[3 + a]));
+          }
+        }
+    }
+  }
+  mesh_check_release();
+  return NULL;
+}
+
+int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  memset(c, 0, sizeof *c);
+  size_t nt = m->nt;
+  for (size_t i = 0; i < 3 * nt; i++)
+    if (m->t[i] < 0 || (size_t)m->t[i] >= m->nv) return -1;
+  for (size_t i = 0; i < 3 * m->nv; i++)
+    if (!isfinite(m->v[i])) return -1;
+  if (nt < 2) return 0;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double mean = 0;
+  for (size_t i = 0; i < nt; i++) {
+    double l[3], h[3], side = 0;
+    tri_box(m, i, l, h);
+    for (int a = 0; a < 3; a++) {
+      lo[a] = fmin(lo[a], l[a]);
+      hi[a] = fmax(hi[a], h[a]);
+      side = fmax(side, h[a] - l[a]);
+    }
+    mean += side;
+  }
+  mean /= (double)nt;
+  /* cells about twice a triangle's box, at most 2 nt of them */
+  double cs = 2 * mean;
+  int g[3];
+  for (;;) {
+    size_t n = 1;
+    for (int a = 0; a < 3; a++) {
+      double w = (hi[a] - lo[a]) / cs;
+      g[a] = w < 1 ? 1 : w > 65535 ? 65535 : (int)ceil(w);
+      n *= (size_t)g[a];
+    }
+    if (cs > 0 && n <= 2 * nt + 8) break;
+    cs = cs > 0 ? cs * 1.26 : fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2])) + 1;
+  }
+  /* a triangle's cells: the monotone map x -> floor((x - lo) / cs) of its
+     exact box, clamped, so two closed boxes that overlap share a cell;
+     the box kept in floats rounded outward (the overlap test is then
+     conservative: it only lets more pairs through to the exact test) */
+  float *box = malloc(6 * nt * sizeof *box);
+  uint16_t (*cb)[6] = malloc(nt * sizeof *cb);
+  size_t ncell = (size_t)g[0] * (size_t)g[1] * (size_t)g[2];
+  size_t *cnt = calloc(ncell + 1, sizeof *cnt);
+  int *items = NULL, rc = 0;
+  if (!box || !cb || !cnt) {
+    rc = -2;
+    goto out;
+  }
+  for (size_t i = 0; i < nt; i++) {
+    double b[2][3];
+    tri_box(m, i, b[0], b[1]);
+    for (int a = 0; a < 3; a++)
+      for (int e = 0; e < 2; e++) {
+        double f = floor((b[e][a] - lo[a]) / cs);
+        cb[i][3 * e + a] = (uint16_t)(f < 0 ? 0 : f >= g[a] ? g[a] - 1 : (int)f);
+        box[6 * i + 3 * (size_t)e + (size_t)a] = e ? up(b[e][a]) : down(b[e][a]);
+      }
+  }
+  /* counting sort of the (cell, triangle) entries: cnt[q] counts cell q's
+     entries, then is made the end of cell q's run as it is filled */
+  for (int pass = 0; pass < 2; pass++) {
+    for (size_t i = 0; i < nt; i++)
+      for (int x = cb[i][0]; x <= cb[i][3]; x++)
+        for (int y = cb[i][1]; y <= cb[i][4]; y++)
+          for (int z = cb[i][2]; z <= cb[i][5]; z++) {
+            size_t q = ((size_t)x * (size_t)g[1] + (size_t)y) * (size_t)g[2] + (size_t)z;
+            if (pass) items[cnt[q]++] = (int)i;
+            else cnt[q]++;
+          }
+    if (!pass) {
+      size_t sum = 0;
+      for (size_t q = 0; q <= ncell; q++) {
+        size_t n = cnt[q];
+        cnt[q] = sum;
+        sum += n;
+      }
+      items = malloc((sum ? sum : 1) * sizeof *items);
+      if (!items) {
+        rc = -2;
+        goto out;
+      }
+    }
+  }
+  Scan sc = {m, box, cb, cnt, items, {g[0], g[1], g[2]}, ncell, 0,
+             safe_coords(m->v, 3 * m->nv)};
+  int nth = nt < 20000 ? 1 : CHECK_THREADS;
+  Part part[CHECK_THREADS];
+  pthread_t th[CHECK_THREADS];
+  memset(part, 0, sizeof part);
+  for (int t = 0; t < nth; t++) {
+    part[t].sc = &sc;
+    part[t].first = SIZE_MAX;
+  }
+  int started = 1;
+  for (int t = 1; t < nth; t++)
+    if (pthread_create(&th[t], NULL, scan, &part[t]) == 0) started++;
+    else break;
+  scan(&part[0]);
+  for (int t = 1; t < started; t++) pthread_join(th[t], NULL);
+  size_t first = SIZE_MAX;
+  for (int t = 0; t < started; t++) {
+    c->pairs += part[t].pairs;
+    c->exact += part[t].exact;
+    c->bad += part[t].bad;
+    if (part[t].bad && part[t].first < first) {
+      first = part[t].first;
+      c->tri[0] = part[t].tri[0], c->tri[1] = part[t].tri[1];
+      memcpy(c->at, part[t].at, sizeof c->at);
+    }
+  }
+  rc = c->bad > 0;
+out:
+  mesh_check_release();
+  free(box);
+  free(cb);
+  free(cnt);
+  free(items);
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  c->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+  return rc;
+}
