@@ -70,4 +70,15 @@ int camera_setup(Camera *cam, const RenderSettings *rs, int has_box,
 /* The unit direction of the primary ray through image position (px, py)
    (pixels from the top-left corner); the ray starts at cam->eye. */
 void camera_ray(const Camera *cam, double px, double py, double d[3]);
+
+/* camera_ray in three steps, for a renderer that shares a column's or a
+   row's factor among its rays (the same values): camera_ray(cam, px, py,
+   d) is camera_dir(cam, camera_u(cam, px), camera_v(cam, py), d). */
+static inline double camera_u(const Camera *cam, double px) {
+  return (2 * px / cam->width - 1) * cam->tan_half * cam->aspect;
+}
+static inline double camera_v(const Camera *cam, double py) {
+  return (1 - 2 * py / cam->height) * cam->tan_half;
+}
+void camera_dir(const Camera *cam, double u, double v, double d[3]);
 #endif

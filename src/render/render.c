@@ -20,6 +20,8 @@
 /* Tiles are traced in blocks of CULL_BLOCK x CULL_BLOCK pixels, each
    culled and pruned to its own rays (TileCull). */
 #define CULL_BLOCK 8
+/* The largest n of n x n samples per pixel (render_scene checks). */
+#define GRID_MAX 16
 
 /* ---- boxes ---- */
 
@@ -1246,12 +1248,20 @@ static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
   Hull H;
   for (int i = 0; i < 3; i++) H.lo[i] = INFINITY, H.hi[i] = -INFINITY;
   double pmax = 1;
+  /* camera_ray's factors of the block's sample columns and rows, once */
+  double us[CULL_BLOCK * GRID_MAX], vs[CULL_BLOCK * GRID_MAX];
+  for (int x = x0; x < x1; x++)
+    for (int sx = 0; sx < g; sx++)
+      us[(x - x0) * g + sx] = camera_u(&T->cam, x + sample_off(sx, g));
+  for (int y = y0; y < y1; y++)
+    for (int sy = 0; sy < g; sy++)
+      vs[(y - y0) * g + sy] = camera_v(&T->cam, y + sample_off(sy, g));
   Sample *sp = W->samples;
   for (int y = y0; y < y1; y++)
     for (int x = x0; x < x1; x++)
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++, sp++) {
-          camera_ray(&T->cam, x + sample_off(sx, g), y + sample_off(sy, g),
+          camera_dir(&T->cam, us[(x - x0) * g + sx], vs[(y - y0) * g + sy],
                      sp->d);
           long w0 = ray_work(W->c);
           sp->found = primary_hit(W, T->cam.eye, sp->d, &sp->h, tc);
@@ -1551,7 +1561,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   memset(rep, 0, sizeof *rep);
   if (img_check_size(rs->width, rs->height, err, errlen)) return NULL;
   int grid = (int)lround(sqrt((double)rs->spp));
-  if (rs->spp < 1 || grid * grid != rs->spp || grid > 16) {
+  if (rs->spp < 1 || grid * grid != rs->spp || grid > GRID_MAX) {
     snprintf(err, errlen, "samples per pixel must be a square number from 1 "
              "to 256 (1, 4, 9, ...: an n x n stratified grid), not %d",
              rs->spp);

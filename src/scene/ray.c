@@ -399,9 +399,9 @@ void ray_normal(const Scene *s, int id, int flip, const double p[3],
   const ScNode *nd = &s->nodes[id];
   double g[3] = {0, 0, 0};
   switch (nd->kind) {
-  case SC_HALFSPACE:
-    memcpy(g, nd->n, sizeof g);
-    break;
+  case SC_HALFSPACE:   /* ray_normal_grad of its n, made by scene_add */
+    memcpy(n, nd->un[flip != 0], sizeof nd->un[0]);
+    return;
   case SC_ROUNDED: /* outward is down the density gradient */
     dt_density_grad(nd->tape, p, g);
     for (int i = 0; i < 3; i++) g[i] = -g[i];
