@@ -440,9 +440,17 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
       trace(s, &sg, &lb, INFINITY, LG_SEG_FLAT, nc, 0);
       continue;
     }
-    double len = sg.b - sg.a;
-    double lhs = lg_multiroot_length(sg.fa, sg.dfa, sg.fb, sg.dfb, lb.L, lb.G);
-    int shorty = lhs > len * LG_SAFE;
+    double len = sg.b - sg.a, lim = len * LG_SAFE;
+    /* lg_multiroot_length, its second reach skipped when the first alone
+       exceeds lim and nothing traces lhs: reach of a finite f is never
+       NaN and never negative, so the sum would exceed lim too (rounding
+       is monotonic) */
+    double lhs = reach(sg.fa, sg.dfa, lb.L, lb.G);
+    int shorty = 1;
+    if (!(lhs > lim && !s->hook && isfinite(sg.fb) && isfinite(sg.dfb))) {
+      lhs += reach(sg.fb, -sg.dfb, lb.L, lb.G);
+      shorty = lhs > lim;
+    }
     double minlen = max2(s->tol, 16 * DBL_EPSILON * max2(fabs(sg.a), fabs(sg.b)));
     double m = 0.5 * (sg.a + sg.b);
     if (!isnan(lb.split) && lb.split > sg.a + 0.25 * minlen &&
