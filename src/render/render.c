@@ -1191,12 +1191,11 @@ static void progress(Tracer *T) {
 
 /* A pixel's values from its g x g samples' radiance, central AOVs and
    hits (render_tile's two forms). */
-static inline void put_pixel(const Tracer *T, int x, int y, const double sum[3],
-                      int hits, double zmin, const double nrm0[3],
-                      long cost) {
+static inline void put_pixel(const Tracer *T, int g, int x, int y,
+                             const double sum[3], int hits, double zmin,
+                             const double nrm0[3], long cost) {
   Image *im = T->im;
   const RenderSettings *rs = T->rs;
-  int g = T->grid;
   size_t k = img_index(im, x - im->x0, y - im->y0);
   /* one sample: dividing by 1 is exact, so it is skipped */
   for (int i = 0; i < 3; i++)
@@ -1237,10 +1236,10 @@ static inline void add_sample(Worker *W, long work, const double rgb[3],
    shadow rays are culled to the hull of their origins and each light.
    Rays do not depend on each other, so the pixels are those of the one
    pass form, bit for bit. */
-static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
+static inline __attribute__((always_inline)) void
+tile_culled(Worker *W, int x0, int x1, int y0, int y1, int g) {
   Tracer *T = W->T;
   const RenderSettings *rs = T->rs;
-  int g = T->grid;
   const TileCull *tc = NULL;
   if (cull_bvh_frustum(T, &W->tc, x0 + 0.5 / g, x1 - 1 + (g - 0.5) / g,
                        y0 + 0.5 / g, y1 - 1 + (g - 0.5) / g) == 0)
@@ -1302,8 +1301,15 @@ static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
           add_sample(W, w, rgb, z, nrm, sx == g / 2 && sy == g / 2, sum,
                      &hits, &zmin, nrm0);
         }
-      put_pixel(T, x, y, sum, hits, zmin, nrm0, cost);
+      put_pixel(T, g, x, y, sum, hits, zmin, nrm0, cost);
     }
+}
+
+/* g (T->grid) a constant in the common one sample a pixel: its loops
+   and divisions by 1 go (the same values). */
+static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
+  if (W->T->grid == 1) tile_culled(W, x0, x1, y0, y1, 1);
+  else tile_culled(W, x0, x1, y0, y1, W->T->grid);
 }
 
 static void render_tile(Worker *W, int tile) {
@@ -1339,7 +1345,7 @@ static void render_tile(Worker *W, int tile) {
           add_sample(W, ray_work(W->c) - w0, rgb, z, nrm,
                      sx == g / 2 && sy == g / 2, sum, &hits, &zmin, nrm0);
         }
-      put_pixel(T, x, y, sum, hits, zmin, nrm0, ray_work(W->c) - work0);
+      put_pixel(T, g, x, y, sum, hits, zmin, nrm0, ray_work(W->c) - work0);
     }
 }
 
