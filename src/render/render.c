@@ -990,7 +990,8 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
    With tc (a ray of tc's tile): only the BVH nodes and slots tc found
    live are visited, and rounded nodes are searched on tc's tapes (the
    same answer: TileCull). */
-static int trace(const Tracer *T, const double o[3], const double d[3],
+static inline __attribute__((always_inline)) int
+trace(const Tracer *T, const double o[3], const double d[3],
                  double t0, double t1, RayCtx *c, Hit *best, int any,
                  const TileCull *tc) {
   int found = 0;
@@ -1339,7 +1340,7 @@ static void render_tile(Worker *W, int tile) {
           double d[3], rgb[3], z, nrm[3];
           camera_ray(&T->cam, x + sample_off(sx, g), y + sample_off(sy, g), d);
           long w0 = ray_work(W->c);
-          Hit h;
+          Hit h = {0};   /* grad is read only when the search set it */
           int found = primary_hit(W, T->cam.eye, d, &h, NULL);
           shade_hit(W, T->cam.eye, d, found, &h, rgb, &z, nrm, NULL);
           add_sample(W, ray_work(W->c) - w0, rgb, z, nrm,
