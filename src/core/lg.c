@@ -175,7 +175,7 @@ static double sdiv(double x, double y) {
 
 /* The least distance from an end to a turning point after the first root
  * (lg.h): f there, df its derivative moving inwards. */
-static double reach(double f, double df, double L, double G) {
+static inline __attribute__((always_inline)) double reach(double f, double df, double L, double G) {
   double g = fabs(f), gp = f >= 0 ? df : -df;
   double s = 0;
   if (g > 0) {
@@ -523,7 +523,9 @@ static int run(const lg_query *q, const double *iv, int n, int bounded_iv) {
   int nc = t->ncode > 0 ? t->ncode : 1;
   /* Buffers: the interval's view, nlv levels (the first is the interval's
    * view itself), one scratch. */
-  int nlv = LG_LEVEL_CODE / nc - 2;
+  /* (without the integer division when the cap decides: a short tape) */
+  int nlv = nc <= LG_LEVEL_CODE / (LG_MAX_LEVELS + 2) ? LG_MAX_LEVELS
+                                                     : LG_LEVEL_CODE / nc - 2;
   if (nlv > LG_MAX_LEVELS) nlv = LG_MAX_LEVELS;
   if (nlv < 1) nlv = 1;
   size_t need = (size_t)(nlv + 2) * (size_t)nc;
