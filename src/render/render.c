@@ -918,7 +918,8 @@ static inline int halfspace_hit(const ScNode *n, int node, int pi,
 /* The first surface crossing of one primitive in (t0, t1); with any != 0
    (a shadow ray) a rounded primitive may report any t in (t0, t1] when
    there is a crossing, and none when there is none. */
-static int prim_hit(const Tracer *T, int pi, const double o[3],
+static inline __attribute__((always_inline)) int
+prim_hit(const Tracer *T, int pi, const double o[3],
                     const double d[3], double t0, double t1, RayCtx *c,
                     Hit *h, int any) {
   const Scene *s = T->s;
