@@ -538,9 +538,16 @@ static inline int convex_span(const csg_tape *t, const double *dots, int g,
   return 1;
 }
 
+static int ray_spans_loop(const csg_tape *t, const double *dots,
+                          const double o[3], const double d[3], double s0,
+                          double s1, csg_span *out, int maxout,
+                          csg_span *scratch, int nscratch);
+
 /* Roth's ray casting: one span per halfspace, combined bottom-up with the
  * span-list set operations; dots as csg_ray_spans_dots has them, or
- * NULL. */
+ * NULL. The two common shapes of a bound here, the rest in
+ * ray_spans_loop (out of line: its frame and scratch lists are not set
+ * up for the common ones). */
 static inline int ray_spans(const csg_tape *t, const double *dots,
                             const double o[3], const double d[3], double s0,
                             double s1, csg_span *out, int maxout,
@@ -549,7 +556,7 @@ static inline int ray_spans(const csg_tape *t, const double *dots,
   if (t->nrcode == 1 && t->rcode[0].op == CSG_CONVEX && maxout >= 1)
     return convex_span(t, dots, t->rcode[0].arg, o, d, s0, s1, out);
   /* Two convex polyhedra and one operation (a bound with a hole): the
-     same spans and merge as the loop below, without its scratch lists. */
+     same spans and merge as the loop, without its scratch lists. */
   if (t->nrcode == 3 && t->rcode[0].op == CSG_CONVEX &&
       t->rcode[1].op == CSG_CONVEX) {
     csg_span x, y, m[2];
@@ -565,6 +572,13 @@ static inline int ray_spans(const csg_tape *t, const double *dots,
     for (int i = 0; i < n; i++) out[i] = m[i];   /* at most 2: no memcpy */
     return n;
   }
+  return ray_spans_loop(t, dots, o, d, s0, s1, out, maxout, scratch, nscratch);
+}
+
+static int ray_spans_loop(const csg_tape *t, const double *dots,
+                          const double o[3], const double d[3], double s0,
+                          double s1, csg_span *out, int maxout,
+                          csg_span *scratch, int nscratch) {
   csg_span local[CSG_LOCAL_SPANS];
   int need = csg_scratch_spans(t);
   if (!scratch) {
