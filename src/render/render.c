@@ -1098,8 +1098,9 @@ typedef struct Worker {
 } Worker;
 
 /* The primary ray of one camera sample: its hit, if any (counted). */
-static inline int primary_hit(Worker *W, const double o[3], const double d[3],
-                       Hit *h, const TileCull *tc) {
+static inline __attribute__((always_inline)) int
+primary_hit(Worker *W, const double o[3], const double d[3], Hit *h,
+            const TileCull *tc) {
   const Tracer *T = W->T;
   RayCtx *c = W->c;
   long evals0 = c->stats.lg.evals;
