@@ -577,8 +577,9 @@ int lg_roots(const dt_tape *t, const double o[3], const double d[3],
 
 /* Search the given sorted spans, each widened by tol (plus a few ulps) and
    clipped to [q->t0, q->t1]; widened neighbours are merged. */
-static int spans_run(const lg_query *q, const csg_span *spans, int nspans,
-                     int bounded_iv) {
+static inline __attribute__((always_inline)) int
+spans_run(const lg_query *q, const csg_span *spans, int nspans,
+          int bounded_iv) {
   const double tol = q->tol, t0 = q->t0, t1 = q->t1;
   double local[2 * 64], *iv = local;
   if (nspans > 64) {
