@@ -229,7 +229,8 @@ static double feval(search *s, const dt_tape *t, double x, double *df) {
 }
 
 /* Returns 0 when out is full (the search stops). */
-static int emit(search *s, const dt_tape *view, double t, int kind) {
+static inline __attribute__((always_inline)) int
+emit(search *s, const dt_tape *view, double t, int kind) {
   if (s->n >= s->maxout) return 0;
   /* One graze seen from two adjacent tiny segments is one touch. */
   if (kind == LG_TOUCH && s->n > 0 && t - s->out[s->n - 1].t <= s->tol)
@@ -269,8 +270,9 @@ static int pos(double f) { return f > 0; }
  * max(tol, 4 ulp).  An end where f is exactly 0 is on the surface: the
  * change is there when it is the outside end next to the bracket's inside
  * part, so exact zeros (a face plane at density 0.5) come back exactly. */
-static double polish(search *s, const dt_tape *t, double a, double b,
-                     double fa, double fb, double dfa, double dfb) {
+static inline __attribute__((always_inline)) double
+polish(search *s, const dt_tape *t, double a, double b, double fa, double fb,
+       double dfa, double dfb) {
   /* The caller only asks whether there is a crossing after first_after
    * (a shadow ray): the bracket's far end stands for it. */
   if (s->first == 2 && a > s->first_after) return b;
