@@ -389,14 +389,11 @@ int csg_inside(const csg_tape *t, const double p[3]) {
   return st[0];
 }
 
-int csg_scratch_spans(const csg_tape *t) {
-  return 2 * t->nleaves + 2;
-}
-
 /* Roth's union: merge by start, coalescing overlapping or touching
  * spans. */
-int csg_spans_union(const csg_span *a, int na, const csg_span *b, int nb,
-                    csg_span *out) {
+static inline __attribute__((always_inline)) int
+spans_union(const csg_span *a, int na, const csg_span *b, int nb,
+            csg_span *out) {
   int i = 0, j = 0, n = 0;
   while (i < na || j < nb) {
     const csg_span *s = (j >= nb || (i < na && a[i].t0 <= b[j].t0)) ? &a[i++]
@@ -414,8 +411,9 @@ int csg_spans_union(const csg_span *a, int na, const csg_span *b, int nb,
   return n;
 }
 
-int csg_spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
-                    csg_span *out) {
+static inline __attribute__((always_inline)) int
+spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
+            csg_span *out) {
   int i = 0, j = 0, n = 0;
   while (i < na && j < nb) {
     const csg_span *lo = a[i].t0 >= b[j].t0 ? &a[i] : &b[j];
@@ -432,8 +430,9 @@ int csg_spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
 
 /* a minus b: each span of a loses the parts covered by b; the cut ends
  * take b's surfaces with their normals flipped. */
-int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
-                   csg_span *out) {
+static inline __attribute__((always_inline)) int
+spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
+           csg_span *out) {
   int j = 0, n = 0;
   for (int i = 0; i < na; i++) {
     csg_span cur = a[i];
@@ -456,6 +455,23 @@ int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
     if (cur.t0 < cur.t1) out[n++] = cur;
   }
   return n;
+}
+
+/* The public set operations: the inline forms above (which ray_spans
+   uses in place). */
+int csg_spans_union(const csg_span *a, int na, const csg_span *b, int nb,
+                    csg_span *out) {
+  return spans_union(a, na, b, nb, out);
+}
+
+int csg_spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
+                    csg_span *out) {
+  return spans_inter(a, na, b, nb, out);
+}
+
+int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
+                   csg_span *out) {
+  return spans_diff(a, na, b, nb, out);
 }
 
 /* The one span (or none) of a halfspace; parallel rays are classified by
@@ -563,10 +579,10 @@ static inline int ray_spans(const csg_tape *t, const double *dots,
     int nx = convex_span(t, dots, t->rcode[0].arg, o, d, s0, s1, &x);
     int ny = convex_span(t, dots, t->rcode[1].arg, o, d, s0, s1, &y), n;
     switch (t->rcode[2].op) {
-    case CSG_UNION: n = csg_spans_union(&x, nx, &y, ny, m); break;
-    case CSG_INTER: n = csg_spans_inter(&x, nx, &y, ny, m); break;
-    case CSG_DIFF: n = csg_spans_diff(&x, nx, &y, ny, m); break;
-    default: n = csg_spans_diff(&y, ny, &x, nx, m); break;
+    case CSG_UNION: n = spans_union(&x, nx, &y, ny, m); break;
+    case CSG_INTER: n = spans_inter(&x, nx, &y, ny, m); break;
+    case CSG_DIFF: n = spans_diff(&x, nx, &y, ny, m); break;
+    default: n = spans_diff(&y, ny, &x, nx, m); break;
     }
     if (n > maxout) return -1;
     for (int i = 0; i < n; i++) out[i] = m[i];   /* at most 2: no memcpy */
@@ -613,10 +629,10 @@ static int ray_spans_loop(const csg_tape *t, const double *dots,
     csg_span *x = &scratch[off[sp - 1]], *y = &scratch[off[sp]];
     int nx = cnt[sp - 1], ny = cnt[sp], n;
     switch (in->op) {
-    case CSG_UNION: n = csg_spans_union(x, nx, y, ny, tmp); break;
-    case CSG_INTER: n = csg_spans_inter(x, nx, y, ny, tmp); break;
-    case CSG_DIFF: n = csg_spans_diff(x, nx, y, ny, tmp); break;
-    default: n = csg_spans_diff(y, ny, x, nx, tmp); break;
+    case CSG_UNION: n = spans_union(x, nx, y, ny, tmp); break;
+    case CSG_INTER: n = spans_inter(x, nx, y, ny, tmp); break;
+    case CSG_DIFF: n = spans_diff(x, nx, y, ny, tmp); break;
+    default: n = spans_diff(y, ny, x, nx, tmp); break;
     }
     memcpy(x, tmp, (size_t)n * sizeof *tmp);
     cnt[sp - 1] = n;
