@@ -15,9 +15,11 @@
 static inline double mulnn(double x, double y) {
   /* x * y is NaN only for 0 * inf (the operands are >= +0 and not NaN),
      so this is the product with that case made 0, without a branch on
-     each operand; bit for bit the same as testing them. */
+     each operand; bit for bit the same as testing them. Otherwise it is
+     +0 or above (never -0), so r > 0 ? r : 0 keeps it to the bit and
+     turns a NaN into 0: one maxsd instead of a compare and a move. */
   double r = x * y;
-  return r == r ? r : 0;
+  return r > 0 ? r : 0;
 }
 
 /* iv_mul (interval.h), to the last bit: when both intervals are ordered
