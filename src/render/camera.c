@@ -116,10 +116,3 @@ int camera_setup(Camera *cam, const RenderSettings *rs, int has_box,
 void camera_ray(const Camera *cam, double px, double py, double d[3]) {
   camera_dir(cam, camera_u(cam, px), camera_v(cam, py), d);
 }
-
-void camera_dir(const Camera *cam, double u, double v, double d[3]) {
-  for (int i = 0; i < 3; i++)
-    d[i] = cam->fwd[i] + u * cam->right[i] + v * cam->upv[i];
-  double len = sqrt(vec3_dot(d, d));
-  for (int i = 0; i < 3; i++) d[i] /= len;
-}

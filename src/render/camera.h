@@ -42,6 +42,7 @@
 
 #include <stddef.h>
 
+#include "core/vec.h"
 #include "render/render.h"
 #include "scene/scene.h"
 
@@ -80,5 +81,11 @@ static inline double camera_u(const Camera *cam, double px) {
 static inline double camera_v(const Camera *cam, double py) {
   return (1 - 2 * py / cam->height) * cam->tan_half;
 }
-void camera_dir(const Camera *cam, double u, double v, double d[3]);
+static inline void camera_dir(const Camera *cam, double u, double v,
+                              double d[3]) {
+  for (int i = 0; i < 3; i++)
+    d[i] = cam->fwd[i] + u * cam->right[i] + v * cam->upv[i];
+  double len = sqrt(vec3_dot(d, d));
+  for (int i = 0; i < 3; i++) d[i] /= len;
+}
 #endif
