@@ -389,14 +389,11 @@ int csg_inside(const csg_tape *t, const double p[3]) {
   return st[0];
 }
 
-int csg_scratch_spans(const csg_tape *t) {
-  return 2 * t->nleaves + 2;
-}
-
 /* Roth's union: merge by start, coalescing overlapping or touching
  * spans. */
-int csg_spans_union(const csg_span *a, int na, const csg_span *b, int nb,
-                    csg_span *out) {
+static inline __attribute__((always_inline)) int
+spans_union(const csg_span *a, int na, const csg_span *b, int nb,
+            csg_span *out) {
   int i = 0, j = 0, n = 0;
   while (i < na || j < nb) {
     const csg_span *s = (j >= nb || (i < na && a[i].t0 <= b[j].t0)) ? &a[i++]
@@ -414,8 +411,9 @@ int csg_spans_union(const csg_span *a, int na, const csg_span *b, int nb,
   return n;
 }
 
-int csg_spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
-                    csg_span *out) {
+static inline __attribute__((always_inline)) int
+spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
+            csg_span *out) {
   int i = 0, j = 0, n = 0;
   while (i < na && j < nb) {
     const csg_span *lo = a[i].t0 >= b[j].t0 ? &a[i] : &b[j];
@@ -432,8 +430,9 @@ int csg_spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
 
 /* a minus b: each span of a loses the parts covered by b; the cut ends
  * take b's surfaces with their normals flipped. */
-int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
-                   csg_span *out) {
+static inline __attribute__((always_inline)) int
+spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
+           csg_span *out) {
   int j = 0, n = 0;
   for (int i = 0; i < na; i++) {
     csg_span cur = a[i];
@@ -456,6 +455,23 @@ int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
     if (cur.t0 < cur.t1) out[n++] = cur;
   }
   return n;
+}
+
+/* The public set operations: the inline forms above (which ray_spans
+   uses in place). */
+int csg_spans_union(const csg_span *a, int na, const csg_span *b, int nb,
+                    csg_span *out) {
+  return spans_union(a, na, b, nb, out);
+}
+
+int csg_spans_inter(const csg_span *a, int na, const csg_span *b, int nb,
+                    csg_span *out) {
+  return spans_inter(a, na, b, nb, out);
+}
+
+int csg_spans_diff(const csg_span *a, int na, const csg_span *b, int nb,
+                   csg_span *out) {
+  return spans_diff(a, na, b, nb, out);
 }
 
 /* The one span (or none) of a halfspace; parallel rays are classified by
@@ -538,9 +554,16 @@ static inline int convex_span(const csg_tape *t, const double *dots, int g,
   return 1;
 }
 
+static int ray_spans_loop(const csg_tape *t, const double *dots,
+                          const double o[3], const double d[3], double s0,
+                          double s1, csg_span *out, int maxout,
+                          csg_span *scratch, int nscratch);
+
 /* Roth's ray casting: one span per halfspace, combined bottom-up with the
  * span-list set operations; dots as csg_ray_spans_dots has them, or
- * NULL. */
+ * NULL. The two common shapes of a bound here, the rest in
+ * ray_spans_loop (out of line: its frame and scratch lists are not set
+ * up for the common ones). */
 static inline int ray_spans(const csg_tape *t, const double *dots,
                             const double o[3], const double d[3], double s0,
                             double s1, csg_span *out, int maxout,
@@ -549,22 +572,29 @@ static inline int ray_spans(const csg_tape *t, const double *dots,
   if (t->nrcode == 1 && t->rcode[0].op == CSG_CONVEX && maxout >= 1)
     return convex_span(t, dots, t->rcode[0].arg, o, d, s0, s1, out);
   /* Two convex polyhedra and one operation (a bound with a hole): the
-     same spans and merge as the loop below, without its scratch lists. */
+     same spans and merge as the loop, without its scratch lists. */
   if (t->nrcode == 3 && t->rcode[0].op == CSG_CONVEX &&
       t->rcode[1].op == CSG_CONVEX) {
     csg_span x, y, m[2];
     int nx = convex_span(t, dots, t->rcode[0].arg, o, d, s0, s1, &x);
     int ny = convex_span(t, dots, t->rcode[1].arg, o, d, s0, s1, &y), n;
     switch (t->rcode[2].op) {
-    case CSG_UNION: n = csg_spans_union(&x, nx, &y, ny, m); break;
-    case CSG_INTER: n = csg_spans_inter(&x, nx, &y, ny, m); break;
-    case CSG_DIFF: n = csg_spans_diff(&x, nx, &y, ny, m); break;
-    default: n = csg_spans_diff(&y, ny, &x, nx, m); break;
+    case CSG_UNION: n = spans_union(&x, nx, &y, ny, m); break;
+    case CSG_INTER: n = spans_inter(&x, nx, &y, ny, m); break;
+    case CSG_DIFF: n = spans_diff(&x, nx, &y, ny, m); break;
+    default: n = spans_diff(&y, ny, &x, nx, m); break;
     }
     if (n > maxout) return -1;
     for (int i = 0; i < n; i++) out[i] = m[i];   /* at most 2: no memcpy */
     return n;
   }
+  return ray_spans_loop(t, dots, o, d, s0, s1, out, maxout, scratch, nscratch);
+}
+
+static int ray_spans_loop(const csg_tape *t, const double *dots,
+                          const double o[3], const double d[3], double s0,
+                          double s1, csg_span *out, int maxout,
+                          csg_span *scratch, int nscratch) {
   csg_span local[CSG_LOCAL_SPANS];
   int need = csg_scratch_spans(t);
   if (!scratch) {
@@ -599,10 +629,10 @@ static inline int ray_spans(const csg_tape *t, const double *dots,
     csg_span *x = &scratch[off[sp - 1]], *y = &scratch[off[sp]];
     int nx = cnt[sp - 1], ny = cnt[sp], n;
     switch (in->op) {
-    case CSG_UNION: n = csg_spans_union(x, nx, y, ny, tmp); break;
-    case CSG_INTER: n = csg_spans_inter(x, nx, y, ny, tmp); break;
-    case CSG_DIFF: n = csg_spans_diff(x, nx, y, ny, tmp); break;
-    default: n = csg_spans_diff(y, ny, x, nx, tmp); break;
+    case CSG_UNION: n = spans_union(x, nx, y, ny, tmp); break;
+    case CSG_INTER: n = spans_inter(x, nx, y, ny, tmp); break;
+    case CSG_DIFF: n = spans_diff(x, nx, y, ny, tmp); break;
+    default: n = spans_diff(y, ny, x, nx, tmp); break;
     }
     memcpy(x, tmp, (size_t)n * sizeof *tmp);
     cnt[sp - 1] = n;

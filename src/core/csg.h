@@ -107,7 +107,9 @@ enum { CSG_BOX_OUT = 0, CSG_BOX_IN = 1, CSG_BOX_MIX = 2 };
 int csg_box_class(const csg_tape *t, const double lo[3], const double hi[3]);
 
 /* Scratch spans a ray query on t needs. */
-int csg_scratch_spans(const csg_tape *t);
+static inline int csg_scratch_spans(const csg_tape *t) {
+  return 2 * t->nleaves + 2;
+}
 
 /* The inside spans of the ray o + s*d for s in [s0, s1], sorted and
  * disjoint, written to out (at most maxout).  d may have any non-zero

@@ -442,7 +442,8 @@ static inline void fold_op(fold_state *f, const dt_instr *in, dt_instr *buf) {
  * the fold stack and only emitted when combined with live code.  A
  * finished tape is pruned through its prune program (density.h), with the
  * same result. */
-static int prune(const dt_tape *t, const double o[3], const double d[3],
+static inline __attribute__((always_inline)) int
+prune(const dt_tape *t, const double o[3], const double d[3],
                  const dt_ray_leaf *rl, const signed char *cls, int groups,
                  double s0, double s1, dt_instr *buf, dt_tape *view) {
   fold_state f;

@@ -15,9 +15,11 @@
 static inline double mulnn(double x, double y) {
   /* x * y is NaN only for 0 * inf (the operands are >= +0 and not NaN),
      so this is the product with that case made 0, without a branch on
-     each operand; bit for bit the same as testing them. */
+     each operand; bit for bit the same as testing them. Otherwise it is
+     +0 or above (never -0), so r > 0 ? r : 0 keeps it to the bit and
+     turns a NaN into 0: one maxsd instead of a compare and a move. */
   double r = x * y;
-  return r == r ? r : 0;
+  return r > 0 ? r : 0;
 }
 
 /* iv_mul (interval.h), to the last bit: when both intervals are ordered
@@ -175,7 +177,7 @@ static double sdiv(double x, double y) {
 
 /* The least distance from an end to a turning point after the first root
  * (lg.h): f there, df its derivative moving inwards. */
-static double reach(double f, double df, double L, double G) {
+static inline __attribute__((always_inline)) double reach(double f, double df, double L, double G) {
   double g = fabs(f), gp = f >= 0 ? df : -df;
   double s = 0;
   if (g > 0) {
@@ -229,7 +231,8 @@ static double feval(search *s, const dt_tape *t, double x, double *df) {
 }
 
 /* Returns 0 when out is full (the search stops). */
-static int emit(search *s, const dt_tape *view, double t, int kind) {
+static inline __attribute__((always_inline)) int
+emit(search *s, const dt_tape *view, double t, int kind) {
   if (s->n >= s->maxout) return 0;
   /* One graze seen from two adjacent tiny segments is one touch. */
   if (kind == LG_TOUCH && s->n > 0 && t - s->out[s->n - 1].t <= s->tol)
@@ -269,8 +272,9 @@ static int pos(double f) { return f > 0; }
  * max(tol, 4 ulp).  An end where f is exactly 0 is on the surface: the
  * change is there when it is the outside end next to the bracket's inside
  * part, so exact zeros (a face plane at density 0.5) come back exactly. */
-static double polish(search *s, const dt_tape *t, double a, double b,
-                     double fa, double fb, double dfa, double dfb) {
+static inline __attribute__((always_inline)) double
+polish(search *s, const dt_tape *t, double a, double b, double fa, double fb,
+       double dfa, double dfb) {
   /* The caller only asks whether there is a crossing after first_after
    * (a shadow ray): the bracket's far end stands for it. */
   if (s->first == 2 && a > s->first_after) return b;
@@ -440,9 +444,17 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
       trace(s, &sg, &lb, INFINITY, LG_SEG_FLAT, nc, 0);
       continue;
     }
-    double len = sg.b - sg.a;
-    double lhs = lg_multiroot_length(sg.fa, sg.dfa, sg.fb, sg.dfb, lb.L, lb.G);
-    int shorty = lhs > len * LG_SAFE;
+    double len = sg.b - sg.a, lim = len * LG_SAFE;
+    /* lg_multiroot_length, its second reach skipped when the first alone
+       exceeds lim and nothing traces lhs: reach of a finite f is never
+       NaN and never negative, so the sum would exceed lim too (rounding
+       is monotonic) */
+    double lhs = reach(sg.fa, sg.dfa, lb.L, lb.G);
+    int shorty = 1;
+    if (!(lhs > lim && !s->hook && isfinite(sg.fb) && isfinite(sg.dfb))) {
+      lhs += reach(sg.fb, -sg.dfb, lb.L, lb.G);
+      shorty = lhs > lim;
+    }
     double minlen = max2(s->tol, 16 * DBL_EPSILON * max2(fabs(sg.a), fabs(sg.b)));
     double m = 0.5 * (sg.a + sg.b);
     if (!isnan(lb.split) && lb.split > sg.a + 0.25 * minlen &&
@@ -515,7 +527,9 @@ static int run(const lg_query *q, const double *iv, int n, int bounded_iv) {
   int nc = t->ncode > 0 ? t->ncode : 1;
   /* Buffers: the interval's view, nlv levels (the first is the interval's
    * view itself), one scratch. */
-  int nlv = LG_LEVEL_CODE / nc - 2;
+  /* (without the integer division when the cap decides: a short tape) */
+  int nlv = nc <= LG_LEVEL_CODE / (LG_MAX_LEVELS + 2) ? LG_MAX_LEVELS
+                                                     : LG_LEVEL_CODE / nc - 2;
   if (nlv > LG_MAX_LEVELS) nlv = LG_MAX_LEVELS;
   if (nlv < 1) nlv = 1;
   size_t need = (size_t)(nlv + 2) * (size_t)nc;
@@ -567,8 +581,9 @@ int lg_roots(const dt_tape *t, const double o[3], const double d[3],
 
 /* Search the given sorted spans, each widened by tol (plus a few ulps) and
    clipped to [q->t0, q->t1]; widened neighbours are merged. */
-static int spans_run(const lg_query *q, const csg_span *spans, int nspans,
-                     int bounded_iv) {
+static inline __attribute__((always_inline)) int
+spans_run(const lg_query *q, const csg_span *spans, int nspans,
+          int bounded_iv) {
   const double tol = q->tol, t0 = q->t0, t1 = q->t1;
   double local[2 * 64], *iv = local;
   if (nspans > 64) {

@@ -114,11 +114,5 @@ int camera_setup(Camera *cam, const RenderSettings *rs, int has_box,
 }
 
 void camera_ray(const Camera *cam, double px, double py, double d[3]) {
-  double h = cam->tan_half;
-  double u = (2 * px / cam->width - 1) * h * cam->aspect;
-  double v = (1 - 2 * py / cam->height) * h;
-  for (int i = 0; i < 3; i++)
-    d[i] = cam->fwd[i] + u * cam->right[i] + v * cam->upv[i];
-  double len = sqrt(vec3_dot(d, d));
-  for (int i = 0; i < 3; i++) d[i] /= len;
+  camera_dir(cam, camera_u(cam, px), camera_v(cam, py), d);
 }

@@ -42,6 +42,7 @@
 
 #include <stddef.h>
 
+#include "core/vec.h"
 #include "render/render.h"
 #include "scene/scene.h"
 
@@ -70,4 +71,21 @@ int camera_setup(Camera *cam, const RenderSettings *rs, int has_box,
 /* The unit direction of the primary ray through image position (px, py)
    (pixels from the top-left corner); the ray starts at cam->eye. */
 void camera_ray(const Camera *cam, double px, double py, double d[3]);
+
+/* camera_ray in three steps, for a renderer that shares a column's or a
+   row's factor among its rays (the same values): camera_ray(cam, px, py,
+   d) is camera_dir(cam, camera_u(cam, px), camera_v(cam, py), d). */
+static inline double camera_u(const Camera *cam, double px) {
+  return (2 * px / cam->width - 1) * cam->tan_half * cam->aspect;
+}
+static inline double camera_v(const Camera *cam, double py) {
+  return (1 - 2 * py / cam->height) * cam->tan_half;
+}
+static inline void camera_dir(const Camera *cam, double u, double v,
+                              double d[3]) {
+  for (int i = 0; i < 3; i++)
+    d[i] = cam->fwd[i] + u * cam->right[i] + v * cam->upv[i];
+  double len = sqrt(vec3_dot(d, d));
+  for (int i = 0; i < 3; i++) d[i] /= len;
+}
 #endif

@@ -20,6 +20,8 @@
 /* Tiles are traced in blocks of CULL_BLOCK x CULL_BLOCK pixels, each
    culled and pruned to its own rays (TileCull). */
 #define CULL_BLOCK 8
+/* The largest n of n x n samples per pixel (render_scene checks). */
+#define GRID_MAX 16
 
 /* ---- boxes ---- */
 
@@ -916,7 +918,8 @@ static inline int halfspace_hit(const ScNode *n, int node, int pi,
 /* The first surface crossing of one primitive in (t0, t1); with any != 0
    (a shadow ray) a rounded primitive may report any t in (t0, t1] when
    there is a crossing, and none when there is none. */
-static int prim_hit(const Tracer *T, int pi, const double o[3],
+static inline __attribute__((always_inline)) int
+prim_hit(const Tracer *T, int pi, const double o[3],
                     const double d[3], double t0, double t1, RayCtx *c,
                     Hit *h, int any) {
   const Scene *s = T->s;
@@ -988,7 +991,8 @@ static int prim_hit(const Tracer *T, int pi, const double o[3],
    With tc (a ray of tc's tile): only the BVH nodes and slots tc found
    live are visited, and rounded nodes are searched on tc's tapes (the
    same answer: TileCull). */
-static int trace(const Tracer *T, const double o[3], const double d[3],
+static inline __attribute__((always_inline)) int
+trace(const Tracer *T, const double o[3], const double d[3],
                  double t0, double t1, RayCtx *c, Hit *best, int any,
                  const TileCull *tc) {
   int found = 0;
@@ -1094,8 +1098,9 @@ typedef struct Worker {
 } Worker;
 
 /* The primary ray of one camera sample: its hit, if any (counted). */
-static inline int primary_hit(Worker *W, const double o[3], const double d[3],
-                       Hit *h, const TileCull *tc) {
+static inline __attribute__((always_inline)) int
+primary_hit(Worker *W, const double o[3], const double d[3], Hit *h,
+            const TileCull *tc) {
   const Tracer *T = W->T;
   RayCtx *c = W->c;
   long evals0 = c->stats.lg.evals;
@@ -1189,12 +1194,11 @@ static void progress(Tracer *T) {
 
 /* A pixel's values from its g x g samples' radiance, central AOVs and
    hits (render_tile's two forms). */
-static inline void put_pixel(const Tracer *T, int x, int y, const double sum[3],
-                      int hits, double zmin, const double nrm0[3],
-                      long cost) {
+static inline void put_pixel(const Tracer *T, int g, int x, int y,
+                             const double sum[3], int hits, double zmin,
+                             const double nrm0[3], long cost) {
   Image *im = T->im;
   const RenderSettings *rs = T->rs;
-  int g = T->grid;
   size_t k = img_index(im, x - im->x0, y - im->y0);
   /* one sample: dividing by 1 is exact, so it is skipped */
   for (int i = 0; i < 3; i++)
@@ -1235,10 +1239,10 @@ static inline void add_sample(Worker *W, long work, const double rgb[3],
    shadow rays are culled to the hull of their origins and each light.
    Rays do not depend on each other, so the pixels are those of the one
    pass form, bit for bit. */
-static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
+static inline __attribute__((always_inline)) void
+tile_culled(Worker *W, int x0, int x1, int y0, int y1, int g) {
   Tracer *T = W->T;
   const RenderSettings *rs = T->rs;
-  int g = T->grid;
   const TileCull *tc = NULL;
   if (cull_bvh_frustum(T, &W->tc, x0 + 0.5 / g, x1 - 1 + (g - 0.5) / g,
                        y0 + 0.5 / g, y1 - 1 + (g - 0.5) / g) == 0)
@@ -1246,12 +1250,20 @@ static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
   Hull H;
   for (int i = 0; i < 3; i++) H.lo[i] = INFINITY, H.hi[i] = -INFINITY;
   double pmax = 1;
+  /* camera_ray's factors of the block's sample columns and rows, once */
+  double us[CULL_BLOCK * GRID_MAX], vs[CULL_BLOCK * GRID_MAX];
+  for (int x = x0; x < x1; x++)
+    for (int sx = 0; sx < g; sx++)
+      us[(x - x0) * g + sx] = camera_u(&T->cam, x + sample_off(sx, g));
+  for (int y = y0; y < y1; y++)
+    for (int sy = 0; sy < g; sy++)
+      vs[(y - y0) * g + sy] = camera_v(&T->cam, y + sample_off(sy, g));
   Sample *sp = W->samples;
   for (int y = y0; y < y1; y++)
     for (int x = x0; x < x1; x++)
       for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++, sp++) {
-          camera_ray(&T->cam, x + sample_off(sx, g), y + sample_off(sy, g),
+          camera_dir(&T->cam, us[(x - x0) * g + sx], vs[(y - y0) * g + sy],
                      sp->d);
           long w0 = ray_work(W->c);
           sp->found = primary_hit(W, T->cam.eye, sp->d, &sp->h, tc);
@@ -1292,8 +1304,15 @@ static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
           add_sample(W, w, rgb, z, nrm, sx == g / 2 && sy == g / 2, sum,
                      &hits, &zmin, nrm0);
         }
-      put_pixel(T, x, y, sum, hits, zmin, nrm0, cost);
+      put_pixel(T, g, x, y, sum, hits, zmin, nrm0, cost);
     }
+}
+
+/* g (T->grid) a constant in the common one sample a pixel: its loops
+   and divisions by 1 go (the same values). */
+static void render_tile_culled(Worker *W, int x0, int x1, int y0, int y1) {
+  if (W->T->grid == 1) tile_culled(W, x0, x1, y0, y1, 1);
+  else tile_culled(W, x0, x1, y0, y1, W->T->grid);
 }
 
 static void render_tile(Worker *W, int tile) {
@@ -1323,13 +1342,13 @@ static void render_tile(Worker *W, int tile) {
           double d[3], rgb[3], z, nrm[3];
           camera_ray(&T->cam, x + sample_off(sx, g), y + sample_off(sy, g), d);
           long w0 = ray_work(W->c);
-          Hit h;
+          Hit h = {0};   /* grad is read only when the search set it */
           int found = primary_hit(W, T->cam.eye, d, &h, NULL);
           shade_hit(W, T->cam.eye, d, found, &h, rgb, &z, nrm, NULL);
           add_sample(W, ray_work(W->c) - w0, rgb, z, nrm,
                      sx == g / 2 && sy == g / 2, sum, &hits, &zmin, nrm0);
         }
-      put_pixel(T, x, y, sum, hits, zmin, nrm0, ray_work(W->c) - work0);
+      put_pixel(T, g, x, y, sum, hits, zmin, nrm0, ray_work(W->c) - work0);
     }
 }
 
@@ -1551,7 +1570,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   memset(rep, 0, sizeof *rep);
   if (img_check_size(rs->width, rs->height, err, errlen)) return NULL;
   int grid = (int)lround(sqrt((double)rs->spp));
-  if (rs->spp < 1 || grid * grid != rs->spp || grid > 16) {
+  if (rs->spp < 1 || grid * grid != rs->spp || grid > GRID_MAX) {
     snprintf(err, errlen, "samples per pixel must be a square number from 1 "
              "to 256 (1, 4, 9, ...: an n x n stratified grid), not %d",
              rs->spp);

@@ -171,8 +171,6 @@ static int rounded_spans(const ScNode *n, int id, const double o[3],
   int nr = lg_search_bounded(&q, n->outer, n->inner);
   if (c->stats.lg.overflows != unsplit) c->unresolved_node = id;
   if (nr < 0) return -1;
-  double p[3] = {o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2]};
-  int inside = isfinite(t0) ? dt_density(n->tape, p) > 0.5 : 0;
   double t[MAX_LEAF_ROOTS];
   int kind[MAX_LEAF_ROOTS];
   for (int i = 0; i < nr; i++) {
@@ -180,12 +178,17 @@ static int rounded_spans(const ScNode *n, int id, const double o[3],
     kind[i] = roots[i].kind;
   }
   /* The state at t0 follows from the first real crossing when there is
-     one (robust at a surface exactly at t0). */
-  for (int i = 0; i < nr; i++)
-    if (kind[i] != LG_TOUCH) {
-      inside = kind[i] == LG_EXIT;
-      break;
-    }
+     one (robust at a surface exactly at t0); else from the density
+     there. */
+  int i = 0;
+  while (i < nr && kind[i] == LG_TOUCH) i++;
+  int inside;
+  if (i < nr) {
+    inside = kind[i] == LG_EXIT;
+  } else {
+    double p[3] = {o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2]};
+    inside = isfinite(t0) ? dt_density(n->tape, p) > 0.5 : 0;
+  }
   return crossings_to_spans(t, kind, nr, inside, id, t0, t1, out);
 }
 
@@ -396,9 +399,9 @@ void ray_normal(const Scene *s, int id, int flip, const double p[3],
   const ScNode *nd = &s->nodes[id];
   double g[3] = {0, 0, 0};
   switch (nd->kind) {
-  case SC_HALFSPACE:
-    memcpy(g, nd->n, sizeof g);
-    break;
+  case SC_HALFSPACE:   /* ray_normal_grad of its n, made by scene_add */
+    memcpy(n, nd->un[flip != 0], sizeof nd->un[0]);
+    return;
   case SC_ROUNDED: /* outward is down the density gradient */
     dt_density_grad(nd->tape, p, g);
     for (int i = 0; i < 3; i++) g[i] = -g[i];

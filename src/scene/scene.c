@@ -2,6 +2,8 @@
  * scene.h. */
 #include "scene/scene.h"
 
+#include "scene/ray.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,7 +28,11 @@ int scene_add(Scene *s, const ScNode *node) {
   if (n->a >= 0 && s->nodes[n->a].first < n->first) n->first = s->nodes[n->a].first;
   if (n->b >= 0 && s->nodes[n->b].first < n->first) n->first = s->nodes[n->b].first;
   switch (n->kind) {
-  case SC_HALFSPACE: s->flags |= SCENE_HAS_HALFSPACE; break;
+  case SC_HALFSPACE:
+    s->flags |= SCENE_HAS_HALFSPACE;
+    ray_normal_grad(n->n, 0, n->un[0]);   /* once, not per hit */
+    ray_normal_grad(n->n, 1, n->un[1]);
+    break;
   case SC_ROUNDED: s->flags |= SCENE_HAS_ROUNDED; break;
   case SC_SOFT:
     s->flags |= SCENE_HAS_SOFT;

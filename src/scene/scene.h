@@ -53,6 +53,8 @@ typedef struct ScNode {
   int first;             /* the lowest index in this node's subtree: the
                             subtree lies in first .. own index */
   double n[3], d;        /* SC_HALFSPACE: unit normal and offset */
+  double un[2][3];       /* SC_HALFSPACE: ray_normal's normal for flip 0
+                            and flip != 0 (set by scene_add) */
   dt_tape *tape;         /* SC_ROUNDED */
   csg_tape *outer, *inner; /* SC_ROUNDED: bounds of the 0.5 isosurface */
   int bound_flags;       /* BND_RANGE, BND_FALLBACK (core/bounds.h) */

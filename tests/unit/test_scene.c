@@ -1302,6 +1302,43 @@ static void test_convex_spans(void) {
         bad == 0 && used == 4 && spans > 4000);
 }
 
+/* ray_normal of a halfspace node reads the normals scene_add made with
+   ray_normal_grad: the same bits as ray_normal_grad of the node's n, for
+   both flips, for unit, unnormalised, tiny, huge and zero normals. */
+static void test_halfspace_normals(void) {
+  rng_t g = {777};
+  Scene *s = scene_new();
+  int bad = 0, n = 0;
+  for (int k = 0; s && k < 2000; k++) {
+    ScNode nd;
+    memset(&nd, 0, sizeof nd);
+    nd.kind = SC_HALFSPACE;
+    nd.a = nd.b = -1;
+    double scale = k % 4 == 0 ? 1 : k % 4 == 1 ? 1e-160 : k % 4 == 2 ? 1e150 : 3;
+    for (int i = 0; i < 3; i++) nd.n[i] = scale * rng_range(&g, -1, 1);
+    if (k % 9 == 0) nd.n[k % 3] = 0;
+    if (k == 5) nd.n[0] = nd.n[1] = nd.n[2] = 0;          /* no direction */
+    if (k == 6) nd.n[0] = INFINITY;                       /* not finite */
+    if (k % 4 == 0) {                                     /* unit, as compiled */
+      double len = sqrt(vec3_dot(nd.n, nd.n));
+      if (len > 0) for (int i = 0; i < 3; i++) nd.n[i] /= len;
+    }
+    nd.d = rng_range(&g, -2, 2);
+    int id = scene_add(s, &nd);
+    if (id < 0) { bad++; break; }
+    for (int flip = 0; flip <= 2; flip++) {
+      double p[3] = {rng_range(&g, -2, 2), 0, 1}, got[3], want[3];
+      ray_normal(s, id, flip, p, got);
+      ray_normal_grad(s->nodes[id].n, flip, want);
+      n++;
+      if (memcmp(got, want, sizeof got)) bad++;
+    }
+  }
+  CHECK("halfspace normals from the scene's table: ray_normal_grad's bits "
+        "(2000 nodes, flips 0, 1, 2)", s && bad == 0 && n == 6000);
+  scene_free(s);
+}
+
 int main(void) {
   check_prefix = "scene";
   I = bind_interp_new();
@@ -1315,5 +1352,6 @@ int main(void) {
   test_soft_cases();
   test_random_scenes();
   test_convex_spans();
+  test_halfspace_normals();
   CHECK_DONE();
 }
