@@ -753,17 +753,42 @@ static void interval_poly(const soft_obj *o, const key_event *act, int nact,
  * hold a key entering before its end has been opened. The state (inside or
  * not) at each interval boundary is computed once and imposed on both
  * neighbours, so a root on a boundary is found once. */
+static int roots_walk(const soft_obj *obj, const double o[3],
+                      const double d[3], double t0, double t1, double *out,
+                      int maxout, soft_scratch *scratch, soft_stats *stats,
+                      const soft_hook *hook, int any);
+
 int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
                double t0, double t1, double *out, int maxout,
                soft_scratch *scratch, soft_stats *stats) {
-  return soft_roots_traced(obj, o, d, t0, t1, out, maxout, scratch, stats,
-                           NULL);
+  return roots_walk(obj, o, d, t0, t1, out, maxout, scratch, stats, NULL, 0);
 }
 
 int soft_roots_traced(const soft_obj *obj, const double o[3],
                       const double d[3], double t0, double t1, double *out,
                       int maxout, soft_scratch *scratch, soft_stats *stats,
                       const soft_hook *hook) {
+  return roots_walk(obj, o, d, t0, t1, out, maxout, scratch, stats, hook, 0);
+}
+
+int soft_any(const soft_obj *obj, const double o[3], const double d[3],
+             double t0, double t1, double *t, soft_scratch *scratch,
+             soft_stats *stats) {
+  double by;
+  int n = roots_walk(obj, o, d, t0, t1, &by, 1, scratch, stats, NULL, 1);
+  if (n > 0 && t) *t = by < t1 ? by : t1;
+  return n;
+}
+
+/* The walk of soft_roots_traced; with any (maxout 1, no hook: soft_any)
+ * an interval whose end states differ ends the search with a crossing
+ * unsolved for (poly_crossings reports an odd number there, and with
+ * maxout 1 nothing before it can cancel its first: out[] holds only
+ * whether there is one). */
+static int roots_walk(const soft_obj *obj, const double o[3],
+                      const double d[3], double t0, double t1, double *out,
+                      int maxout, soft_scratch *scratch, soft_stats *stats,
+                      const soft_hook *hook, int any) {
   soft_stats dummy;
   if (!stats) { memset(&dummy, 0, sizeof dummy); stats = &dummy; }
   stats->rays++;
@@ -880,6 +905,10 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
         if (hook) hook->fn(hook->ctx, &ev);
       } else {
         int sb = poly_eval(c, 6, 1.0, NULL) > 0;
+        if (any && sb != state) {
+          out[nout++] = tnext / len;  /* a crossing in (cur, tnext] */
+          break;
+        }
         double v[POLY_MAX_DEG];
         poly_stats before = stats->poly;
         int nv = poly_crossings(c, 6, -1.0, 1.0, state, sb, 0, v, &stats->poly);

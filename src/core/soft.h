@@ -141,6 +141,17 @@ int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
                double t0, double t1, double *out, int maxout,
                soft_scratch *scratch, soft_stats *stats);
 
+/* Whether the ray crosses the surface in (t0, t1): soft_roots with
+ * maxout 1 returning 1, 0 or -1, the same answer on every ray (a shadow
+ * ray needs no more). It stops at the first interval between key-bound
+ * events whose ends lie on the two sides of the surface, without solving
+ * for the crossing there. On 1, *t (t may be NULL) is a t in (t0, t1]
+ * by which the ray has crossed: the crossing, or the end of the interval
+ * holding it. */
+int soft_any(const soft_obj *obj, const double o[3], const double d[3],
+             double t0, double t1, double *t, soft_scratch *scratch,
+             soft_stats *stats);
+
 /* Trace of soft_roots_traced: one event per interval between consecutive
  * key-bound events along the ray (the paper's step 1), saying how it was
  * decided (step 2). */
