@@ -18,7 +18,10 @@
 #define A1 (-22.0 / 9.0)
 #define A2 (17.0 / 9.0)
 #define A3 (-4.0 / 9.0)
-#define LEAF_MAX 4
+/* Keys a leaf of the key BVH holds at most: at 8 (median splits leave
+ * about 5 a leaf at soft-cloud's sizes) a ray pops fewer nodes than at 4
+ * for a few more key tests (bench/NOTES.md, 2026-11-26). */
+#define LEAF_MAX 8
 
 /* A key normalised to s(x) = (x-x0)' A (x-x0) + k, A already divided by
  * R^2 (for a sphere A = I/R^2, k = 0); the key acts where s < 1. */
