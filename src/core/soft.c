@@ -18,10 +18,13 @@
 #define A1 (-22.0 / 9.0)
 #define A2 (17.0 / 9.0)
 #define A3 (-4.0 / 9.0)
-/* Keys a leaf of the key BVH holds at most: at 8 (median splits leave
- * about 5 a leaf at soft-cloud's sizes) a ray pops fewer nodes than at 4
- * for a few more key tests (bench/NOTES.md, 2026-11-26). */
-#define LEAF_MAX 8
+/* Keys a leaf of the key BVH holds at most: at 16 (median splits leave
+ * about 10 a leaf at soft-cloud's sizes) a ray pops fewer nodes than at 4
+ * or 8 for more key tests, which read keys in a row; the walk is bound by
+ * its dependent loads more than by instructions (bench/NOTES.md,
+ * 2026-11-26: CPU paired, 10^4 keys: 8 0.885 of 4, 16 0.964 of 8, 32
+ * 1.014 of 16, 64 1.115). */
+#define LEAF_MAX 16
 
 /* A key normalised to s(x) = (x-x0)' A (x-x0) + k, A already divided by
  * R^2 (for a sphere A = I/R^2, k = 0); the key acts where s < 1. */
