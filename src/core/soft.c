@@ -849,15 +849,37 @@ static int roots_walk(const soft_obj *obj, const double o[3],
      * lowers tnext as it would the top of the key heap. */
     while (nn && nheap[0].t < tnext) {
       node_ent e = nheap_pop(nheap, &nn);
-      const bvh_node *nd = &obj->tree.nodes[e.i];
+      const bvh_node *nd;
+    open:
+      nd = &obj->tree.nodes[e.i];
       stats->nodes++;
       if (nd->count == 0) {
+        /* The nearer child met is opened at once when the heap would pop
+           it next (it enters no later than the heap's top, and before
+           tnext): the same nodes in the same order of entry, one push and
+           pop fewer (only ties may go the other way). */
         int f = nd->first;
         const bvh_node *ch = &obj->tree.nodes[f];
-        if (hit_box(&r, ch, &tn))  /* fmax(tn, cur), no call: */
-          nheap_push(nheap, &nn, (node_ent){tn > cur ? tn : cur, f});
-        if (hit_box(&r, ch + 1, &tn))
-          nheap_push(nheap, &nn, (node_ent){tn > cur ? tn : cur, f + 1});
+        double ta_ = INFINITY, tb_ = INFINITY;
+        int ha = hit_box(&r, ch, &ta_), hb = hit_box(&r, ch + 1, &tb_);
+        ta_ = ta_ > cur ? ta_ : cur;  /* fmax(tn, cur), no call */
+        tb_ = tb_ > cur ? tb_ : cur;
+        node_ent near_ = {ta_, f}, far_ = {tb_, f + 1};
+        int hn = ha, hf = hb;
+        if (hb && (!ha || tb_ < ta_)) {
+          near_ = far_;
+          far_ = (node_ent){ta_, f};
+          hn = hb;
+          hf = ha;
+        }
+        if (hf) nheap_push(nheap, &nn, far_);
+        if (hn) {
+          if (near_.t < tnext && (nn == 0 || near_.t <= nheap[0].t)) {
+            e = near_;
+            goto open;
+          }
+          nheap_push(nheap, &nn, near_);
+        }
       } else {
         for (int j = nd->first; j < nd->first + nd->count; j++) {
           key_event ev;
