@@ -59,6 +59,7 @@ struct soft_scratch {
   key_event *kheap;  /* discovered keys by entry, cap */
   key_event *act;    /* active keys, cap */
   double *sq;        /* s(v) coefficients of the active keys, 3 cap */
+  int plain;         /* soft_scratch_plain: no quick miss in hit_key */
 };
 
 /* eq. (1) in the factored form C(s) = (1 - s)^2 (1 - 4s/9): the same
@@ -634,6 +635,8 @@ soft_scratch *soft_scratch_new(size_t max_keys) {
   return s;
 }
 
+void soft_scratch_plain(soft_scratch *s, int plain) { s->plain = plain != 0; }
+
 void soft_scratch_free(soft_scratch *s) {
   if (!s) return;
   free(s->nheap);
@@ -677,8 +680,17 @@ static inline int hit_box(const soft_ray *r, const bvh_node *nd, double *tn) {
 
 /* eq. (2) into the key's quadric: s(t) = a2 (t - tc)^2 + smin along the
  * ray; the key acts where s < 1. Returns 0 if the ray misses its bound. */
-static int hit_key(const soft_ray *r, const nkey *k, double *te, double *tx) {
+static int hit_key(const soft_ray *r, const nkey *k, double *te, double *tx,
+                   int plain) {
   double p[3] = {r->o[0] - k->x0[0], r->o[1] - k->x0[1], r->o[2] - k->x0[2]};
+  if (k->sphere && !plain) {
+    /* A quick miss: s at the point of the line nearest the centre, a0
+       (|p|^2 - (p.d)^2), clearly >= 1. Its rounding, and smin's below, are
+       within a few eps of a0 |p|^2 (d is unit to an eps), far inside the
+       margin, so only keys the test below refuses are refused here. */
+    double pd = vec3_dot(p, r->d), pp = vec3_dot(p, p);
+    if (k->a[0] * (pp - pd * pd) > 1 + 1e-9 * (1 + k->a[0] * pp)) return 0;
+  }
   double ad[3], ap[3];
   apply_a(k, r->d, ad);
   double a2 = vec3_dot(r->d, ad), b = vec3_dot(p, ad);
@@ -827,6 +839,7 @@ static int roots_walk(const soft_obj *obj, const double o[3],
   r.ta = t0 * len;
   r.tb = t1 * len;
 
+  int plain = scratch->plain;
   node_ent *nheap = scratch->nheap;
   key_event *kheap = scratch->kheap, *act = scratch->act;
   int nn = 0, nk = 0, na = 0, nout = 0;
@@ -883,7 +896,8 @@ static int roots_walk(const soft_obj *obj, const double o[3],
       } else {
         for (int j = nd->first; j < nd->first + nd->count; j++) {
           key_event ev;
-          if (!hit_key(&r, &obj->keys[j], &ev.te, &ev.tx) || ev.tx <= cur) continue;
+          if (!hit_key(&r, &obj->keys[j], &ev.te, &ev.tx, plain) || ev.tx <= cur)
+            continue;
           stats->keys++;
           ev.te = ev.te > cur ? ev.te : cur;  /* fmax: te is not NaN */
           ev.i = j;

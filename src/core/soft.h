@@ -128,6 +128,12 @@ double soft_field_grad(const soft_obj *obj, const double p[3], double g[3]);
 soft_scratch *soft_scratch_new(size_t max_keys);
 void soft_scratch_free(soft_scratch *s);
 
+/* With plain nonzero, the walks on this scratch test every key they meet
+ * in full, without the quick miss that refuses a spherical key whose
+ * nearest point to the line is clearly outside it: the reference the
+ * tests hold the quick miss to (the same crossings, bit for bit). */
+void soft_scratch_plain(soft_scratch *s, int plain);
+
 /* The crossings of the surface by the ray o + t d, t0 < t < t1 (t1 may be
  * INFINITY), ascending, into out[0..maxout-1]; returns their number, or -1
  * if d is zero or not finite, o or t0/t1 is NaN, or the scratch is too

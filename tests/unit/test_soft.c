@@ -1027,6 +1027,117 @@ static void test_any(void)
   CHECK(name, sa.poly.solves < sr.poly.solves);
 }
 
+/* The key test's quick miss against plain key tests (soft_scratch_plain):
+ * every crossing, bit for bit, and the same keys met, on rays through the
+ * soft-cloud keys (3000), a lattice, and random clouds with quadric and
+ * negative keys; rays from outside, from inside, and shadow rays from
+ * surface points, long directions and rays at 1e6. */
+static long quick_rays(const soft_obj *o, const double lo[3], const double hi[3],
+                       int nrays, double dscale, soft_scratch *s, soft_scratch *p,
+                       long *roots)
+{
+  long bad = 0;
+  double mid[3], span = 0;
+  for (int i = 0; i < 3; i++) {
+    mid[i] = 0.5 * (lo[i] + hi[i]);
+    span = fmax(span, hi[i] - lo[i]);
+  }
+  for (int r = 0; r < nrays; r++) {
+    double org[3], d[3], a[64], b[64];
+    aim_ray(mid, span, org, d);
+    if (r % 3 == 0)  /* from inside the cloud's box */
+      for (int i = 0; i < 3; i++) org[i] = mid[i] + (rnd() - 0.5) * span;
+    else
+      for (int i = 0; i < 3; i++) org[i] = mid[i] + (org[i] - mid[i]) * span;
+    if (r % 5 == 4) {  /* along an axis, at a multiple of 0.7 off it */
+      int ax = r / 5 % 3;
+      for (int i = 0; i < 3; i++) {
+        d[i] = i == ax ? 1 : 0;
+        org[i] = i == ax ? lo[i] - 1 : 0.7 * floor(rnd() * 5);
+      }
+    }
+    for (int i = 0; i < 3; i++) d[i] *= dscale;
+    soft_stats sa, sb;
+    memset(&sa, 0, sizeof sa);
+    memset(&sb, 0, sizeof sb);
+    int na = soft_roots(o, org, d, 0, INFINITY, a, 64, s, &sa);
+    int nb = soft_roots(o, org, d, 0, INFINITY, b, 64, p, &sb);
+    if (na != nb || sa.keys != sb.keys || sa.intervals != sb.intervals ||
+        (na > 0 && memcmp(a, b, (size_t)na * sizeof *a) != 0)) bad++;
+    if (na > 0) {
+      *roots += na;
+      /* a shadow ray from the first crossing, as the renderer casts it */
+      double q[3], g[3], L[3];
+      for (int i = 0; i < 3; i++) q[i] = org[i] + a[0] * d[i];
+      soft_field_grad(o, q, g);
+      random_dir(L);
+      int sha = soft_any(o, q, L, 1e-9, 10 * span, NULL, s, NULL);
+      int shb = soft_any(o, q, L, 1e-9, 10 * span, NULL, p, NULL);
+      if (sha != shb) bad++;
+    }
+  }
+  return bad;
+}
+
+static void test_quick_miss(void)
+{
+  long bad = 0, roots = 0;
+  int N = 3000;
+  soft_key *keys = calloc(N, sizeof *keys);
+  double L = 0.5 * cbrt((double)N);
+  for (int k = 0; k < N; k++) {
+    keys[k].kind = SOFT_SPHERE;
+    keys[k].c[0] = L * fmod(0.5 + k * 0.8191725134, 1.0);
+    keys[k].c[1] = L * fmod(0.5 + k * 0.6710436067, 1.0);
+    keys[k].c[2] = L * fmod(0.5 + k * 0.5497004779, 1.0);
+    keys[k].R = 0.6;
+    keys[k].w = 1;
+  }
+  soft_scratch *s = soft_scratch_new(N), *p = soft_scratch_new(N);
+  soft_scratch_plain(p, 1);
+  soft_obj *o;
+  size_t bad_key;
+  double lo[3], hi[3];
+  if (soft_build(keys, N, 0.5, &o, &bad_key) == SOFT_OK && soft_bounds(o, lo, hi)) {
+    bad += quick_rays(o, lo, hi, 8000, 1, s, p, &roots);
+    bad += quick_rays(o, lo, hi, 500, 1e3, s, p, &roots);
+    bad += quick_rays(o, lo, hi, 500, 1e-3, s, p, &roots);
+    soft_free(o);
+  } else {
+    bad++;
+  }
+  for (int k = 0; k < 125; k++) {  /* a lattice: keys in rows, rays along them */
+    keys[k].c[0] = 0.7 * (k % 5);
+    keys[k].c[1] = 0.7 * (k / 5 % 5);
+    keys[k].c[2] = 0.7 * (k / 25);
+  }
+  if (soft_build(keys, 125, 0.5, &o, &bad_key) == SOFT_OK && soft_bounds(o, lo, hi)) {
+    bad += quick_rays(o, lo, hi, 2000, 1, s, p, &roots);
+    soft_free(o);
+  } else {
+    bad++;
+  }
+  for (int c = 0; c < 12; c++) {
+    tkey tk[40];
+    double off[3] = {c % 4 == 3 ? 1e6 : 0, 0, 0};
+    make_cloud(tk, 40, off, c % 3 != 0, c % 2);
+    soft_obj *oc = build(tk, 40, c % 4 == 1 ? 1e-6 : 0.5);
+    if (!oc) { bad++; continue; }
+    if (soft_bounds(oc, lo, hi))
+      bad += quick_rays(oc, lo, hi, 1500, 1, s, p, &roots);
+    soft_free(oc);
+  }
+  soft_scratch_free(s);
+  soft_scratch_free(p);
+  free(keys);
+  char name[200];
+  snprintf(name, sizeof name, "the key test's quick miss: the same crossings "
+           "bit for bit, keys and intervals as plain key tests (%ld crossings)",
+           roots);
+  printf("# quick miss: %ld rays differ\n", bad);
+  CHECK(name, bad == 0 && roots > 10000);
+}
+
 int main(void)
 {
   check_prefix = "soft";
@@ -1042,5 +1153,6 @@ int main(void)
   test_tangent();
   test_index_and_limits();
   test_any();
+  test_quick_miss();
   CHECK_DONE();
 }
