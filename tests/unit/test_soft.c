@@ -845,10 +845,10 @@ static void test_tangent(void)
   soft_free(o);
 }
 
-/* Spatial index: cost follows the keys near the ray, and maxout / t0 / t1. */
-static void test_index_and_limits(void)
+/* The keys of examples/soft-cloud.qcs with n = N (R = 0.6, w = 1, the R2
+ * sequence over a cube of edge 0.5 N^(1/3)), calloc'd. */
+static soft_key *cloud_keys(int N)
 {
-  int N = 20000;
   soft_key *keys = calloc(N, sizeof *keys);
   double L = 0.5 * cbrt((double)N);
   for (int k = 0; k < N; k++) {
@@ -859,6 +859,26 @@ static void test_index_and_limits(void)
     keys[k].R = 0.6;
     keys[k].w = 1;
   }
+  return keys;
+}
+
+/* The first 125 of keys moved onto a 5 x 5 x 5 lattice of spacing 0.7
+ * (keys in rows: bound events tie). */
+static void lattice_keys(soft_key *keys)
+{
+  for (int k = 0; k < 125; k++) {
+    keys[k].c[0] = 0.7 * (k % 5);
+    keys[k].c[1] = 0.7 * (k / 5 % 5);
+    keys[k].c[2] = 0.7 * (k / 25);
+  }
+}
+
+/* Spatial index: cost follows the keys near the ray, and maxout / t0 / t1. */
+static void test_index_and_limits(void)
+{
+  int N = 20000;
+  soft_key *keys = cloud_keys(N);
+  double L = 0.5 * cbrt((double)N);
   soft_obj *o;
   size_t bad;
   CHECK("soft-cloud 20000 builds", soft_build(keys, N, 0.5, &o, &bad) == SOFT_OK);
@@ -967,16 +987,7 @@ static void test_any(void)
   memset(&sr, 0, sizeof sr);
   /* soft-cloud with 3000 keys (the canonical scene's keys) */
   int N = 3000;
-  soft_key *keys = calloc(N, sizeof *keys);
-  double L = 0.5 * cbrt((double)N);
-  for (int k = 0; k < N; k++) {
-    keys[k].kind = SOFT_SPHERE;
-    keys[k].c[0] = L * fmod(0.5 + k * 0.8191725134, 1.0);
-    keys[k].c[1] = L * fmod(0.5 + k * 0.6710436067, 1.0);
-    keys[k].c[2] = L * fmod(0.5 + k * 0.5497004779, 1.0);
-    keys[k].R = 0.6;
-    keys[k].w = 1;
-  }
+  soft_key *keys = cloud_keys(N);
   soft_obj *o;
   size_t bad_key;
   soft_scratch *s = soft_scratch_new(N);
@@ -990,11 +1001,7 @@ static void test_any(void)
   }
   /* a lattice of equal keys (ties between bound events), and random
    * clouds with negative and quadric keys at several magics */
-  for (int k = 0; k < 125; k++) {
-    keys[k].c[0] = 0.7 * (k % 5);
-    keys[k].c[1] = 0.7 * (k / 5 % 5);
-    keys[k].c[2] = 0.7 * (k / 25);
-  }
+  lattice_keys(keys);
   if (soft_build(keys, 125, 0.5, &o, &bad_key) == SOFT_OK) {
     double lo[3], hi[3];
     soft_bounds(o, lo, hi);
@@ -1083,16 +1090,7 @@ static void test_quick_miss(void)
 {
   long bad = 0, roots = 0;
   int N = 3000;
-  soft_key *keys = calloc(N, sizeof *keys);
-  double L = 0.5 * cbrt((double)N);
-  for (int k = 0; k < N; k++) {
-    keys[k].kind = SOFT_SPHERE;
-    keys[k].c[0] = L * fmod(0.5 + k * 0.8191725134, 1.0);
-    keys[k].c[1] = L * fmod(0.5 + k * 0.6710436067, 1.0);
-    keys[k].c[2] = L * fmod(0.5 + k * 0.5497004779, 1.0);
-    keys[k].R = 0.6;
-    keys[k].w = 1;
-  }
+  soft_key *keys = cloud_keys(N);
   soft_scratch *s = soft_scratch_new(N), *p = soft_scratch_new(N);
   soft_scratch_plain(p, 1);
   soft_obj *o;
@@ -1106,11 +1104,7 @@ static void test_quick_miss(void)
   } else {
     bad++;
   }
-  for (int k = 0; k < 125; k++) {  /* a lattice: keys in rows, rays along them */
-    keys[k].c[0] = 0.7 * (k % 5);
-    keys[k].c[1] = 0.7 * (k / 5 % 5);
-    keys[k].c[2] = 0.7 * (k / 25);
-  }
+  lattice_keys(keys);
   if (soft_build(keys, 125, 0.5, &o, &bad_key) == SOFT_OK && soft_bounds(o, lo, hi)) {
     bad += quick_rays(o, lo, hi, 2000, 1, s, p, &roots);
     soft_free(o);
