@@ -18,7 +18,13 @@
 #define A1 (-22.0 / 9.0)
 #define A2 (17.0 / 9.0)
 #define A3 (-4.0 / 9.0)
-#define LEAF_MAX 4
+/* Keys a leaf of the key BVH holds at most: at 16 (median splits leave
+ * about 10 a leaf at soft-cloud's sizes) a ray pops fewer nodes than at 4
+ * or 8 for more key tests, which read keys in a row; the walk is bound by
+ * its dependent loads more than by instructions (bench/NOTES.md,
+ * 2026-11-26: CPU paired, 10^4 keys: 8 0.885 of 4, 16 0.964 of 8, 32
+ * 1.014 of 16, 64 1.115). */
+#define LEAF_MAX 16
 
 /* A key normalised to s(x) = (x-x0)' A (x-x0) + k, A already divided by
  * R^2 (for a sphere A = I/R^2, k = 0); the key acts where s < 1. */
@@ -53,6 +59,7 @@ struct soft_scratch {
   key_event *kheap;  /* discovered keys by entry, cap */
   key_event *act;    /* active keys, cap */
   double *sq;        /* s(v) coefficients of the active keys, 3 cap */
+  int plain;         /* soft_scratch_plain: no quick miss in hit_key */
 };
 
 /* eq. (1) in the factored form C(s) = (1 - s)^2 (1 - 4s/9): the same
@@ -628,6 +635,8 @@ soft_scratch *soft_scratch_new(size_t max_keys) {
   return s;
 }
 
+void soft_scratch_plain(soft_scratch *s, int plain) { s->plain = plain != 0; }
+
 void soft_scratch_free(soft_scratch *s) {
   if (!s) return;
   free(s->nheap);
@@ -671,8 +680,17 @@ static inline int hit_box(const soft_ray *r, const bvh_node *nd, double *tn) {
 
 /* eq. (2) into the key's quadric: s(t) = a2 (t - tc)^2 + smin along the
  * ray; the key acts where s < 1. Returns 0 if the ray misses its bound. */
-static int hit_key(const soft_ray *r, const nkey *k, double *te, double *tx) {
+static int hit_key(const soft_ray *r, const nkey *k, double *te, double *tx,
+                   int plain) {
   double p[3] = {r->o[0] - k->x0[0], r->o[1] - k->x0[1], r->o[2] - k->x0[2]};
+  if (k->sphere && !plain) {
+    /* A quick miss: s at the point of the line nearest the centre, a0
+       (|p|^2 - (p.d)^2), clearly >= 1. Its rounding, and smin's below, are
+       within a few eps of a0 |p|^2 (d is unit to an eps), far inside the
+       margin, so only keys the test below refuses are refused here. */
+    double pd = vec3_dot(p, r->d), pp = vec3_dot(p, p);
+    if (k->a[0] * (pp - pd * pd) > 1 + 1e-9 * (1 + k->a[0] * pp)) return 0;
+  }
   double ad[3], ap[3];
   apply_a(k, r->d, ad);
   double a2 = vec3_dot(r->d, ad), b = vec3_dot(p, ad);
@@ -753,17 +771,42 @@ static void interval_poly(const soft_obj *o, const key_event *act, int nact,
  * hold a key entering before its end has been opened. The state (inside or
  * not) at each interval boundary is computed once and imposed on both
  * neighbours, so a root on a boundary is found once. */
+static int roots_walk(const soft_obj *obj, const double o[3],
+                      const double d[3], double t0, double t1, double *out,
+                      int maxout, soft_scratch *scratch, soft_stats *stats,
+                      const soft_hook *hook, int any);
+
 int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
                double t0, double t1, double *out, int maxout,
                soft_scratch *scratch, soft_stats *stats) {
-  return soft_roots_traced(obj, o, d, t0, t1, out, maxout, scratch, stats,
-                           NULL);
+  return roots_walk(obj, o, d, t0, t1, out, maxout, scratch, stats, NULL, 0);
 }
 
 int soft_roots_traced(const soft_obj *obj, const double o[3],
                       const double d[3], double t0, double t1, double *out,
                       int maxout, soft_scratch *scratch, soft_stats *stats,
                       const soft_hook *hook) {
+  return roots_walk(obj, o, d, t0, t1, out, maxout, scratch, stats, hook, 0);
+}
+
+int soft_any(const soft_obj *obj, const double o[3], const double d[3],
+             double t0, double t1, double *t, soft_scratch *scratch,
+             soft_stats *stats) {
+  double by;
+  int n = roots_walk(obj, o, d, t0, t1, &by, 1, scratch, stats, NULL, 1);
+  if (n > 0 && t) *t = by < t1 ? by : t1;
+  return n;
+}
+
+/* The walk of soft_roots_traced; with any (maxout 1, no hook: soft_any)
+ * an interval whose end states differ ends the search with a crossing
+ * unsolved for (poly_crossings reports an odd number there, and with
+ * maxout 1 nothing before it can cancel its first: out[] holds only
+ * whether there is one). */
+static int roots_walk(const soft_obj *obj, const double o[3],
+                      const double d[3], double t0, double t1, double *out,
+                      int maxout, soft_scratch *scratch, soft_stats *stats,
+                      const soft_hook *hook, int any) {
   soft_stats dummy;
   if (!stats) { memset(&dummy, 0, sizeof dummy); stats = &dummy; }
   stats->rays++;
@@ -796,6 +839,7 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
   r.ta = t0 * len;
   r.tb = t1 * len;
 
+  int plain = scratch->plain;
   node_ent *nheap = scratch->nheap;
   key_event *kheap = scratch->kheap, *act = scratch->act;
   int nn = 0, nk = 0, na = 0, nout = 0;
@@ -818,19 +862,42 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
      * lowers tnext as it would the top of the key heap. */
     while (nn && nheap[0].t < tnext) {
       node_ent e = nheap_pop(nheap, &nn);
-      const bvh_node *nd = &obj->tree.nodes[e.i];
+      const bvh_node *nd;
+    open:
+      nd = &obj->tree.nodes[e.i];
       stats->nodes++;
       if (nd->count == 0) {
+        /* The nearer child met is opened at once when the heap would pop
+           it next (it enters no later than the heap's top, and before
+           tnext): the same nodes in the same order of entry, one push and
+           pop fewer (only ties may go the other way). */
         int f = nd->first;
         const bvh_node *ch = &obj->tree.nodes[f];
-        if (hit_box(&r, ch, &tn))  /* fmax(tn, cur), no call: */
-          nheap_push(nheap, &nn, (node_ent){tn > cur ? tn : cur, f});
-        if (hit_box(&r, ch + 1, &tn))
-          nheap_push(nheap, &nn, (node_ent){tn > cur ? tn : cur, f + 1});
+        double ta_ = INFINITY, tb_ = INFINITY;
+        int ha = hit_box(&r, ch, &ta_), hb = hit_box(&r, ch + 1, &tb_);
+        ta_ = ta_ > cur ? ta_ : cur;  /* fmax(tn, cur), no call */
+        tb_ = tb_ > cur ? tb_ : cur;
+        node_ent near_ = {ta_, f}, far_ = {tb_, f + 1};
+        int hn = ha, hf = hb;
+        if (hb && (!ha || tb_ < ta_)) {
+          near_ = far_;
+          far_ = (node_ent){ta_, f};
+          hn = hb;
+          hf = ha;
+        }
+        if (hf) nheap_push(nheap, &nn, far_);
+        if (hn) {
+          if (near_.t < tnext && (nn == 0 || near_.t <= nheap[0].t)) {
+            e = near_;
+            goto open;
+          }
+          nheap_push(nheap, &nn, near_);
+        }
       } else {
         for (int j = nd->first; j < nd->first + nd->count; j++) {
           key_event ev;
-          if (!hit_key(&r, &obj->keys[j], &ev.te, &ev.tx) || ev.tx <= cur) continue;
+          if (!hit_key(&r, &obj->keys[j], &ev.te, &ev.tx, plain) || ev.tx <= cur)
+            continue;
           stats->keys++;
           ev.te = ev.te > cur ? ev.te : cur;  /* fmax: te is not NaN */
           ev.i = j;
@@ -880,6 +947,10 @@ int soft_roots_traced(const soft_obj *obj, const double o[3],
         if (hook) hook->fn(hook->ctx, &ev);
       } else {
         int sb = poly_eval(c, 6, 1.0, NULL) > 0;
+        if (any && sb != state) {
+          out[nout++] = tnext / len;  /* a crossing in (cur, tnext] */
+          break;
+        }
         double v[POLY_MAX_DEG];
         poly_stats before = stats->poly;
         int nv = poly_crossings(c, 6, -1.0, 1.0, state, sb, 0, v, &stats->poly);

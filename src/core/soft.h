@@ -128,6 +128,12 @@ double soft_field_grad(const soft_obj *obj, const double p[3], double g[3]);
 soft_scratch *soft_scratch_new(size_t max_keys);
 void soft_scratch_free(soft_scratch *s);
 
+/* With plain nonzero, the walks on this scratch test every key they meet
+ * in full, without the quick miss that refuses a spherical key whose
+ * nearest point to the line is clearly outside it: the reference the
+ * tests hold the quick miss to (the same crossings, bit for bit). */
+void soft_scratch_plain(soft_scratch *s, int plain);
+
 /* The crossings of the surface by the ray o + t d, t0 < t < t1 (t1 may be
  * INFINITY), ascending, into out[0..maxout-1]; returns their number, or -1
  * if d is zero or not finite, o or t0/t1 is NaN, or the scratch is too
@@ -140,6 +146,17 @@ void soft_scratch_free(soft_scratch *s);
 int soft_roots(const soft_obj *obj, const double o[3], const double d[3],
                double t0, double t1, double *out, int maxout,
                soft_scratch *scratch, soft_stats *stats);
+
+/* Whether the ray crosses the surface in (t0, t1): soft_roots with
+ * maxout 1 returning 1, 0 or -1, the same answer on every ray (a shadow
+ * ray needs no more). It stops at the first interval between key-bound
+ * events whose ends lie on the two sides of the surface, without solving
+ * for the crossing there. On 1, *t (t may be NULL) is a t in (t0, t1]
+ * by which the ray has crossed: the crossing, or the end of the interval
+ * holding it. */
+int soft_any(const soft_obj *obj, const double o[3], const double d[3],
+             double t0, double t1, double *t, soft_scratch *scratch,
+             soft_stats *stats);
 
 /* Trace of soft_roots_traced: one event per interval between consecutive
  * key-bound events along the ray (the paper's step 1), saying how it was

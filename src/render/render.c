@@ -952,7 +952,8 @@ prim_hit(const Tracer *T, int pi, const double o[3],
   }
   case SC_SOFT: {
     double t;
-    int nr = soft_roots(n->soft, o, d, t0, t1, &t, 1, c->soft, &c->stats.soft);
+    int nr = any ? soft_any(n->soft, o, d, t0, t1, &t, c->soft, &c->stats.soft)
+                 : soft_roots(n->soft, o, d, t0, t1, &t, 1, c->soft, &c->stats.soft);
     if (nr < 0) c->failed = 1;
     if (nr < 1) return 0;
     h->t = t;

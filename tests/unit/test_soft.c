@@ -845,10 +845,10 @@ static void test_tangent(void)
   soft_free(o);
 }
 
-/* Spatial index: cost follows the keys near the ray, and maxout / t0 / t1. */
-static void test_index_and_limits(void)
+/* The keys of examples/soft-cloud.qcs with n = N (R = 0.6, w = 1, the R2
+ * sequence over a cube of edge 0.5 N^(1/3)), calloc'd. */
+static soft_key *cloud_keys(int N)
 {
-  int N = 20000;
   soft_key *keys = calloc(N, sizeof *keys);
   double L = 0.5 * cbrt((double)N);
   for (int k = 0; k < N; k++) {
@@ -859,6 +859,26 @@ static void test_index_and_limits(void)
     keys[k].R = 0.6;
     keys[k].w = 1;
   }
+  return keys;
+}
+
+/* The first 125 of keys moved onto a 5 x 5 x 5 lattice of spacing 0.7
+ * (keys in rows: bound events tie). */
+static void lattice_keys(soft_key *keys)
+{
+  for (int k = 0; k < 125; k++) {
+    keys[k].c[0] = 0.7 * (k % 5);
+    keys[k].c[1] = 0.7 * (k / 5 % 5);
+    keys[k].c[2] = 0.7 * (k / 25);
+  }
+}
+
+/* Spatial index: cost follows the keys near the ray, and maxout / t0 / t1. */
+static void test_index_and_limits(void)
+{
+  int N = 20000;
+  soft_key *keys = cloud_keys(N);
+  double L = 0.5 * cbrt((double)N);
   soft_obj *o;
   size_t bad;
   CHECK("soft-cloud 20000 builds", soft_build(keys, N, 0.5, &o, &bad) == SOFT_OK);
@@ -900,6 +920,218 @@ static void test_index_and_limits(void)
   free(keys);
 }
 
+/* soft_any (shadow rays) against soft_roots with maxout 1, the general
+ * path, on one object: camera-like rays, and shadow-like rays from points
+ * on, just off and just inside the surface towards a light, clipped at it.
+ * The answers must agree on every ray (1, 0 or -1), and the point
+ * soft_any gives must lie in (t0, t1], at or past the general path's
+ * crossing. Counts into *same, *hits, *rays; returns rays that differ. */
+static long any_rays(const soft_obj *o, const double lo[3], const double hi[3],
+                     int nrays, soft_scratch *s, soft_stats *sa,
+                     soft_stats *sr, long *hits, long *rays)
+{
+  long bad = 0;
+  double mid[3], span = 0;
+  for (int i = 0; i < 3; i++) {
+    mid[i] = 0.5 * (lo[i] + hi[i]);
+    span = fmax(span, hi[i] - lo[i]);
+  }
+  for (int r = 0; r < nrays; r++) {
+    double org[3], d[3], t1 = INFINITY;
+    aim_ray(mid, span, org, d);
+    for (int i = 0; i < 3; i++) org[i] = mid[i] + (org[i] - mid[i]) * span;
+    double th, tr[2];
+    int nr = soft_roots(o, org, d, 0, INFINITY, tr, 1, s, sr);
+    int na = soft_any(o, org, d, 0, INFINITY, &th, s, sa);
+    ++*rays;
+    if (na != nr || (nr == 1 && !(th >= tr[0] && th > 0))) bad++;
+    if (nr != 1) continue;
+    ++*hits;
+    /* shadow rays from the hit: towards a light, from the point, from
+     * eps off along the normal either way, t1 at the light or at
+     * infinity, and a t0 > 0 */
+    double p[3], g[3], light[3];
+    for (int i = 0; i < 3; i++) p[i] = org[i] + tr[0] * d[i];
+    soft_field_grad(o, p, g);
+    double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    if (!(gl > 0)) gl = 1;
+    random_dir(light);
+    for (int i = 0; i < 3; i++) light[i] = mid[i] + light[i] * 2 * span;
+    static const double offs[5] = {0, 1e-9, -1e-9, 1e-6, -1e-3};
+    for (int k = 0; k < 5; k++) {
+      double so[3], L[3];
+      for (int i = 0; i < 3; i++) so[i] = p[i] - offs[k] * g[i] / gl;
+      for (int i = 0; i < 3; i++) L[i] = light[i] - so[i];
+      double dist = sqrt(L[0] * L[0] + L[1] * L[1] + L[2] * L[2]);
+      for (int i = 0; i < 3; i++) L[i] /= dist;
+      double ts[3][2] = {{0, dist}, {0, t1}, {1e-7, 0.5 * dist}};
+      for (int q = 0; q < 3; q++) {
+        nr = soft_roots(o, so, L, ts[q][0], ts[q][1], tr, 1, s, sr);
+        na = soft_any(o, so, L, ts[q][0], ts[q][1], &th, s, sa);
+        ++*rays;
+        if (nr == 1) ++*hits;
+        if (na != nr || (nr == 1 && !(th >= tr[0] && th > ts[q][0] &&
+                                      th <= ts[q][1])))
+          bad++;
+      }
+    }
+  }
+  return bad;
+}
+
+static void test_any(void)
+{
+  long bad = 0, hits = 0, rays = 0;
+  soft_stats sa, sr;
+  memset(&sa, 0, sizeof sa);
+  memset(&sr, 0, sizeof sr);
+  /* soft-cloud with 3000 keys (the canonical scene's keys) */
+  int N = 3000;
+  soft_key *keys = cloud_keys(N);
+  soft_obj *o;
+  size_t bad_key;
+  soft_scratch *s = soft_scratch_new(N);
+  if (soft_build(keys, N, 0.5, &o, &bad_key) == SOFT_OK) {
+    double lo[3], hi[3];
+    soft_bounds(o, lo, hi);
+    bad += any_rays(o, lo, hi, 8000, s, &sa, &sr, &hits, &rays);
+    soft_free(o);
+  } else {
+    bad++;
+  }
+  /* a lattice of equal keys (ties between bound events), and random
+   * clouds with negative and quadric keys at several magics */
+  lattice_keys(keys);
+  if (soft_build(keys, 125, 0.5, &o, &bad_key) == SOFT_OK) {
+    double lo[3], hi[3];
+    soft_bounds(o, lo, hi);
+    bad += any_rays(o, lo, hi, 3000, s, &sa, &sr, &hits, &rays);
+    soft_free(o);
+  } else {
+    bad++;
+  }
+  static const double magics[4] = {0.5, 1e-6, 0.9, 2};
+  for (int c = 0; c < 12; c++) {
+    tkey tk[40];
+    double off[3] = {0, 0, 0}, lo[3], hi[3];
+    make_cloud(tk, 40, off, c % 3 != 0, c % 2);
+    soft_obj *oc = build(tk, 40, magics[c % 4]);
+    if (!oc) { bad++; continue; }
+    if (soft_bounds(oc, lo, hi))
+      bad += any_rays(oc, lo, hi, 1200, s, &sa, &sr, &hits, &rays);
+    soft_free(oc);
+  }
+  soft_scratch_free(s);
+  free(keys);
+  char name[200];
+  snprintf(name, sizeof name, "soft_any gives soft_roots' (maxout 1) answer "
+           "on all of %ld rays (%ld hits), with a point at or past its crossing",
+           rays, hits);
+  printf("# soft_any: %ld rays differ\n", bad);
+  CHECK(name, bad == 0 && hits > 5000 && rays - hits > 5000);
+  snprintf(name, sizeof name, "soft_any solves fewer polynomials (%ld against %ld)",
+           sa.poly.solves, sr.poly.solves);
+  CHECK(name, sa.poly.solves < sr.poly.solves);
+}
+
+/* The key test's quick miss against plain key tests (soft_scratch_plain):
+ * every crossing, bit for bit, and the same keys met, on rays through the
+ * soft-cloud keys (3000), a lattice, and random clouds with quadric and
+ * negative keys; rays from outside, from inside, and shadow rays from
+ * surface points, long directions and rays at 1e6. */
+static long quick_rays(const soft_obj *o, const double lo[3], const double hi[3],
+                       int nrays, double dscale, soft_scratch *s, soft_scratch *p,
+                       long *roots)
+{
+  long bad = 0;
+  double mid[3], span = 0;
+  for (int i = 0; i < 3; i++) {
+    mid[i] = 0.5 * (lo[i] + hi[i]);
+    span = fmax(span, hi[i] - lo[i]);
+  }
+  for (int r = 0; r < nrays; r++) {
+    double org[3], d[3], a[64], b[64];
+    aim_ray(mid, span, org, d);
+    if (r % 3 == 0)  /* from inside the cloud's box */
+      for (int i = 0; i < 3; i++) org[i] = mid[i] + (rnd() - 0.5) * span;
+    else
+      for (int i = 0; i < 3; i++) org[i] = mid[i] + (org[i] - mid[i]) * span;
+    if (r % 5 == 4) {  /* along an axis, at a multiple of 0.7 off it */
+      int ax = r / 5 % 3;
+      for (int i = 0; i < 3; i++) {
+        d[i] = i == ax ? 1 : 0;
+        org[i] = i == ax ? lo[i] - 1 : 0.7 * floor(rnd() * 5);
+      }
+    }
+    for (int i = 0; i < 3; i++) d[i] *= dscale;
+    soft_stats sa, sb;
+    memset(&sa, 0, sizeof sa);
+    memset(&sb, 0, sizeof sb);
+    int na = soft_roots(o, org, d, 0, INFINITY, a, 64, s, &sa);
+    int nb = soft_roots(o, org, d, 0, INFINITY, b, 64, p, &sb);
+    if (na != nb || sa.keys != sb.keys || sa.intervals != sb.intervals ||
+        (na > 0 && memcmp(a, b, (size_t)na * sizeof *a) != 0)) bad++;
+    if (na > 0) {
+      *roots += na;
+      /* a shadow ray from the first crossing, as the renderer casts it */
+      double q[3], g[3], L[3];
+      for (int i = 0; i < 3; i++) q[i] = org[i] + a[0] * d[i];
+      soft_field_grad(o, q, g);
+      random_dir(L);
+      int sha = soft_any(o, q, L, 1e-9, 10 * span, NULL, s, NULL);
+      int shb = soft_any(o, q, L, 1e-9, 10 * span, NULL, p, NULL);
+      if (sha != shb) bad++;
+    }
+  }
+  return bad;
+}
+
+static void test_quick_miss(void)
+{
+  long bad = 0, roots = 0;
+  int N = 3000;
+  soft_key *keys = cloud_keys(N);
+  soft_scratch *s = soft_scratch_new(N), *p = soft_scratch_new(N);
+  soft_scratch_plain(p, 1);
+  soft_obj *o;
+  size_t bad_key;
+  double lo[3], hi[3];
+  if (soft_build(keys, N, 0.5, &o, &bad_key) == SOFT_OK && soft_bounds(o, lo, hi)) {
+    bad += quick_rays(o, lo, hi, 8000, 1, s, p, &roots);
+    bad += quick_rays(o, lo, hi, 500, 1e3, s, p, &roots);
+    bad += quick_rays(o, lo, hi, 500, 1e-3, s, p, &roots);
+    soft_free(o);
+  } else {
+    bad++;
+  }
+  lattice_keys(keys);
+  if (soft_build(keys, 125, 0.5, &o, &bad_key) == SOFT_OK && soft_bounds(o, lo, hi)) {
+    bad += quick_rays(o, lo, hi, 2000, 1, s, p, &roots);
+    soft_free(o);
+  } else {
+    bad++;
+  }
+  for (int c = 0; c < 12; c++) {
+    tkey tk[40];
+    double off[3] = {c % 4 == 3 ? 1e6 : 0, 0, 0};
+    make_cloud(tk, 40, off, c % 3 != 0, c % 2);
+    soft_obj *oc = build(tk, 40, c % 4 == 1 ? 1e-6 : 0.5);
+    if (!oc) { bad++; continue; }
+    if (soft_bounds(oc, lo, hi))
+      bad += quick_rays(oc, lo, hi, 1500, 1, s, p, &roots);
+    soft_free(oc);
+  }
+  soft_scratch_free(s);
+  soft_scratch_free(p);
+  free(keys);
+  char name[200];
+  snprintf(name, sizeof name, "the key test's quick miss: the same crossings "
+           "bit for bit, keys and intervals as plain key tests (%ld crossings)",
+           roots);
+  printf("# quick miss: %ld rays differ\n", bad);
+  CHECK(name, bad == 0 && roots > 10000);
+}
+
 int main(void)
 {
   check_prefix = "soft";
@@ -914,5 +1146,7 @@ int main(void)
   test_boundary_root();
   test_tangent();
   test_index_and_limits();
+  test_any();
+  test_quick_miss();
   CHECK_DONE();
 }
