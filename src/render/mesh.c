@@ -2253,7 +2253,9 @@ static double measured_error(Mesher *m, const Mesh *me, double reach, int n,
     }
     if (near_clip) continue;
     double best = crossing_along(m, p, nn, reach);
-    for (int ax = 0; ax < 3; ax++) {
+    /* the axes only where the normal's distance would raise the largest
+       (the least of the four cannot exceed it) */
+    for (int ax = 0; ax < 3 && best > worst; ax++) {
       double e[3] = {0, 0, 0};
       e[ax] = 1;
       best = fmin(best, crossing_along(m, p, e, reach));
