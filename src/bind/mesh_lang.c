@@ -48,8 +48,8 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           "exactly (%ld signs in exact arithmetic) in %.2f s\n", r->pairs,
           r->pairs_exact, r->check_seconds);
   fprintf(f, "  distance to the surface: certified <= %.4g (requested %.4g; vertices within "
-          "%.2g of the surface); measured %.3g (the largest along the normals "
-          "from %d points of the triangles)\n", r->certified, e, r->vtol,
+          "%.2g of the surface); measured %.3g (the largest distance to "
+          "the surface along the normal or an axis from %d points of the triangles)\n", r->certified, e, r->vtol,
           r->measured, r->samples);
   fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",
           r->crossings - r->bisected, r->bisected);

@@ -43,7 +43,7 @@
  * tri_bound): the vertices' tolerance vtol in plane and sharp cells, the
  * gradient bound in smooth cells, vtol plus the triangle's covering radius
  * in finest cells; the report gives the largest, and a measured error
- * (sample points to the surface along the normals). That every part of
+ * (sample points to the surface along the normal or an axis). That every part of
  * the surface is near the mesh is proven in plane and sharp cells only.
  * Closure is checked by edge counting before anything is returned, and
  * then self-intersection, exactly (mesh_check.h: every pair of triangles
@@ -106,9 +106,10 @@ typedef struct MeshReport {
   double two_at[3];        /* the lowest corner of the first */
   double vtol;             /* the vertices' distance bound */
   double certified;        /* the proven bound, see above */
-  double measured;         /* the largest distance along the normal from
-                              sample points of the triangles to the
-                              surface (INFINITY: none within reach) */
+  double measured;         /* the largest distance from sample points of
+                              the triangles to the surface along the
+                              normal or an axis, the least of the four
+                              (INFINITY: none within reach) */
   int samples;             /* the sample points used */
   long crossings, bisected;/* edge vertices; of them found by bisection */
   size_t vertices, triangles;
