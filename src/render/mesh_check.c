@@ -192,17 +192,8 @@ static int safe_coords(const double *v, size_t n) {
   return 1;
 }
 
-int mesh_orient2d(const double a[3], const double b[3], const double c[3],
-                  int i, int j, long *exact) {
-  double acx = a[i] - c[i], bcx = b[i] - c[i];
-  double acy = a[j] - c[j], bcy = b[j] - c[j];
-  if (tame(acx) && tame(bcx) && tame(acy) && tame(bcy)) {
-    double l = acx * bcy, r = acy * bcx, det = l - r;
-    double bound = o2d_bound * (fabs(l) + fabs(r));
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-    if (l == 0 && r == 0) return 0;
-  }
+static int orient2d_exact(const double a[3], const double b[3],
+                          const double c[3], int i, int j, long *exact) {
   if (exact) ++*exact;
   double x[6] = {a[i], a[j], b[i], b[j], c[i], c[j]};
   int e0 = least_exp(x, 6);
@@ -213,6 +204,26 @@ int mesh_orient2d(const double a[3], const double b[3], const double c[3],
   mpz_mul(*v, z[1], z[2]);
   int s = mpz_cmp(*u, *v);
   return s > 0 ? 1 : s < 0 ? -1 : 0;
+}
+
+/* The filter inline (the pair tests call it most), GMP behind it. */
+static inline int orient2d(const double a[3], const double b[3],
+                           const double c[3], int i, int j, long *exact) {
+  double acx = a[i] - c[i], bcx = b[i] - c[i];
+  double acy = a[j] - c[j], bcy = b[j] - c[j];
+  if (tame(acx) && tame(bcx) && tame(acy) && tame(bcy)) {
+    double l = acx * bcy, r = acy * bcx, det = l - r;
+    double bound = o2d_bound * (fabs(l) + fabs(r));
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+    if (l == 0 && r == 0) return 0;
+  }
+  return orient2d_exact(a, b, c, i, j, exact);
+}
+
+int mesh_orient2d(const double a[3], const double b[3], const double c[3],
+                  int i, int j, long *exact) {
+  return orient2d(a, b, c, i, j, exact);
 }
 
 /* ---- the pair test ------------------------------------------------------- */
@@ -229,7 +240,7 @@ static int o3(Ctx *c, const double *a, const double *b, const double *p,
 }
 
 static int o2(Ctx *c, const double *a, const double *b, const double *p) {
-  return mesh_orient2d(a, b, p, c->i, c->j, c->ex);
+  return orient2d(a, b, p, c->i, c->j, c->ex);
 }
 
 /* The axis k along which triangle abc projects to a triangle of nonzero
@@ -479,7 +490,7 @@ static int early_out(Ctx *c, const Tri *A, const Tri *B, int shared) {
 /* The fast path's triangles (below): when pair is given them, its signs
    of vertices against a plane are taken on the plane made once. */
 typedef struct CTri CTri;
-static int plane_side(Ctx *c, const CTri *t, const double *d);
+static inline int plane_side(Ctx *c, const CTri *t, const double *d);
 
 static int side(Ctx *c, const CTri *ct, const Tri *t, const double *x) {
   return ct ? plane_side(c, ct, x) : o3(c, t->v[0], t->v[1], t->v[2], x);
@@ -663,8 +674,16 @@ static int two_places_t(const CTri *t, const double *d) {
   return 0;
 }
 
+/* Where the filter cannot decide: as orient3d ends, first the planes
+   along an axis (exact zeros, which no filter decides: its long double
+   stage would be wasted), then orient3d itself. */
+static int plane_side_slow(Ctx *c, const CTri *t, const double *d) {
+  if (two_places_t(t, d)) return 0;
+  return orient3d(t->v[0], t->v[1], t->v[2], d, c->ex, 1);
+}
+
 /* The sign of orient3d(t's vertices, d): exact (safe coordinates only). */
-static int plane_side(Ctx *c, const CTri *t, const double *d) {
+static inline int plane_side(Ctx *c, const CTri *t, const double *d) {
   double wx = d[0] - t->v[0][0], wy = d[1] - t->v[0][1], wz = d[2] - t->v[0][2];
   double s = wx * t->n[0] + wy * t->n[1] + wz * t->n[2];
   double p = fabs(wx) * t->pn[0] + fabs(wy) * t->pn[1] + fabs(wz) * t->pn[2];
@@ -672,10 +691,7 @@ static int plane_side(Ctx *c, const CTri *t, const double *d) {
   if (s > b) return -1;
   if (-s > b) return 1;
   if (p == 0) return 0;
-  /* as orient3d ends: first the planes along an axis (exact zeros, which
-     no filter decides: its long double stage would be wasted) */
-  if (two_places_t(t, d)) return 0;
-  return orient3d(t->v[0], t->v[1], t->v[2], d, c->ex, 1);
+  return plane_side_slow(c, t, d);
 }
 
 /* early_out on the planes made once: the same signs, so the same answer. */
@@ -793,13 +809,12 @@ int mesh_tri_pair_fast(const Mesh *m, size_t i, size_t j) {
 
 /* Triangle i's box. */
 static void tri_box(const Mesh *m, size_t i, double l[3], double h[3]) {
-  for (int a = 0; a < 3; a++) {
-    l[a] = INFINITY, h[a] = -INFINITY;
-    for (int k = 0; k < 3; k++) {
-      double x = m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)a];
-      l[a] = fmin(l[a], x);
-      h[a] = fmax(h[a], x);
-    }
+  const double *p = m->v + 3 * (size_t)m->t[3 * i], *q = m->v + 3 * (size_t)m->t[3 * i + 1],
+               *r = m->v + 3 * (size_t)m->t[3 * i + 2];
+  for (int a = 0; a < 3; a++) { /* finite (checked first): no NaN rules */
+    double lo = p[a] < q[a] ? p[a] : q[a], hi = p[a] < q[a] ? q[a] : p[a];
+    l[a] = r[a] < lo ? r[a] : lo;
+    h[a] = r[a] > hi ? r[a] : hi;
   }
 }
 
@@ -979,8 +994,9 @@ int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
     tri_box(m, i, b[0], b[1]);
     for (int a = 0; a < 3; a++)
       for (int e = 0; e < 2; e++) {
-        double f = floor((b[e][a] - lo[a]) / cs);
-        cb[i][3 * e + a] = (uint16_t)(f < 0 ? 0 : f >= g[a] ? g[a] - 1 : (int)f);
+        /* b - lo >= 0: truncation is floor */
+        double f = (b[e][a] - lo[a]) / cs;
+        cb[i][3 * e + a] = (uint16_t)(f >= g[a] ? g[a] - 1 : (int)f);
         box[6 * i + 3 * (size_t)e + (size_t)a] = e ? up(b[e][a]) : down(b[e][a]);
       }
   }
