@@ -349,7 +349,9 @@ static int seg_tri3(Ctx *c, const double *p, const double *q, const Tri *t,
   }
   /* the segment crosses the plane at one point: inside the closed
      triangle when the line passes no edge on the wrong side */
-  int s1 = o3(c, p, q, a, b), s2 = o3(c, p, q, b, d), s3 = o3(c, p, q, d, a);
+  int s1 = o3(c, p, q, a, b), s2 = o3(c, p, q, b, d);
+  if (s1 * s2 < 0) return 0; /* already signs both ways: s3 cannot help */
+  int s3 = o3(c, p, q, d, a);
   return !((s1 > 0 || s2 > 0 || s3 > 0) && (s1 < 0 || s2 < 0 || s3 < 0));
 }
 
