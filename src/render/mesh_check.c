@@ -494,6 +494,8 @@ static int early_out(Ctx *c, const Tri *A, const Tri *B, int shared) {
 typedef struct CTri CTri;
 static inline int plane_side(Ctx *c, const CTri *t, const double *d);
 
+static int ctri_axis(Ctx *c, const CTri *t, int *s);
+
 static int side(Ctx *c, const CTri *ct, const Tri *t, const double *x) {
   return ct ? plane_side(c, ct, x) : o3(c, t->v[0], t->v[1], t->v[2], x);
 }
@@ -520,8 +522,8 @@ static int pair(Ctx *c, const Mesh *m, size_t i, size_t j, const CTri *ca,
     }
   if (shared >= 3) return 1; /* the same three vertices twice */
   if (!ca && early_out(c, &A, &B, shared)) return 0;
-  A.k = tri_axis(c, A.v[0], A.v[1], A.v[2], &A.s);
-  B.k = tri_axis(c, B.v[0], B.v[1], B.v[2], &B.s);
+  A.k = ca ? ctri_axis(c, ca, &A.s) : tri_axis(c, A.v[0], A.v[1], A.v[2], &A.s);
+  B.k = cb ? ctri_axis(c, cb, &B.s) : tri_axis(c, B.v[0], B.v[1], B.v[2], &B.s);
   if (A.k < 0 || B.k < 0) {
     if (A.k < 0 && B.k < 0) return seg_seg3(c, &A, &B);
     const Tri *a = A.k < 0 ? &A : &B, *b = A.k < 0 ? &B : &A;
@@ -696,6 +698,26 @@ static inline int plane_side(Ctx *c, const CTri *t, const double *d) {
   return plane_side_slow(c, t, d);
 }
 
+/* tri_axis from the plane made once: n[k] (k its largest magnitude, the
+   first of equals, the axis tri_axis tries first) is computed exactly as
+   orient2d(v1, v2, v0) on the axes k + 1, k + 2 computes its
+   determinant (the differences from v0, the two products, their
+   difference) and pn[k] as its permanent, so where |n[k]| exceeds
+   orient2d's bound its sign is that orient2d's, the sign of the
+   triangle's projection: tri_axis's answer without its tests. Else
+   tri_axis. */
+static int ctri_axis(Ctx *c, const CTri *t, int *s) {
+  int k = 0;
+  for (int a = 1; a < 3; a++)
+    if (fabs(t->n[a]) > fabs(t->n[k])) k = a;
+  if (fabs(t->n[k]) > o2d_bound * t->pn[k]) {
+    set_axis(c, k);
+    *s = t->n[k] > 0 ? 1 : -1;
+    return k;
+  }
+  return tri_axis(c, t->v[0], t->v[1], t->v[2], s);
+}
+
 /* early_out on the planes made once: the same signs, so the same answer. */
 static int early_fast(Ctx *c, const CTri *A, const CTri *B) {
   for (int pass = 0; pass < 2; pass++) {
@@ -726,8 +748,8 @@ static int early_fast(Ctx *c, const CTri *A, const CTri *B) {
      neither pass of early_out can find every other vertex strictly on
      one side. The test is made next, as in pair.
    - coplanar pairs, both triangles of nonzero area in the projection
-     along the axis of A's largest normal component (that projection is
-     then one to one on their plane, so neither is collinear, and pair's
+     along A's axis from ctri_axis (that projection is then one to one on
+     their plane, so neither is collinear, and pair's
      2-D tests, whose answers are products of signs in one projection,
      answer the same in it as in pair's own): on one edge u w (early_fast
      found B's third vertex not strictly off A's plane, so on it), pair's
@@ -751,19 +773,16 @@ static int pair_fast(Ctx *c, const Mesh *m, const CTri *A, const CTri *B,
     for (int q = 0; q < 3; q++)
       if (B->id[q] != A->id[ia] && plane_side(c, A, B->v[q]) != 0)
         return pair(c, m, i, j, A, B);
-  int k = 0;
-  double best = -1;
-  for (int a = 0; a < 3; a++)
-    if (fabs(A->n[a]) > best) best = fabs(A->n[a]), k = a;
   Tri TA, TB;
   for (int q = 0; q < 3; q++) {
     TA.v[q] = A->v[q], TA.id[q] = A->id[q];
     TB.v[q] = B->v[q], TB.id[q] = B->id[q];
   }
+  int k = ctri_axis(c, A, &TA.s);
+  if (k < 0) return pair(c, m, i, j, A, B);
   TA.k = TB.k = k;
   set_axis(c, k);
-  TA.s = o2(c, TA.v[0], TA.v[1], TA.v[2]);
-  TB.s = TA.s ? o2(c, TB.v[0], TB.v[1], TB.v[2]) : 0;
+  TB.s = o2(c, TB.v[0], TB.v[1], TB.v[2]);
   if (!TA.s || !TB.s) return pair(c, m, i, j, A, B);
   if (shared == 0) return tri_tri2(c, &TA, &TB);
   if (shared == 1) {
