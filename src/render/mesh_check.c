@@ -347,6 +347,13 @@ static int seg_tri3(Ctx *c, const double *p, const double *q, const Tri *t,
     set_axis(c, t->k);
     return seg_tri2(c, p, q, a, b, d, t->s);
   }
+  /* one end in the plane, the other off it: that end is all the segment
+     has in the plane, so they meet when it is in the triangle (three
+     orient2d in its projection instead of three orient3d) */
+  if (sp == 0 || sq == 0) {
+    set_axis(c, t->k);
+    return pt_tri2(c, sp == 0 ? p : q, a, b, d, t->s);
+  }
   /* the segment crosses the plane at one point: inside the closed
      triangle when the line passes no edge on the wrong side */
   int s1 = o3(c, p, q, a, b), s2 = o3(c, p, q, b, d);
