@@ -192,17 +192,8 @@ static int safe_coords(const double *v, size_t n) {
   return 1;
 }
 
-int mesh_orient2d(const double a[3], const double b[3], const double c[3],
-                  int i, int j, long *exact) {
-  double acx = a[i] - c[i], bcx = b[i] - c[i];
-  double acy = a[j] - c[j], bcy = b[j] - c[j];
-  if (tame(acx) && tame(bcx) && tame(acy) && tame(bcy)) {
-    double l = acx * bcy, r = acy * bcx, det = l - r;
-    double bound = o2d_bound * (fabs(l) + fabs(r));
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-    if (l == 0 && r == 0) return 0;
-  }
+static int orient2d_exact(const double a[3], const double b[3],
+                          const double c[3], int i, int j, long *exact) {
   if (exact) ++*exact;
   double x[6] = {a[i], a[j], b[i], b[j], c[i], c[j]};
   int e0 = least_exp(x, 6);
@@ -213,6 +204,26 @@ int mesh_orient2d(const double a[3], const double b[3], const double c[3],
   mpz_mul(*v, z[1], z[2]);
   int s = mpz_cmp(*u, *v);
   return s > 0 ? 1 : s < 0 ? -1 : 0;
+}
+
+/* The filter inline (the pair tests call it most), GMP behind it. */
+static inline int orient2d(const double a[3], const double b[3],
+                           const double c[3], int i, int j, long *exact) {
+  double acx = a[i] - c[i], bcx = b[i] - c[i];
+  double acy = a[j] - c[j], bcy = b[j] - c[j];
+  if (tame(acx) && tame(bcx) && tame(acy) && tame(bcy)) {
+    double l = acx * bcy, r = acy * bcx, det = l - r;
+    double bound = o2d_bound * (fabs(l) + fabs(r));
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+    if (l == 0 && r == 0) return 0;
+  }
+  return orient2d_exact(a, b, c, i, j, exact);
+}
+
+int mesh_orient2d(const double a[3], const double b[3], const double c[3],
+                  int i, int j, long *exact) {
+  return orient2d(a, b, c, i, j, exact);
 }
 
 /* ---- the pair test ------------------------------------------------------- */
@@ -229,7 +240,7 @@ static int o3(Ctx *c, const double *a, const double *b, const double *p,
 }
 
 static int o2(Ctx *c, const double *a, const double *b, const double *p) {
-  return mesh_orient2d(a, b, p, c->i, c->j, c->ex);
+  return orient2d(a, b, p, c->i, c->j, c->ex);
 }
 
 /* The axis k along which triangle abc projects to a triangle of nonzero
@@ -336,9 +347,18 @@ static int seg_tri3(Ctx *c, const double *p, const double *q, const Tri *t,
     set_axis(c, t->k);
     return seg_tri2(c, p, q, a, b, d, t->s);
   }
+  /* one end in the plane, the other off it: that end is all the segment
+     has in the plane, so they meet when it is in the triangle (three
+     orient2d in its projection instead of three orient3d) */
+  if (sp == 0 || sq == 0) {
+    set_axis(c, t->k);
+    return pt_tri2(c, sp == 0 ? p : q, a, b, d, t->s);
+  }
   /* the segment crosses the plane at one point: inside the closed
      triangle when the line passes no edge on the wrong side */
-  int s1 = o3(c, p, q, a, b), s2 = o3(c, p, q, b, d), s3 = o3(c, p, q, d, a);
+  int s1 = o3(c, p, q, a, b), s2 = o3(c, p, q, b, d);
+  if (s1 * s2 < 0) return 0; /* already signs both ways: s3 cannot help */
+  int s3 = o3(c, p, q, d, a);
   return !((s1 > 0 || s2 > 0 || s3 > 0) && (s1 < 0 || s2 < 0 || s3 < 0));
 }
 
@@ -476,7 +496,21 @@ static int early_out(Ctx *c, const Tri *A, const Tri *B, int shared) {
   return 0;
 }
 
-static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
+/* The fast path's triangles (below): when pair is given them, its signs
+   of vertices against a plane are taken on the plane made once. */
+typedef struct CTri CTri;
+static inline int plane_side(Ctx *c, const CTri *t, const double *d);
+
+static int ctri_axis(Ctx *c, const CTri *t, int *s);
+
+static int side(Ctx *c, const CTri *ct, const Tri *t, const double *x) {
+  return ct ? plane_side(c, ct, x) : o3(c, t->v[0], t->v[1], t->v[2], x);
+}
+
+/* ca, cb: triangles i and j as CTri, or NULL; when given, early_out has
+   been done (early_fast) and is not repeated. */
+static int pair(Ctx *c, const Mesh *m, size_t i, size_t j, const CTri *ca,
+                const CTri *cb) {
   Tri A, B;
   const int *ta = m->t + 3 * i, *tb = m->t + 3 * j;
   int shared = 0;
@@ -494,9 +528,9 @@ static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
         return 1; /* two vertices at one place */
     }
   if (shared >= 3) return 1; /* the same three vertices twice */
-  if (early_out(c, &A, &B, shared)) return 0;
-  A.k = tri_axis(c, A.v[0], A.v[1], A.v[2], &A.s);
-  B.k = tri_axis(c, B.v[0], B.v[1], B.v[2], &B.s);
+  if (!ca && early_out(c, &A, &B, shared)) return 0;
+  A.k = ca ? ctri_axis(c, ca, &A.s) : tri_axis(c, A.v[0], A.v[1], A.v[2], &A.s);
+  B.k = cb ? ctri_axis(c, cb, &B.s) : tri_axis(c, B.v[0], B.v[1], B.v[2], &B.s);
   if (A.k < 0 || B.k < 0) {
     if (A.k < 0 && B.k < 0) return seg_seg3(c, &A, &B);
     const Tri *a = A.k < 0 ? &A : &B, *b = A.k < 0 ? &B : &A;
@@ -508,13 +542,13 @@ static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
   if (shared == 0) {
     int sa[3], sb[3], pa = 0, na = 0, pb = 0, nb = 0;
     for (int q = 0; q < 3; q++) {
-      sb[q] = o3(c, A.v[0], A.v[1], A.v[2], B.v[q]);
+      sb[q] = side(c, ca, &A, B.v[q]);
       pb += sb[q] > 0;
       nb += sb[q] < 0;
     }
     if (pb == 3 || nb == 3) return 0;
     for (int q = 0; q < 3; q++) {
-      sa[q] = o3(c, B.v[0], B.v[1], B.v[2], A.v[q]);
+      sa[q] = side(c, cb, &B, A.v[q]);
       pa += sa[q] > 0;
       na += sa[q] < 0;
     }
@@ -537,13 +571,13 @@ static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
     /* the edges opposite the shared vertex against the other triangle */
     const double *a1 = A.v[(ia + 1) % 3], *a2 = A.v[(ia + 2) % 3];
     const double *b1 = B.v[(ib + 1) % 3], *b2 = B.v[(ib + 2) % 3];
-    int s1 = o3(c, A.v[0], A.v[1], A.v[2], b1), s2 = o3(c, A.v[0], A.v[1], A.v[2], b2);
+    int s1 = side(c, ca, &A, b1), s2 = side(c, ca, &A, b2);
     if (s1 == 0 && s2 == 0)
       /* one plane: two angles at v, each under 180 degrees, overlap
          beyond v exactly when a side of one lies in the other */
       return into2(c, &B, ib, a1) || into2(c, &B, ib, a2) ||
              into2(c, &A, ia, b1) || into2(c, &A, ia, b2);
-    int r1 = o3(c, B.v[0], B.v[1], B.v[2], a1), r2 = o3(c, B.v[0], B.v[1], B.v[2], a2);
+    int r1 = side(c, cb, &B, a1), r2 = side(c, cb, &B, a2);
     if (seg_tri3(c, a1, a2, &B, r1, r2) || seg_tri3(c, b1, b2, &A, s1, s2))
       return 1;
     /* the edges at the shared vertex going into the other triangle (only
@@ -566,20 +600,249 @@ static int pair(Ctx *c, const Mesh *m, size_t i, size_t j) {
 
 int mesh_tri_pair(const Mesh *m, size_t i, size_t j) {
   Ctx c = {NULL, 0, 1, 0};
-  return pair(&c, m, i, j);
+  return pair(&c, m, i, j, NULL, NULL);
+}
+
+/* ---- the fast path: planes made once per triangle ------------------------ */
+
+/* A triangle as a grid cell's scan keeps it: vertices, indices, its box and
+   first cell, and its plane. orient3d(a, b, c, d) = det [a - d; b - d;
+   c - d] = -(d - a) . n with n = (b - a) x (c - a): n is made once per
+   triangle (and cell), and each sign against the plane is then three
+   differences, three products and two sums.
+
+   The filter's bound, proven here for this order of operations (the
+   standard model: every operation's result is the exact one times
+   1 + delta, |delta| <= eps = 2^-53, which holds when no result
+   underflows, so only with safe coordinates: every nonzero difference
+   between 2^-300 and 2^300, every product of three a normal number).
+   With U = b - a, V = c - a, W = d - a exact and u, v, w their rounded
+   differences, n_x = fl(fl(u_y v_z) - fl(u_z v_y)) (and cyclically), the
+   computed s = fl(fl(fl(w_x n_x) + fl(w_y n_y)) + fl(w_z n_z)) is the sum
+   of the six monomials of the exact E = W . (U x V), each times a factor
+   within (1 + eps)^8 of 1 (a difference, a product, the minor's
+   difference, the product by w, two sums: at most 8 roundings), so
+   |s - E| <= g M with g = (1 + eps)^8 - 1 <= 8 eps + 29 eps^2 and M the
+   sum of the monomials' magnitudes. The permanent computed the same way
+   from magnitudes, p = fl(sum |w_i| fl(|fl(u_j v_k)| + |fl(u_k v_j)|)),
+   takes at most 8 roundings per monomial too, all of the same sign, so
+   p >= M (1 - eps)^8; the bound fl(B p) >= B p (1 - eps). s > fl(B p)
+   then gives E >= s - g M > p (B (1 - eps) - g / (1 - eps)^8) >= 0 when
+   B >= g / (1 - eps)^9, which B = (8 + 256 eps) eps is (g / (1 - eps)^9
+   <= (8 eps + 29 eps^2)(1 + 10 eps) < (8 + 110 eps) eps). p = 0 means
+   every monomial is exactly zero (none underflows), so E = 0. Where the
+   bound cannot decide, the full orient3d (its own filter, long double,
+   GMP) does, so the sign is always the exact one. */
+static const double plane_bound = (8.0 + 256.0 * EPS) * EPS;
+
+struct CTri {
+  double v[3][3];
+  double n[3], pn[3]; /* the plane's normal and its magnitudes (above) */
+  int id[3];
+  float box[6];
+  uint16_t c0[3];     /* the first grid cell it reaches */
+  /* two_places made once: along axis k the vertices' projections take
+     one place (tp[k][0] = 3: any fourth point makes two at most), two
+     (vertices tp[k][0], tp[k][1]: a fourth point at either place), or
+     three (tp[k][0] = -1) */
+  signed char tp[3][2];
+};
+
+static void ctri_make(CTri *t, const Mesh *m, size_t i) {
+  for (int q = 0; q < 3; q++) {
+    t->id[q] = m->t[3 * i + (size_t)q];
+    memcpy(t->v[q], m->v + 3 * (size_t)t->id[q], sizeof t->v[q]);
+  }
+  double u[3], v[3];
+  for (int a = 0; a < 3; a++) u[a] = t->v[1][a] - t->v[0][a], v[a] = t->v[2][a] - t->v[0][a];
+  for (int a = 0; a < 3; a++) {
+    int j = (a + 1) % 3, k = (a + 2) % 3;
+    double l = u[j] * v[k], r = u[k] * v[j];
+    t->n[a] = l - r;
+    t->pn[a] = fabs(l) + fabs(r);
+  }
+  for (int k = 0; k < 3; k++) {
+    int x = (k + 1) % 3, y = (k + 2) % 3;
+    int e01 = same2(t->v[0], t->v[1], x, y), e02 = same2(t->v[0], t->v[2], x, y),
+        e12 = same2(t->v[1], t->v[2], x, y);
+    signed char *tp = t->tp[k];
+    if (e01 && e02) tp[0] = 3, tp[1] = 0;
+    else if (e01 || e02) tp[0] = 0, tp[1] = e01 ? 2 : 1;
+    else if (e12) tp[0] = 0, tp[1] = 1;
+    else tp[0] = -1, tp[1] = 0;
+  }
+}
+
+/* two_places(t's vertices, d), from t->tp. */
+static int two_places_t(const CTri *t, const double *d) {
+  for (int k = 0; k < 3; k++) {
+    const signed char *tp = t->tp[k];
+    if (tp[0] < 0) continue;
+    if (tp[0] == 3) return 1;
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    if (same2(t->v[tp[0]], d, i, j) || same2(t->v[tp[1]], d, i, j)) return 1;
+  }
+  return 0;
+}
+
+/* Where the filter cannot decide: as orient3d ends, first the planes
+   along an axis (exact zeros, which no filter decides: its long double
+   stage would be wasted), then orient3d itself. */
+static int plane_side_slow(Ctx *c, const CTri *t, const double *d) {
+  if (two_places_t(t, d)) return 0;
+  return orient3d(t->v[0], t->v[1], t->v[2], d, c->ex, 1);
+}
+
+/* The sign of orient3d(t's vertices, d): exact (safe coordinates only). */
+static inline int plane_side(Ctx *c, const CTri *t, const double *d) {
+  double wx = d[0] - t->v[0][0], wy = d[1] - t->v[0][1], wz = d[2] - t->v[0][2];
+  double s = wx * t->n[0] + wy * t->n[1] + wz * t->n[2];
+  double p = fabs(wx) * t->pn[0] + fabs(wy) * t->pn[1] + fabs(wz) * t->pn[2];
+  double b = plane_bound * p;
+  if (s > b) return -1;
+  if (-s > b) return 1;
+  if (p == 0) return 0;
+  return plane_side_slow(c, t, d);
+}
+
+/* tri_axis from the plane made once: n[k] (k its largest magnitude, the
+   first of equals, the axis tri_axis tries first) is computed exactly as
+   orient2d(v1, v2, v0) on the axes k + 1, k + 2 computes its
+   determinant (the differences from v0, the two products, their
+   difference) and pn[k] as its permanent, so where |n[k]| exceeds
+   orient2d's bound its sign is that orient2d's, the sign of the
+   triangle's projection: tri_axis's answer without its tests. Else
+   tri_axis. */
+static int ctri_axis(Ctx *c, const CTri *t, int *s) {
+  int k = 0;
+  for (int a = 1; a < 3; a++)
+    if (fabs(t->n[a]) > fabs(t->n[k])) k = a;
+  if (fabs(t->n[k]) > o2d_bound * t->pn[k]) {
+    set_axis(c, k);
+    *s = t->n[k] > 0 ? 1 : -1;
+    return k;
+  }
+  return tri_axis(c, t->v[0], t->v[1], t->v[2], s);
+}
+
+/* early_out on the planes made once: the same signs, so the same answer. */
+static int early_fast(Ctx *c, const CTri *A, const CTri *B) {
+  for (int pass = 0; pass < 2; pass++) {
+    const CTri *a = pass ? B : A, *b = pass ? A : B;
+    int pos = 0, neg = 0, n = 0, shared = 0;
+    for (int q = 0; q < 3; q++) {
+      const int id = b->id[q];
+      if (id == a->id[0] || id == a->id[1] || id == a->id[2]) {
+        shared++;
+        continue;
+      }
+      int s = plane_side(c, a, b->v[q]);
+      pos += s > 0, neg += s < 0, n++;
+      if (!s || (pos && neg)) break;
+    }
+    if (n && (pos == n || neg == n)) return 1;
+    if (shared == 2) return 0; /* the other pass sees the same plane pair */
+  }
+  return 0;
+}
+
+/* The pair test (pair) with the common cases first, on safe coordinates.
+   A pair is decided here only as pair decides it:
+   - by early_fast, which is early_out with the same exact signs. pair
+     tests two distinct vertices at one place before early_out; that order
+     does not matter: such a vertex of one triangle lies on the other's
+     plane (or makes the other collinear, all of whose signs are 0), so
+     neither pass of early_out can find every other vertex strictly on
+     one side. The test is made next, as in pair.
+   - coplanar pairs, both triangles of nonzero area in the projection
+     along A's axis from ctri_axis (that projection is then one to one on
+     their plane, so neither is collinear, and pair's
+     2-D tests, whose answers are products of signs in one projection,
+     answer the same in it as in pair's own): on one edge u w (early_fast
+     found B's third vertex not strictly off A's plane, so on it), pair's
+     last case, o2(u, w, a3) o2(u, w, b3) > 0; on one vertex, pair's
+     angles at it; on nothing, pair's separating sides (tri_tri2).
+   Everything else goes to pair. */
+static int pair_fast(Ctx *c, const Mesh *m, const CTri *A, const CTri *B,
+                     size_t i, size_t j) {
+  if (early_fast(c, A, B)) return 0;
+  int shared = 0, ia = 0, ib = 0;
+  for (int x = 0; x < 3; x++)
+    for (int y = 0; y < 3; y++) {
+      if (A->id[x] == B->id[y]) shared++, ia = x, ib = y;
+      else if (A->v[x][0] == B->v[y][0] && A->v[x][1] == B->v[y][1] &&
+               A->v[x][2] == B->v[y][2])
+        return 1; /* two vertices at one place */
+    }
+  if (shared >= 3) return 1;
+  /* are B's other vertices on A's plane? */
+  if (shared < 2)
+    for (int q = 0; q < 3; q++)
+      if (B->id[q] != A->id[ia] && plane_side(c, A, B->v[q]) != 0)
+        return pair(c, m, i, j, A, B);
+  Tri TA, TB;
+  for (int q = 0; q < 3; q++) {
+    TA.v[q] = A->v[q], TA.id[q] = A->id[q];
+    TB.v[q] = B->v[q], TB.id[q] = B->id[q];
+  }
+  int k = ctri_axis(c, A, &TA.s);
+  if (k < 0) return pair(c, m, i, j, A, B);
+  TA.k = TB.k = k;
+  set_axis(c, k);
+  TB.s = o2(c, TB.v[0], TB.v[1], TB.v[2]);
+  if (!TA.s || !TB.s) return pair(c, m, i, j, A, B);
+  if (shared == 0) return tri_tri2(c, &TA, &TB);
+  if (shared == 1) {
+    const double *a1 = A->v[(ia + 1) % 3], *a2 = A->v[(ia + 2) % 3];
+    const double *b1 = B->v[(ib + 1) % 3], *b2 = B->v[(ib + 2) % 3];
+    return into2(c, &TB, ib, a1) || into2(c, &TB, ib, a2) ||
+           into2(c, &TA, ia, b1) || into2(c, &TA, ia, b2);
+  }
+  int a3 = 0, b3 = 0;
+  for (int q = 0; q < 3; q++) {
+    if (where(&TB, A->id[q]) < 0) a3 = q;
+    if (where(&TA, B->id[q]) < 0) b3 = q;
+  }
+  const double *u = A->v[(a3 + 1) % 3], *w = A->v[(a3 + 2) % 3];
+  return o2(c, u, w, A->v[a3]) * o2(c, u, w, B->v[b3]) > 0;
+}
+
+int mesh_orient3d_plane(const double a[3], const double b[3],
+                        const double c[3], const double d[3], long *exact) {
+  double v[12];
+  int t[3] = {0, 1, 2};
+  memcpy(v, a, 3 * sizeof *v);
+  memcpy(v + 3, b, 3 * sizeof *v);
+  memcpy(v + 6, c, 3 * sizeof *v);
+  memcpy(v + 9, d, 3 * sizeof *v);
+  if (!safe_coords(v, 12)) return orient3d(a, b, c, d, exact, 0);
+  Mesh m = {3, 1, v, t, NULL};
+  Ctx ctx = {exact, 0, 1, 1};
+  CTri ct;
+  ctri_make(&ct, &m, 0);
+  return plane_side(&ctx, &ct, d);
+}
+
+int mesh_tri_pair_fast(const Mesh *m, size_t i, size_t j) {
+  Ctx c = {NULL, 0, 1, 0};
+  if (!safe_coords(m->v, 3 * m->nv)) return pair(&c, m, i, j, NULL, NULL);
+  c.safe = 1;
+  CTri A, B;
+  ctri_make(&A, m, i);
+  ctri_make(&B, m, j);
+  return pair_fast(&c, m, &A, &B, i, j);
 }
 
 /* ---- the broad phase: a uniform grid over the triangles' boxes ---------- */
 
 /* Triangle i's box. */
 static void tri_box(const Mesh *m, size_t i, double l[3], double h[3]) {
-  for (int a = 0; a < 3; a++) {
-    l[a] = INFINITY, h[a] = -INFINITY;
-    for (int k = 0; k < 3; k++) {
-      double x = m->v[3 * (size_t)m->t[3 * i + (size_t)k] + (size_t)a];
-      l[a] = fmin(l[a], x);
-      h[a] = fmax(h[a], x);
-    }
+  const double *p = m->v + 3 * (size_t)m->t[3 * i], *q = m->v + 3 * (size_t)m->t[3 * i + 1],
+               *r = m->v + 3 * (size_t)m->t[3 * i + 2];
+  for (int a = 0; a < 3; a++) { /* finite (checked first): no NaN rules */
+    double lo = p[a] < q[a] ? p[a] : q[a], hi = p[a] < q[a] ? q[a] : p[a];
+    l[a] = r[a] < lo ? r[a] : lo;
+    h[a] = r[a] > hi ? r[a] : hi;
   }
 }
 
@@ -609,6 +872,7 @@ typedef struct {
   const int *items;
   int g[3];
   size_t ncell;
+  size_t maxrun;           /* the most triangles in a cell */
   atomic_size_t next;      /* the next block of cells */
   int safe;
 } Scan;
@@ -619,7 +883,18 @@ typedef struct {
   size_t first;            /* the cell of the first intersecting pair */
   size_t tri[2];
   double at[3];
+  int nomem;
 } Part;
+
+/* The pair i, j of cell q intersects: counted, the first kept. */
+static void found(Part *pt, size_t q, size_t i, size_t j, const float *bi,
+                  const float *bj) {
+  if (pt->bad++) return;
+  pt->first = q;
+  pt->tri[0] = i, pt->tri[1] = j;
+  for (int a = 0; a < 3; a++)
+    pt->at[a] = 0.5 * ((double)fmaxf(bi[a], bj[a]) + (double)fminf(bi[3 + a], bj[3 + a]));
+}
 
 static void *scan(void *arg) {
   Part *pt = arg;
@@ -627,37 +902,68 @@ static void *scan(void *arg) {
   const float *box = sc->box;
   uint16_t (*cb)[6] = sc->cb;
   Ctx ctx = {&pt->exact, 0, 1, sc->safe};
+  /* a cell's triangles copied together, planes made (safe meshes only) */
+  CTri *ct = sc->safe ? malloc((sc->maxrun ? sc->maxrun : 1) * sizeof *ct) : NULL;
+  if (sc->safe && !ct) {
+    pt->nomem = 1;
+    return NULL;
+  }
   for (;;) {
     size_t q0 = atomic_fetch_add(&sc->next, CHECK_BLOCK);
     if (q0 >= sc->ncell) break;
     size_t q1 = q0 + CHECK_BLOCK < sc->ncell ? q0 + CHECK_BLOCK : sc->ncell;
     for (size_t q = q0; q < q1; q++) {
-      int cx = (int)(q / ((size_t)sc->g[1] * (size_t)sc->g[2]));
-      int cy = (int)(q / (size_t)sc->g[2] % (size_t)sc->g[1]);
-      int cz = (int)(q % (size_t)sc->g[2]);
+      uint16_t cx = (uint16_t)(q / ((size_t)sc->g[1] * (size_t)sc->g[2]));
+      uint16_t cy = (uint16_t)(q / (size_t)sc->g[2] % (size_t)sc->g[1]);
+      uint16_t cz = (uint16_t)(q % (size_t)sc->g[2]);
       size_t start = q ? sc->cnt[q - 1] : 0, end = sc->cnt[q];
-      for (size_t x = start; x < end; x++)
-        for (size_t y = x + 1; y < end; y++) {
-          size_t i = (size_t)sc->items[x], j = (size_t)sc->items[y];
-          const float *bi = box + 6 * i, *bj = box + 6 * j;
+      if (end - start < 2) continue;
+      if (!ct) {
+        for (size_t x = start; x < end; x++)
+          for (size_t y = x + 1; y < end; y++) {
+            size_t i = (size_t)sc->items[x], j = (size_t)sc->items[y];
+            const float *bi = box + 6 * i, *bj = box + 6 * j;
+            if (bi[0] > bj[3] || bj[0] > bi[3] || bi[1] > bj[4] || bj[1] > bi[4] ||
+                bi[2] > bj[5] || bj[2] > bi[5])
+              continue;
+            /* tested in the first cell both reach */
+            if ((cb[i][0] > cb[j][0] ? cb[i][0] : cb[j][0]) != cx ||
+                (cb[i][1] > cb[j][1] ? cb[i][1] : cb[j][1]) != cy ||
+                (cb[i][2] > cb[j][2] ? cb[i][2] : cb[j][2]) != cz)
+              continue;
+            pt->pairs++;
+            if (pair(&ctx, sc->m, i, j, NULL, NULL)) found(pt, q, i, j, bi, bj);
+          }
+        continue;
+      }
+      size_t n = end - start;
+      for (size_t x = 0; x < n; x++) {
+        size_t i = (size_t)sc->items[start + x];
+        ctri_make(&ct[x], sc->m, i);
+        memcpy(ct[x].box, box + 6 * i, sizeof ct[x].box);
+        memcpy(ct[x].c0, cb[i], sizeof ct[x].c0);
+      }
+      for (size_t x = 0; x < n; x++) {
+        const CTri *A = &ct[x];
+        for (size_t y = x + 1; y < n; y++) {
+          const CTri *B = &ct[y];
+          const float *bi = A->box, *bj = B->box;
           if (bi[0] > bj[3] || bj[0] > bi[3] || bi[1] > bj[4] || bj[1] > bi[4] ||
               bi[2] > bj[5] || bj[2] > bi[5])
             continue;
           /* tested in the first cell both reach */
-          if ((cb[i][0] > cb[j][0] ? cb[i][0] : cb[j][0]) != cx ||
-              (cb[i][1] > cb[j][1] ? cb[i][1] : cb[j][1]) != cy ||
-              (cb[i][2] > cb[j][2] ? cb[i][2] : cb[j][2]) != cz)
+          if ((A->c0[0] > B->c0[0] ? A->c0[0] : B->c0[0]) != cx ||
+              (A->c0[1] > B->c0[1] ? A->c0[1] : B->c0[1]) != cy ||
+              (A->c0[2] > B->c0[2] ? A->c0[2] : B->c0[2]) != cz)
             continue;
           pt->pairs++;
-          if (pair(&ctx, sc->m, i, j) && !pt->bad++) {
-            pt->first = q;
-            pt->tri[0] = i, pt->tri[1] = j;
-            for (int a = 0; a < 3; a++)
-              pt->at[a] = 0.5 * ((double)fmaxf(bi[a], bj[a]) + (double)fminf(bi[3 + a], bj[3 + a]));
-          }
+          size_t i = (size_t)sc->items[start + x], j = (size_t)sc->items[start + y];
+          if (pair_fast(&ctx, sc->m, A, B, i, j)) found(pt, q, i, j, bi, bj);
         }
+      }
     }
   }
+  free(ct);
   mesh_check_release();
   return NULL;
 }
@@ -716,8 +1022,9 @@ int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
     tri_box(m, i, b[0], b[1]);
     for (int a = 0; a < 3; a++)
       for (int e = 0; e < 2; e++) {
-        double f = floor((b[e][a] - lo[a]) / cs);
-        cb[i][3 * e + a] = (uint16_t)(f < 0 ? 0 : f >= g[a] ? g[a] - 1 : (int)f);
+        /* b - lo >= 0: truncation is floor */
+        double f = (b[e][a] - lo[a]) / cs;
+        cb[i][3 * e + a] = (uint16_t)(f >= g[a] ? g[a] - 1 : (int)f);
         box[6 * i + 3 * (size_t)e + (size_t)a] = e ? up(b[e][a]) : down(b[e][a]);
       }
   }
@@ -746,7 +1053,12 @@ int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
       }
     }
   }
-  Scan sc = {m, box, cb, cnt, items, {g[0], g[1], g[2]}, ncell, 0,
+  size_t maxrun = 0;
+  for (size_t q = 0; q < ncell; q++) {
+    size_t n = cnt[q] - (q ? cnt[q - 1] : 0);
+    if (n > maxrun) maxrun = n;
+  }
+  Scan sc = {m, box, cb, cnt, items, {g[0], g[1], g[2]}, ncell, maxrun, 0,
              safe_coords(m->v, 3 * m->nv)};
   int nth = nt < 20000 ? 1 : CHECK_THREADS;
   Part part[CHECK_THREADS];
@@ -763,6 +1075,11 @@ int mesh_self_check(const Mesh *m, MeshSelfCheck *c) {
   scan(&part[0]);
   for (int t = 1; t < started; t++) pthread_join(th[t], NULL);
   size_t first = SIZE_MAX;
+  for (int t = 0; t < started; t++)
+    if (part[t].nomem) {
+      rc = -2;
+      goto out;
+    }
   for (int t = 0; t < started; t++) {
     c->pairs += part[t].pairs;
     c->exact += part[t].exact;

@@ -39,6 +39,10 @@ int mesh_self_check(const struct Mesh *m, MeshSelfCheck *c);
 /* The pair test alone: 1 if triangles i and j of m meet other than in the
    vertices (by index) they share. */
 int mesh_tri_pair(const struct Mesh *m, size_t i, size_t j);
+/* The same answer by the path mesh_self_check takes: each triangle's
+   plane made once, the common cases first (to test it against
+   mesh_tri_pair). */
+int mesh_tri_pair_fast(const struct Mesh *m, size_t i, size_t j);
 
 /* The exact predicates. orient3d: the sign of det [a - d; b - d; c - d]
    (positive when d is below the plane of a, b, c seen counter-clockwise
@@ -49,6 +53,10 @@ int mesh_orient3d(const double a[3], const double b[3], const double c[3],
                   const double d[3], long *exact);
 int mesh_orient2d(const double a[3], const double b[3], const double c[3],
                   int i, int j, long *exact);
+/* orient3d(a, b, c, d) as the fast path takes it: the plane of a, b, c
+   made once, its own proven filter, then orient3d (to test it). */
+int mesh_orient3d_plane(const double a[3], const double b[3],
+                        const double c[3], const double d[3], long *exact);
 /* Frees the calling thread's scratch integers of the exact evaluations
    (kept between calls; mesh_self_check releases its own). */
 void mesh_check_release(void);

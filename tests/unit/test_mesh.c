@@ -561,7 +561,7 @@ static double prand(void) { /* its own stream: urand's is the property test's */
 /* Random points, and points made coplanar (collinear in 2-D) exactly on
    a dyadic grid, then nudged by an ulp or two: the signs against GMP. */
 static void predicates(void) {
-  long exact = 0, zero = 0, bad3 = 0, bad2 = 0, n = 0;
+  long exact = 0, zero = 0, bad3 = 0, bad2 = 0, n = 0, badp = 0, exactp = 0;
   for (int k = 0; k < 30000; k++) {
     double p[4][3];
     int kind = k % 5;
@@ -587,6 +587,7 @@ static void predicates(void) {
     int r = ref_orient3d(p[0], p[1], p[2], p[3]);
     zero += r == 0;
     bad3 += mesh_orient3d(p[0], p[1], p[2], p[3], &exact) != r;
+    badp += mesh_orient3d_plane(p[0], p[1], p[2], p[3], &exactp) != r;
     int i = (int)(prand() * 3), j = (i + 1 + (int)(prand() * 2)) % 3;
     bad2 += mesh_orient2d(p[0], p[1], p[3], i, j, &exact) !=
             ref_orient2d(p[0], p[1], p[3], i, j);
@@ -607,6 +608,98 @@ static void predicates(void) {
   CHECK(buf, bad3 == 0 && zero > 1000 && exact > 1000);
   snprintf(buf, sizeof buf, "orient2d: %ld signs of %ld agree with GMP", n - bad2, n);
   CHECK(buf, bad2 == 0);
+  badp += mesh_orient3d_plane(tiny[0], tiny[1], tiny[2], tiny[3], NULL) !=
+          ref_orient3d(tiny[0], tiny[1], tiny[2], tiny[3]);
+  badp += mesh_orient3d_plane(huge[0], huge[1], huge[2], huge[3], NULL) !=
+          ref_orient3d(huge[0], huge[1], huge[2], huge[3]);
+  snprintf(buf, sizeof buf, "orient3d by the plane made once (the check's fast "
+           "path): %ld signs of %ld agree with GMP (%ld left to exact arithmetic)",
+           n - badp, n, exactp);
+  CHECK(buf, badp == 0 && exactp > 1000);
+}
+
+/* A random point on the dyadic grid of 2^-10 * sc. */
+static void grid_pt(double *p, double sc) {
+  for (int a = 0; a < 3; a++) p[a] = ldexp(floor((prand() - 0.5) * 1024), -10) * sc;
+}
+
+/* p = a + s (b - a) + t (c - a) with s, t small dyadic: exact, in the
+   plane of a, b, c (on the grid of 2^-12 * sc). */
+static void in_plane(double *p, const double *a, const double *b,
+                     const double *c) {
+  double s = floor(prand() * 12) / 4 - 1, t = floor(prand() * 12) / 4 - 1;
+  for (int k = 0; k < 3; k++) p[k] = a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]);
+}
+
+/* One coordinate of p an ulp or two off. */
+static void nudge(double *p) {
+  int a = (int)(prand() * 3);
+  double dir = prand() < 0.5 ? INFINITY : -INFINITY;
+  p[a] = nextafter(p[a], dir);
+  if (prand() < 0.5) p[a] = nextafter(p[a], dir);
+}
+
+/* The check's fast path (planes made once, coplanar neighbours first)
+   against the general pair test on pairs made to be near-degenerate:
+   on one edge (third vertices in one plane, folded onto each other or
+   flat, or an ulp off it), on one vertex (both in one plane, or an ulp
+   off), on nothing (coplanar, overlapping or not), on two lines along an
+   axis (a rounded edge's strips), each in a few scales; a wrong sign or
+   a wrong shortcut makes the two differ. */
+static void fast_pairs(void) {
+  long n = 0, differ = 0, met = 0, kinds[5] = {0};
+  for (int k = 0; k < 40000; k++) {
+    double v[6][3];
+    int t[2][3];
+    int kind = k % 5;
+    double sc = ldexp(1, (int)(prand() * 20) - 10);
+    for (int i = 0; i < 6; i++) grid_pt(v[i], sc);
+    if (kind == 0) { /* one edge 0 1: B's third vertex in A's plane */
+      in_plane(v[3], v[0], v[1], v[2]);
+      t[0][0] = 0, t[0][1] = 1, t[0][2] = 2, t[1][0] = 1, t[1][1] = 0, t[1][2] = 3;
+    } else if (kind == 1) { /* one vertex 0 */
+      in_plane(v[3], v[0], v[1], v[2]);
+      in_plane(v[4], v[0], v[1], v[2]);
+      t[0][0] = 0, t[0][1] = 1, t[0][2] = 2, t[1][0] = 0, t[1][1] = 3, t[1][2] = 4;
+    } else if (kind == 2) { /* nothing shared, one plane */
+      for (int i = 3; i < 6; i++) in_plane(v[i], v[0], v[1], v[2]);
+      t[0][0] = 0, t[0][1] = 1, t[0][2] = 2, t[1][0] = 3, t[1][1] = 4, t[1][2] = 5;
+    } else { /* vertices on two lines along axis ax: a strip */
+      int ax = (int)(prand() * 3);
+      for (int i = 0; i < 6; i++) {
+        const double *base = v[i % 2 ? 1 : 0];
+        double x = v[i][ax];
+        memcpy(v[i], base, sizeof v[i]);
+        v[i][ax] = x;
+      }
+      if (kind == 3) /* one edge */
+        t[0][0] = 0, t[0][1] = 1, t[0][2] = 2, t[1][0] = 1, t[1][1] = 2,
+        t[1][2] = 3;
+      else /* one vertex */
+        t[0][0] = 0, t[0][1] = 1, t[0][2] = 2, t[1][0] = 2, t[1][1] = 3,
+        t[1][2] = 5;
+    }
+    if (k % 3 == 1) nudge(v[3 + (int)(prand() * 3)]);
+    if (k % 7 == 2) nudge(v[(int)(prand() * 3)]);
+    Mesh m = {6, 2, &v[0][0], &t[0][0], NULL};
+    int g = mesh_tri_pair(&m, 0, 1), f = mesh_tri_pair_fast(&m, 0, 1);
+    if (g != f && differ < 5)
+      printf("# fast path %d, general %d, kind %d, pair %ld\n", f, g, kind, n);
+    differ += g != f;
+    met += g;
+    kinds[kind] += g;
+    n++;
+  }
+  mesh_check_release();
+  char buf[300];
+  snprintf(buf, sizeof buf, "self-intersection check's fast path: %ld of %ld "
+           "near-degenerate pairs as the general test has them (%ld meet: "
+           "%ld on an edge, %ld on a vertex, %ld coplanar, %ld and %ld in strips)",
+           n - differ, n, met, kinds[0], kinds[1], kinds[2], kinds[3], kinds[4]);
+  /* both answers common in every kind, so neither answer is a default */
+  int mixed = 1;
+  for (int q = 0; q < 5; q++) mixed &= kinds[q] > 200 && kinds[q] < 7800;
+  CHECK(buf, differ == 0 && mixed);
 }
 
 /* A mesh of the given vertices and triangles (no closure needed). */
@@ -1419,6 +1512,7 @@ int main(void) {
            "(SoftObject 0.5 [Key (1, 1, 1) 0.8 1])");
   one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
   predicates();
+  fast_pairs();
   hand_meshes();
   bad_input();
   sharp_corners();
