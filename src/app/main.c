@@ -903,7 +903,7 @@ int main(int argc, char **argv) {
                 (unsigned long long)o.render.height, o.max_pixels);
     return 1;
   }
-  GC_INIT();
+  interp_gc_init();
   GC_allow_register_threads();
   /* Ctrl-C ends a script's evaluation or render with "interrupted" (no
      partial image is ever left); the REPL installs its own handling. */

@@ -54,8 +54,14 @@ typedef enum {
 /* A new interpreter with the language's own built-ins, then install(I)
    (may be NULL: the built-ins of the layers above, which the language does
    not know, such as the probes and the renderer; see bind/bind.h), then
-   the prelude. Calls GC_INIT on first use. */
+   the prelude. Calls interp_gc_init on first use. */
 Interp *interp_new(void (*install)(Interp *I));
+
+/* Starts the collector the way qcs needs it (once; later calls do
+   nothing): its heap and free-space settings, and its roots without the
+   collector's own static data (see interp.c). main calls it before any
+   thread is made; interp_new calls it too, for tests and tools. */
+void interp_gc_init(void);
 
 /* Run source text; name is used in error positions ("<stdin>", a path). */
 RunStatus interp_run_string(Interp *I, const char *name, const char *text,
