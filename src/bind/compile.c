@@ -492,7 +492,7 @@ static int compile_rounded(Compile *C, Value *tree, double r, Pos pos) {
   for (int j = 0; j < t->nleaves; j++) ws = fmax(ws, fabs(t->leaves[j].d));
   warn_resolution(C, pos, "a radius of", wr, ws);
   int fo = 0, fi = 0;
-  nd->outer = bnd_outer(t, 0.5, &fo);
+  nd->outer = bnd_outer_chamfered(t, 0.5, &fo);
   nd->inner = bnd_inner(t, 0.5, &fi);
   nd->bound_flags = fo | fi;
   if (!nd->outer || !nd->inner ||

@@ -166,6 +166,7 @@ static int check_bounds(const rtree *t, int root, const dt_tape *tp,
                         double box_lo, double box_hi) {
   int fo, fi, bad = 0;
   csg_tape *ob = bnd_outer(tp, level, &fo);
+  csg_tape *oc = bnd_outer_chamfered(tp, level, &fo);
   csg_tape *ib = bnd_inner(tp, level, &fi);
   *flags_out = fo | fi;
   for (int k = 0; k < npts; k++) {
@@ -185,9 +186,11 @@ static int check_bounds(const rtree *t, int root, const dt_tape *tp,
     int in_o = csg_inside(ob, p), in_i = csg_inside(ib, p);
     double rho = ref_density(t, root, p);
     if (!in_o && rho > level) bad++;
+    if (!csg_inside(oc, p) && rho > level) bad++;
     if (in_i && rho < level) bad++;
   }
   csg_tape_free(ob);
+  csg_tape_free(oc);
   csg_tape_free(ib);
   return bad;
 }
@@ -209,8 +212,8 @@ static void test_bounds_random(void) {
   }
   printf("# bounds: %d of 240 random scene/level pairs needed the fallback\n",
          fallback);
-  CHECK("random scenes: outside outer => rho <= t, inside inner => rho >= t "
-        "(36000 points, MPFR)", bad == 0);
+  CHECK("random scenes: outside outer (Figure 8's and the chamfered) => "
+        "rho <= t, inside inner => rho >= t (36000 points, MPFR)", bad == 0);
 }
 
 static void test_bounds_figure15b(void) {
@@ -268,20 +271,43 @@ static void test_bounds_figure15b(void) {
   dt_tape_free(tp);
 }
 
-/* The rounded unit cube: outer(0.5) is the cube itself (plus ulps), the
- * inner bound is strictly inside. */
+/* The unit cube rounded by 0.3: outer(0.5) of Figure 8 is the cube itself (plus
+ * ulps); the chamfered one is the cube with its edges and
+ * corners chamfered (bounds.c: a pair of faces at radius r cannot reach
+ * 0.5 beyond a1 + a2 = 2 a*_2, a triple beyond a1 + a2 + a3 = 3 a*_3),
+ * the inner bound is strictly inside. */
 static void test_bounds_cube(void) {
   rtree t;
   double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-  double r[6] = {0.07, 0.07, 0.07, 0.07, 0.07, 0.07};
+  double r[6] = {0.3, 0.3, 0.3, 0.3, 0.3, 0.3};
   t.n = 0;
   int root = rt_box(&t, lo, hi, r);
   dt_tape *tp = rt_tape(&t, root);
   int fl;
-  csg_tape *ob = bnd_outer(tp, 0.5, &fl), *ib = bnd_inner(tp, 0.5, &fl);
+  csg_tape *ob = bnd_outer_chamfered(tp, 0.5, &fl), *ib = bnd_inner(tp, 0.5, &fl);
   double c[3] = {1, 1, 1}, in[3] = {0.5, 0.5, 0.5}, face[3] = {0.5, 0.5, 1};
-  double out[3] = {0.5, 0.5, 1 + 1e-9};
-  CHECK("cube outer bound contains the corner", csg_inside(ob, c));
+  double out[3] = {0.5, 0.5, 1 + 1e-9}, e[3] = {0.5, 1, 1};
+  csg_tape *o8 = bnd_outer(tp, 0.5, &fl);
+  CHECK("cube outer bound of Figure 8 is the sharp cube (holds the corner)",
+        csg_inside(o8, c) && !csg_inside(o8, out));
+  csg_tape_free(o8);
+  CHECK("cube outer bound cuts off the corner", !csg_inside(ob, c));
+  CHECK("cube outer bound cuts off the edge", !csg_inside(ob, e));
+  /* the surface's own points on the diagonal and at the edge's middle
+   * (found by bisection on the MPFR density) lie inside */
+  double sd[2] = {0.5, 1}, se[2] = {0.5, 1};
+  for (int k = 0; k < 60; k++) {
+    double m = 0.5 * (sd[0] + sd[1]), q[3] = {m, m, m};
+    sd[ref_density(&t, root, q) >= 0.5 ? 0 : 1] = m;
+    m = 0.5 * (se[0] + se[1]);
+    double w[3] = {0.5, m, m};
+    se[ref_density(&t, root, w) >= 0.5 ? 0 : 1] = m;
+  }
+  double qd[3] = {sd[0], sd[0], sd[0]}, qe[3] = {0.5, se[0], se[0]};
+  CHECK("cube outer bound contains the rounded corner's surface point",
+        csg_inside(ob, qd));
+  CHECK("cube outer bound contains the rounded edge's surface point",
+        csg_inside(ob, qe));
   CHECK("cube outer bound contains the face centre", csg_inside(ob, face));
   CHECK("cube outer bound excludes points beyond the face",
         !csg_inside(ob, out));
@@ -291,6 +317,93 @@ static void test_bounds_cube(void) {
   csg_tape_free(ob);
   csg_tape_free(ib);
   dt_tape_free(tp);
+  /* radius 0.07: the chamfers would cut 2% of the cube's extent, less
+     than they cost a ray (CHAMFER_GAIN): none, the corner stays */
+  rtree t2;
+  double r2[6] = {0.07, 0.07, 0.07, 0.07, 0.07, 0.07};
+  t2.n = 0;
+  tp = rt_tape(&t2, rt_box(&t2, lo, hi, r2));
+  ob = bnd_outer_chamfered(tp, 0.5, &fl);
+  CHECK("cube rounded by 0.07: no chamfers worth their planes",
+        ob && csg_inside(ob, c) && ob->nplanes == 6);
+  csg_tape_free(ob);
+  dt_tape_free(tp);
+}
+
+/* Chamfers where they cut: rounded boxes and random convex polyhedra
+ * (products of 4 to 8 random planes around a centre), radii from 0.002 to
+ * 0.8 and unequal per face, at t = 0.5, 0.293 (a Union's request) and a
+ * random level, with points drawn around the polyhedra's edges and
+ * corners: outside the outer bound the MPFR density is <= t everywhere;
+ * and the chamfers must cut (some sampled points near corners fall
+ * outside the bound although inside the sharp polyhedron). */
+static void test_bounds_chamfers(void) {
+  rng_t g = {1999};
+  int bad = 0, cut = 0, total = 0;
+  for (int sc = 0; sc < 80; sc++) {
+    rtree t;
+    t.n = 0;
+    int root;
+    double c[3] = {0, 0, 0};
+    if (sc % 2 == 0) {
+      double lo[3], hi[3], r[6];
+      for (int j = 0; j < 3; j++) {
+        lo[j] = rng_range(&g, -1, 0);
+        hi[j] = lo[j] + rng_range(&g, 0.3, 1.5);
+        c[j] = 0.5 * (lo[j] + hi[j]);
+      }
+      for (int j = 0; j < 6; j++)
+        r[j] = sc % 8 == 2 ? (j % 2 ? 0.002 : 0.8) : rng_range(&g, 0.01, 0.6);
+      root = rt_box(&t, lo, hi, r);
+    } else {
+      int m = 4 + (int)(rng_u64(&g) % 5);
+      root = -1;
+      for (int k = 0; k < m; k++) {
+        double n[3];
+        rand_dir(&g, 1, n);
+        int lf = rt_leaf(&t, n[0], n[1], n[2], rng_range(&g, 0.3, 1),
+                         rng_range(&g, 0.005, 0.7));
+        root = root < 0 ? lf : rt_op(&t, R_PROD, root, lf);
+      }
+    }
+    dt_tape *tp = rt_tape(&t, root);
+    double levels[3] = {0.5, 0.293, rng_range(&g, 0.05, 0.95)};
+    for (int k = 0; k < 3; k++) {
+      int fl;
+      csg_tape *ob = bnd_outer_chamfered(tp, levels[k], &fl);
+      for (int q = 0; q < 400; q++) {
+        /* a point on the sharp surface near two or three planes: from the
+           centre out along a random direction to the first plane, then
+           pulled towards the others' intersection by a random amount */
+        double d[3], p[3];
+        rand_dir(&g, 1, d);
+        double smin = INFINITY;
+        for (int i = 0; i < t.n; i++) {
+          const rnode *x = &t.nodes[i];
+          if (x->op != R_LEAF) continue;
+          double nd = x->n[0] * d[0] + x->n[1] * d[1] + x->n[2] * d[2];
+          double nc = x->n[0] * c[0] + x->n[1] * c[1] + x->n[2] * c[2];
+          if (nd > 1e-9) smin = fmin(smin, (x->d - nc) / nd);
+        }
+        if (!isfinite(smin)) continue;
+        double s = smin * rng_range(&g, 0.7, 1.05);
+        for (int j = 0; j < 3; j++) p[j] = c[j] + s * d[j];
+        double rho = ref_density(&t, root, p);
+        int in_o = csg_inside(ob, p);
+        total++;
+        if (!in_o && rho > levels[k]) bad++;
+        if (!in_o && ref_in(&t, root, p)) cut++;
+      }
+      csg_tape_free(ob);
+    }
+    dt_tape_free(tp);
+  }
+  printf("# chamfers: %d of %d points near edges and corners cut off\n", cut,
+         total);
+  CHECK("chamfers: outside outer => rho <= t (boxes and random convex "
+        "polyhedra, radii 0.002 to 0.8, MPFR)", bad == 0);
+  CHECK("chamfers: they cut (points inside the sharp polyhedron outside "
+        "the bound)", cut > total / 50);
 }
 
 /* csg_box_class and dt_range_box (the mesher's cell proofs) against the
@@ -342,5 +455,6 @@ int main(void) {
   test_bounds_cube();
   test_bounds_random();
   test_bounds_figure15b();
+  test_bounds_chamfers();
   CHECK_DONE();
 }
