@@ -2282,6 +2282,23 @@ static double measured_error(Mesher *m, const Mesh *me, double reach, int n,
   return worst;
 }
 
+static int test_fault;
+
+void mesh_test_fault(int fault) { test_fault = fault; }
+
+/* mesh_test_fault's corruption: vertex 0 reflected through the centroid
+   of the vertices, 1.5 times as far: its triangles then cross the solid
+   and meet the far side's. */
+static void push_through(Mesh *me) {
+  double c[3] = {0, 0, 0};
+  for (size_t i = 0; i < me->nv; i++)
+    for (size_t k = 0; k < 3; k++) c[k] += me->v[3 * i + k];
+  for (size_t k = 0; k < 3; k++) {
+    c[k] /= (double)me->nv;
+    me->v[k] = c[k] + 1.5 * (c[k] - me->v[k]);
+  }
+}
+
 /* No two triangles meet other than in what they share, checked exactly
    (mesh_check.c); else *rc is set and the error names the place. */
 static int self_check(const Mesh *me, MeshReport *rep, char *err,
@@ -2556,6 +2573,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_EINTERNAL;
     goto done;
   }
+  if (me->nv && (test_fault == 2 || (test_fault == 1 && sharp)))
+    push_through(me);
   if (self_check(me, rep, err, errlen, &rc) != 0) {
     mesh_free(me);
     goto done;

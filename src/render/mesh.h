@@ -149,6 +149,14 @@ typedef struct MeshCheck {
   long euler;              /* V - E + F over the used vertices */
 } MeshCheck;
 
+/* For tests only: from the next call on, each mesh made with sharp cells
+   (fault 1), or each mesh (fault 2), has one vertex pushed through the
+   solid (reflected through the vertices' centroid, half as far again)
+   just before its self-intersection check, so that the check's failure
+   paths run: the remake without sharp cells, and the error that writes
+   nothing. 0 (the default) turns it off. Not thread-safe. */
+void mesh_test_fault(int fault);
+
 /* Returns 0 when the mesh is a closed, consistently oriented 2-manifold,
    else -1 (details in *c); -2 when memory runs out. */
 int mesh_check(const Mesh *m, MeshCheck *c);

@@ -1487,6 +1487,56 @@ static void bad_input(void) {
   scene_free(s);
 }
 
+/* The self-intersection check's failure paths, by mesh_test_fault: a
+   mesh made with sharp cells that intersects itself is made again without
+   them (and that one passes); one that intersects itself without them is
+   an error, and `mesh` writes no file. The corruption is a real crossing:
+   the exact check must find it. */
+static void self_check_failures(void) {
+  Scene *s = compile("UnitCube");
+  MeshSettings ms = {0};
+  ms.tol = 0.05;
+  Mesh *m = NULL;
+  MeshReport rep;
+  char err[400];
+  int bad;
+  mesh_test_fault(1);
+  int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  long eu;
+  MeshSelfCheck sc;
+  CHECK("a sharp mesh that intersects itself is made again without sharp "
+        "cells, and that one is closed and free of intersections",
+        rc == 0 && m && rep.sharp_off == 2 && closed_oriented(m, &eu) &&
+            eu == 2 && mesh_self_check(m, &sc) == 0);
+  mesh_free(m);
+  m = NULL;
+  mesh_test_fault(2);
+  rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  CHECK("a mesh that intersects itself without sharp cells is an error "
+        "naming the place",
+        rc == MESH_ESELF && !m && strstr(err, "intersects itself") &&
+            strstr(err, "nothing was written"));
+  scene_free(s);
+  const char *path = "/tmp/qcs-test-fault.stl";
+  remove(path);
+  char text[200];
+  snprintf(text, sizeof text, "mesh \"%s\" UnitCube", path);
+  Src *src = src_of("<test>", text);
+  ErrFrame f;
+  int failed = 0;
+  if (ERR_TRY(f)) {
+    Expr *e = parse_expression(I, src);
+    force(I, eval(I, e, NULL));
+    err_pop(&f);
+  } else {
+    err_pop(&f);
+    failed = strstr(err_info()->msg, "intersects itself") != NULL;
+  }
+  CHECK("mesh \"f.stl\" of a mesh that intersects itself: an error, and no "
+        "file", failed && access(path, F_OK) != 0);
+  mesh_test_fault(0);
+}
+
 int main(void) {
   check_prefix = "mesh";
   I = bind_interp_new();
@@ -1515,6 +1565,7 @@ int main(void) {
   fast_pairs();
   hand_meshes();
   bad_input();
+  self_check_failures();
   sharp_corners();
   thin_parts();
   property();
