@@ -37,6 +37,15 @@ static __attribute__((noinline)) void scrub_near(void) {
   __asm__ volatile("" : : "r"(pad) : "memory");
 }
 
+/* Error paths that need a text buffer are functions of their own, never
+   inlined: a buffer in a hot recursive frame (eval, call, select_clause)
+   is never written on the paths that run, so whatever an earlier, deeper
+   call left at those addresses stays there, and the collector, which
+   scans the stack conservatively, keeps it alive: pipeline's xs
+   (bench/hugs) kept 13,700 consumed cells so, from a stale Env in
+   eval's unused 120-byte buffer. */
+#define COLD __attribute__((noinline, cold))
+
 /* Zeroes the registers a callee saves (and so keeps, in its frame or
    unchanged, through the whole call): whatever the caller held there
    that it no longer needs (env, in eval's E_APP) would otherwise stay
@@ -64,6 +73,14 @@ static __attribute__((noinline)) void scrub_near(void) {
 /* eval_check (eval.h) found something to do: I->steps is counted and,
    unless a check before failed, I->memcheck too. No system calls, no
    allocation. */
+static _Noreturn COLD void memory_error(Interp *I, Pos pos,
+                                       const char *would) {
+  char sz[32];
+  interp_format_size(sz, sizeof sz, I->max_memory);
+  eval_limit_error(I, pos, "max-memory", "evaluation stopped: values "
+                   "%suse more than %s of memory", would, sz);
+}
+
 void eval_check_slow(Interp *I, Pos pos) {
   char probe;
   if (atomic_load_explicit(&qcs_interrupted, memory_order_relaxed)) {
@@ -86,12 +103,7 @@ void eval_check_slow(Interp *I, Pos pos) {
     if (used > I->max_memory) {
       GC_gcollect();
       used = GC_get_heap_size() - GC_get_free_bytes();
-      if (used > I->max_memory) {
-        char sz[32];
-        interp_format_size(sz, sizeof sz, I->max_memory);
-        eval_limit_error(I, pos, "max-memory", "evaluation stopped: values "
-                         "use more than %s of memory", sz);
-      }
+      if (used > I->max_memory) memory_error(I, pos, "");
     }
   }
 }
@@ -102,12 +114,8 @@ void eval_alloc_check(Interp *I, Pos pos, size_t bytes) {
   if (bytes > I->max_memory || used + bytes > I->max_memory) {
     GC_gcollect();
     used = GC_get_heap_size() - GC_get_free_bytes();
-    if (bytes > I->max_memory || used + bytes > I->max_memory) {
-      char sz[32];
-      interp_format_size(sz, sizeof sz, I->max_memory);
-      eval_limit_error(I, pos, "max-memory", "evaluation stopped: values "
-                       "would use more than %s of memory", sz);
-    }
+    if (bytes > I->max_memory || used + bytes > I->max_memory)
+      memory_error(I, pos, "would ");
   }
 }
 
@@ -680,16 +688,18 @@ void eval_restore(Interp *I, int nforcing) {
   }
 }
 
+static _Noreturn COLD void patsel_error(Interp *I, Pat *pat, Value *whole) {
+  char buf[200];
+  val_brief(force(I, whole), buf, sizeof buf);
+  qcs_error(pat->pos, "the pattern does not match the value %s", buf);
+}
+
 static Value *force_patsel(Interp *I, Value *v) {
   Pat *pat = v->u.patsel.pat;
   Sym *var = v->u.patsel.var;
   Value *whole = v->u.patsel.whole;
   Env *tmp = env_new(NULL, 4);
-  if (!match(I, pat, whole, tmp)) {
-    char buf[200];
-    val_brief(force(I, whole), buf, sizeof buf);
-    qcs_error(pat->pos, "the pattern does not match the value %s", buf);
-  }
+  if (!match(I, pat, whole, tmp)) patsel_error(I, pat, whole);
   for (int i = 0; i < tmp->n; i++)
     if (tmp->names[i] == var) return force(I, tmp->vals[i]);
   qcs_error(pat->pos, "internal error: pattern variable lost");
@@ -765,7 +775,7 @@ Value *force(Interp *I, Value *v) {
 
 /* ---- checked forcing ---- */
 
-static _Noreturn void type_error(Interp *I, Value *v, Pos pos, const char *want,
+static _Noreturn COLD void type_error(Interp *I, Value *v, Pos pos, const char *want,
                                  const char *what) {
   char buf[160];
   val_brief(v, buf, sizeof buf);
@@ -1183,12 +1193,53 @@ static Env *match_simple(Interp *I, Clause *cl, int simple, Env *env,
    of the size it needs. */
 #define MATCH_SCRATCH 16
 
+/* A clause's patterns matched in general (match_simple handles the
+   common ones): its frame, or NULL when it does not match. A function of
+   its own, so that its scratch arrays are not holes in select_clause's
+   frame (see COLD); the values' array starts zeroed for the same reason. */
+static __attribute__((noinline)) Env *match_general(Interp *I, Clause *cl,
+                                                    Env *env, Value **args) {
+  Sym *snames[MATCH_SCRATCH];
+  Value *svals[MATCH_SCRATCH] = {0};
+  Env *frame;
+  Env scratch = {env, 0, MATCH_SCRATCH, snames, svals};
+  int ok = 1;
+  for (int i = 0; i < cl->npats && ok; i++)
+    ok = match(I, cl->pats[i], args[i], &scratch);
+  if (!ok) return NULL;
+  int n = scratch.n;
+  if (cl->nwhere == 0 && n > 0) {
+    /* as match_simple's: a match that succeeds binds the same names
+       in the same order every time, kept once in the clause */
+    if (!cl->frame_names) {
+      Sym **names = GC_MALLOC(sizeof(Sym *) * (size_t)n);
+      memcpy(names, scratch.names, sizeof(Sym *) * (size_t)n);
+      cl->frame_names = names;
+    }
+    frame = val_small(sizeof(Env) + sizeof(Value *) * (size_t)n);
+    frame->up = env;
+    frame->n = frame->cap = n;
+    frame->names = cl->frame_names;
+    frame->vals = (Value **)(frame + 1);
+    for (int i = 0; i < n; i++) frame->vals[i] = scratch.vals[i];
+  } else {
+    frame = env_new(env, n + cl->nwhere);
+    for (int i = 0; i < n; i++) {
+      frame->names[i] = scratch.names[i];
+      frame->vals[i] = scratch.vals[i];
+    }
+    frame->n = n;
+  }
+  return frame;
+}
+
+static _Noreturn COLD void no_clause_error(Interp *I, Def *d, Value **args,
+                                           Pos pos);
+
 /* Choose the clause of d that matches args and the body whose guard holds;
    returns the body and its environment for the caller to evaluate. */
 static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
                            Pos pos, Env **out_env) {
-  Sym *snames[MATCH_SCRATCH];
-  Value *svals[MATCH_SCRATCH];
   for (int c = 0; c < d->nclauses; c++) {
     Clause *cl = d->clauses[c];
     Env *frame;
@@ -1221,34 +1272,8 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
       frame = match_simple(I, cl, simple, env, args);
       if (!frame) continue;
     } else {
-      Env scratch = {env, 0, MATCH_SCRATCH, snames, svals};
-      int ok = 1;
-      for (int i = 0; i < cl->npats && ok; i++)
-        ok = match(I, cl->pats[i], args[i], &scratch);
-      if (!ok) continue;
-      int n = scratch.n;
-      if (cl->nwhere == 0 && n > 0) {
-        /* as match_simple's: a match that succeeds binds the same names
-           in the same order every time, kept once in the clause */
-        if (!cl->frame_names) {
-          Sym **names = GC_MALLOC(sizeof(Sym *) * (size_t)n);
-          memcpy(names, scratch.names, sizeof(Sym *) * (size_t)n);
-          cl->frame_names = names;
-        }
-        frame = val_small(sizeof(Env) + sizeof(Value *) * (size_t)n);
-        frame->up = env;
-        frame->n = frame->cap = n;
-        frame->names = cl->frame_names;
-        frame->vals = (Value **)(frame + 1);
-        for (int i = 0; i < n; i++) frame->vals[i] = scratch.vals[i];
-      } else {
-        frame = env_new(env, n + cl->nwhere);
-        for (int i = 0; i < n; i++) {
-          frame->names[i] = scratch.names[i];
-          frame->vals[i] = scratch.vals[i];
-        }
-        frame->n = n;
-      }
+      frame = match_general(I, cl, env, args);
+      if (!frame) continue;
     }
     if (cl->nwhere) bind_defs(I, cl->nwhere, cl->where, frame);
     for (int b = 0; b < cl->nbodies; b++) {
@@ -1262,6 +1287,11 @@ static Expr *select_clause(Interp *I, Def *d, Env *env, Value **args,
       }
     }
   }
+  no_clause_error(I, d, args, pos);
+}
+
+static _Noreturn COLD void no_clause_error(Interp *I, Def *d, Value **args,
+                                           Pos pos) {
   char buf[400];
   brief_args(I, d->arity, args, buf, sizeof buf);
   if (d->name && !strcmp(d->name->name, "case"))
@@ -1307,6 +1337,24 @@ static int after_minus(Pos pos) {
   return 0;
 }
 
+static _Noreturn COLD void not_function_error(Value *f, int n, Pos pos,
+                                              const char *over_name,
+                                              int over_arity) {
+  char buf[160];
+  val_brief(f, buf, sizeof buf);
+  if (over_name)
+    qcs_error(pos, "%s takes %d argument%s, but it is given %d (its "
+              "result, %s, is not a function: %s)", over_name, over_arity,
+              over_arity == 1 ? "" : "s", over_arity + n, val_describe(f),
+              buf);
+  qcs_error(pos, "%s is not a function, but it is applied to %d "
+            "argument%s: %s%s", val_describe(f), n, n == 1 ? "" : "s", buf,
+            f->kind == V_NUM && after_minus(pos)
+                ? " (a negative argument goes in parentheses: "
+                  "f (-1), not f -1)"
+                : "");
+}
+
 /* Apply f to n arguments. Returns 1 with (*body, *benv) set when the result
    is a function body to evaluate in tail position, or 0 with *result. */
 static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
@@ -1327,21 +1375,8 @@ static int call(Interp *I, Value *f, int n, Value **args, Pos pos,
       f = f->u.pap.fn;
       continue;
     }
-    if (f->kind != V_FUNC) {
-      char buf[160];
-      val_brief(f, buf, sizeof buf);
-      if (over_name)
-        qcs_error(pos, "%s takes %d argument%s, but it is given %d (its "
-                  "result, %s, is not a function: %s)", over_name, over_arity,
-                  over_arity == 1 ? "" : "s", over_arity + n, val_describe(f),
-                  buf);
-      qcs_error(pos, "%s is not a function, but it is applied to %d "
-                "argument%s: %s%s", val_describe(f), n, n == 1 ? "" : "s", buf,
-                f->kind == V_NUM && after_minus(pos)
-                    ? " (a negative argument goes in parentheses: "
-                      "f (-1), not f -1)"
-                    : "");
-    }
+    if (f->kind != V_FUNC)
+      not_function_error(f, n, pos, over_name, over_arity);
     int a = f->u.fn.arity;
     if (n < a) {
       Value *p = val_cell();
@@ -1598,6 +1633,22 @@ static int values_equal(Interp *I, Value *a, Value *b, Pos pos) {
   }
 }
 
+/* fmt names v's kind (%s), then shows it briefly (%s) */
+static _Noreturn COLD void brief_error(Value *v, Pos pos, const char *fmt) {
+  char b[120];
+  val_brief(v, b, sizeof b);
+  qcs_error(pos, fmt, val_describe(v), b);
+}
+
+static _Noreturn COLD void compare_error(Value *a, Value *b, Pos pos,
+                                         TokKind op) {
+  char ba[120], bb[120];
+  val_brief(a, ba, sizeof ba);
+  val_brief(b, bb, sizeof bb);
+  qcs_error(pos, "'%s' compares two Reals or two Strings, not %s (%s) and %s "
+            "(%s)", op_text(op), val_describe(a), ba, val_describe(b), bb);
+}
+
 static int compare(Interp *I, Value *a, Value *b, Pos pos, TokKind op) {
   a = force(I, a);
   b = force(I, b);
@@ -1605,11 +1656,7 @@ static int compare(Interp *I, Value *a, Value *b, Pos pos, TokKind op) {
     return a->u.num < b->u.num ? -1 : a->u.num > b->u.num ? 1 : 0;
   if (a->kind == V_STR && b->kind == V_STR)
     return strcmp(eval_str_chars(I, a, pos), eval_str_chars(I, b, pos));
-  char ba[120], bb[120];
-  val_brief(a, ba, sizeof ba);
-  val_brief(b, bb, sizeof bb);
-  qcs_error(pos, "'%s' compares two Reals or two Strings, not %s (%s) and %s "
-            "(%s)", op_text(op), val_describe(a), ba, val_describe(b), bb);
+  compare_error(a, b, pos, op);
 }
 
 static Value *append(Interp *I, Value *a, Value *b, Pos pos);
@@ -1662,11 +1709,8 @@ static Value *index_list(Interp *I, Value *xs, Value *nv, Pos pos) {
   if (n < 0 || n != floor(n))
     qcs_error(pos, "'!!' needs a whole index >= 0, not %.17g", n);
   Value *v = force(I, xs);
-  if (v->kind != V_CONS && v->kind != V_NIL) {
-    char b[120];
-    val_brief(v, b, sizeof b);
-    qcs_error(pos, "'!!' indexes a list, not %s: %s", val_describe(v), b);
-  }
+  if (v->kind != V_CONS && v->kind != V_NIL)
+    brief_error(v, pos, "'!!' indexes a list, not %s: %s");
   for (double i = 0; i < n; i++) {
     if (v->kind != V_CONS) break;
     eval_check(I, pos);
@@ -1963,10 +2007,7 @@ Value *eval(Interp *I, Expr *e, Env *env) {
       } else if (x->kind == V_TUPLE) {
         result = vec_scale(I, T_STAR, x, val_num(-1), 1, e->pos);
       } else {
-        char b[120];
-        val_brief(x, b, sizeof b);
-        qcs_error(e->pos, "unary '-' needs a Real or a tuple, not %s (%s)",
-                  val_describe(x), b);
+        brief_error(x, e->pos, "unary '-' needs a Real or a tuple, not %s (%s)");
       }
       goto done;
     }
