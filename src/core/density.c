@@ -166,6 +166,113 @@ double dt_max(const dt_tape *t) {
   return t->hi;
 }
 
+/* dt_envelope: a stack of subtrees, each with its range (leaves in
+ * [0, 1]), whether it has an envelope, and that envelope's leaves at
+ * env[start .. start + n): a later subtree's leaves lie after an earlier
+ * one's, so combining the top two moves the second's next to the first. */
+int dt_envelope(const dt_tape *t, int *env) {
+  struct { double lo, hi; int ok, start, n; } st[DT_STACK_MAX];
+  int sp = 0, top = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF || in->op == DT_CONST) {
+      if (sp == DT_STACK_MAX) return 0;
+      int leaf = in->op == DT_LEAF;
+      st[sp].lo = leaf ? 0 : in->c;
+      st[sp].hi = leaf ? 1 : in->c;
+      st[sp].ok = leaf;
+      st[sp].start = top;
+      st[sp].n = leaf;
+      if (leaf) env[top++] = in->arg;
+      sp++;
+      continue;
+    }
+    if (sp < 2) return 0;
+    sp--;
+    int xi = sp - 1, ok = 0, keep_x = 0, keep_y = 0;
+    double lo, hi;
+    double xl = st[xi].lo, xh = st[xi].hi, yl = st[sp].lo, yh = st[sp].hi;
+    dt_range_op(in->op, xl, xh, yl, yh, &lo, &hi);
+    switch (in->op) {
+    case DT_PRODUCT:
+      if (xl >= 0 && yl >= 0) {
+        keep_x = st[xi].ok && (st[sp].ok || yh <= 1);
+        keep_y = st[sp].ok && (st[xi].ok || xh <= 1);
+        ok = keep_x || keep_y;
+      }
+      break;
+    case DT_DIFF:   /* x - y <= x when y >= 0 */
+      ok = keep_x = st[xi].ok && yl >= 0;
+      break;
+    case DT_RDIFF:  /* y - x <= y when x >= 0 */
+      ok = keep_y = st[sp].ok && xl >= 0;
+      break;
+    default:        /* Sum, Union: no log-concave envelope */
+      break;
+    }
+    int start = st[xi].start, n = 0;
+    if (keep_x) n = st[xi].n;
+    if (keep_y) {
+      memmove(env + start + n, env + st[sp].start,
+              sizeof *env * (size_t)st[sp].n);
+      n += st[sp].n;
+    }
+    st[xi].lo = lo;
+    st[xi].hi = hi;
+    st[xi].ok = ok;
+    st[xi].start = start;
+    st[xi].n = ok ? n : 0;
+    top = start + st[xi].n;
+  }
+  return sp == 1 && st[0].ok ? st[0].n : 0;
+}
+
+/* -(log rho)'(a) = 3 (1 + a) / ((1 - a) (2 + a)) inside the filter,
+ * rising from 0 at a = -1 to infinity at a = 1 (rho log-concave). */
+static double env_slope(double a) {
+  if (a <= -1) return 0;
+  if (a >= 1) return INFINITY;
+  return 3 * (1 + a) / ((1 - a) * (2 + a));
+}
+
+int dt_envelope_clear(const dt_tape *t, const int *env, int n,
+                      const double o[3], const double d[3]) {
+  const double u = DBL_EPSILON;   /* twice the unit roundoff: generous */
+  double e0 = 1, slope = 0, mag = 0;
+  for (int k = 0; k < n; k++) {
+    const dt_leaf *lf = &t->leaves[env[k]];
+    double dist = dt_leaf_dist(lf, o), nd = vec3_dot(lf->n, d);
+    /* |error| of each: 3 products and 2 sums (one more for -d) */
+    double edist = 4 * u * (fabs(lf->n[0] * o[0]) + fabs(lf->n[1] * o[1]) +
+                            fabs(lf->n[2] * o[2]) + fabs(lf->d)) + DBL_MIN;
+    double end = 4 * u * (fabs(lf->n[0] * d[0]) + fabs(lf->n[1] * d[1]) +
+                          fabs(lf->n[2] * d[2])) + DBL_MIN;
+    if (!(isfinite(dist) && isfinite(nd))) return 0;
+    if (lf->r <= 0) {                  /* a sharp step: 1, 0.5 or 0 */
+      if (dist > edist && nd >= end) return 1;   /* 0 all along the ray */
+      if (dist < -edist) continue;     /* 1 here: a tangent of slope 0 */
+      return 0;
+    }
+    double a = dist * lf->inv_r, b = nd * lf->inv_r;
+    double ea = edist * lf->inv_r * (1 + 2 * u) + 2 * u * fabs(a);
+    double eb = end * lf->inv_r * (1 + 2 * u) + 2 * u * fabs(b);
+    double alo = a - ea, ahi = a + ea, blo = b - eb;
+    if (alo >= 1 && blo >= 0) return 1;  /* 0 here and from here on */
+    if (ahi >= 1) return 0;              /* near 0: log E has no tangent */
+    /* rho falls as a rises: its value at alo bounds E's factor above */
+    e0 *= dt_halfspace_a(alo) * (1 + 8 * u);
+    /* the factor's part of -(log E)' along the ray, c b with c in
+       [env_slope(alo), env_slope(ahi)] and b in [blo, bhi]: its least */
+    double clo = env_slope(alo) * (1 - 8 * u), chi = env_slope(ahi) * (1 + 8 * u);
+    double term = blo >= 0 ? clo * blo : chi * blo;
+    if (!isfinite(term)) return 0;
+    slope += term;
+    mag += fabs(term);
+  }
+  /* E(o) < 0.5 and -(log E)' >= 0 at s = 0, after the sum's rounding */
+  return e0 * (1 + 2 * n * u) < 0.5 && slope - 2 * (n + 1) * u * mag >= 0;
+}
+
 /* Apply a binary op to stack values x (below) and y (top). */
 static double apply(int op, double x, double y) {
   switch (op) {

@@ -162,6 +162,30 @@ static inline void dt_range_op(int op, double xl, double xh, double yl,
   }
 }
 
+/* A log-concave envelope of the density (beyond the paper): a product E
+ * of some of t's leaves with density <= E everywhere.  A smoothed
+ * halfspace is log-concave in x (its kernel integrates the log-concave
+ * 3/4 (1 - a^2): Prekopa), and so is a product of them; a Difference
+ * x - y with y >= 0 is at most x, and a Product of non-negative factors
+ * at most the product of their envelopes (a factor in [0, 1] without
+ * one may be dropped).  A Sum or Union has none.  Writes the leaves'
+ * indices to env (room for t->nleaves) and returns how many, or 0 when
+ * the tree has no such envelope.  Rounded convex polyhedra have their
+ * own density as envelope; figure13's cube with a notch has the cube's. */
+int dt_envelope(const dt_tape *t, int *env);
+
+/* Whether the ray o + s*d, s >= 0, provably stays where the envelope E
+ * (dt_envelope's n leaves env of t) is below 0.5, and so never enters
+ * the solid (density > 0.5): E(o) < 0.5 and E does not grow at s = 0
+ * (then, log E being concave along the ray, it never grows), or some
+ * factor is 0 at o and the ray moves away from its plane.  Every
+ * quantity is bounded with its rounding (the leaves' distances, the
+ * kernel, the sums), so a 1 is a proof; 0 means only "not shown" (a
+ * ray grazing or entering, or precision too poor to tell).  Used for a
+ * shadow ray leaving the surface it starts on (render.c). */
+int dt_envelope_clear(const dt_tape *t, const int *env, int n,
+                      const double o[3], const double d[3]);
+
 /* Figure 4: the density at point p. */
 double dt_density(const dt_tape *t, const double p[3]);
 

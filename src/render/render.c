@@ -329,6 +329,13 @@ typedef struct Tracer {
   int grid;                   /* n of the n x n samples */
   atomic_int oom;             /* a worker ran out of memory: all stop */
   int tiled;                  /* per-tile culling and pruning (TileCull) */
+  /* Per primitive, a rounded one's log-concave envelope (dt_envelope):
+     env_n[i] leaves at env_leaf[env_start[i] ..], 0 for none; NULL when
+     QCS_ENVELOPE=0 or no primitive has one.  A shadow ray leaving the
+     surface of its own primitive is first tried against it
+     (dt_envelope_clear): a proof that it never re-enters spares the
+     search. */
+  int *env_n, *env_start, *env_leaf;
   double tile_pad;            /* how far a searched point may stray from
                                  a box it was bounded by (scene units) */
   Box *rbox;                  /* per scene node: a rounded node's outer
@@ -917,7 +924,8 @@ static inline int halfspace_hit(const ScNode *n, int node, int pi,
 
 /* The first surface crossing of one primitive in (t0, t1); with any != 0
    (a shadow ray) a rounded primitive may report any t in (t0, t1] when
-   there is a crossing, and none when there is none. */
+   there is a crossing, and none when there is none; any == 2 says the
+   ray starts on this primitive's surface. */
 static inline __attribute__((always_inline)) int
 prim_hit(const Tracer *T, int pi, const double o[3],
                     const double d[3], double t0, double t1, RayCtx *c,
@@ -929,6 +937,11 @@ prim_hit(const Tracer *T, int pi, const double o[3],
   case SC_HALFSPACE:
     return halfspace_hit(n, node, pi, o, d, t0, t1, h);
   case SC_ROUNDED: {
+    /* any == 2: a shadow ray from this primitive's own surface */
+    if (any == 2 && T->env_n && T->env_n[pi] &&
+        dt_envelope_clear(n->tape, T->env_leaf + T->env_start[pi],
+                          T->env_n[pi], o, d))
+      return 0;
     lg_root roots[8];
     double tol = ray_dist_tol(c, o, d);
     long unsplit = c->stats.lg.overflows;
@@ -995,7 +1008,7 @@ prim_hit(const Tracer *T, int pi, const double o[3],
 static inline __attribute__((always_inline)) int
 trace(const Tracer *T, const double o[3], const double d[3],
                  double t0, double t1, RayCtx *c, Hit *best, int any,
-                 const TileCull *tc) {
+                 const TileCull *tc, int self) {
   int found = 0;
   c->tapes = tc ? tc->tape : NULL;
   for (int i = 0; i < T->nunbounded; i++) {
@@ -1004,7 +1017,8 @@ trace(const Tracer *T, const double o[3], const double d[3],
     const ScNode *n = &T->s->nodes[node];
     if (n->kind == SC_HALFSPACE
             ? halfspace_hit(n, node, pi, o, d, t0, t1, &h)
-            : prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
+            : prim_hit(T, pi, o, d, t0, t1, c, &h,
+                       any && pi == self ? 2 : any)) {
       *best = h;
       t1 = h.t;
       found = 1;
@@ -1020,7 +1034,7 @@ trace(const Tracer *T, const double o[3], const double d[3],
     double e2;
     Hit h;
     if (slab_hit(pb->lo, pb->hi, &rs, t0, t1, &e2) &&
-        prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
+        prim_hit(T, pi, o, d, t0, t1, c, &h, any && pi == self ? 2 : any)) {
       *best = h;
       found = 1;
     }
@@ -1042,7 +1056,7 @@ trace(const Tracer *T, const double o[3], const double d[3],
         double e2;
         if (!slab_hit(pb->lo, pb->hi, &rs, t0, t1, &e2)) continue;
         Hit h;
-        if (prim_hit(T, pi, o, d, t0, t1, c, &h, any)) {
+        if (prim_hit(T, pi, o, d, t0, t1, c, &h, any && pi == self ? 2 : any)) {
           *best = h;
           t1 = h.t;
           found = 1;
@@ -1106,7 +1120,7 @@ primary_hit(Worker *W, const double o[3], const double d[3], Hit *h,
   RayCtx *c = W->c;
   long evals0 = c->stats.lg.evals;
   W->primary++;
-  if (!trace(T, o, d, 0, INFINITY, c, h, 0, tc)) return 0;
+  if (!trace(T, o, d, 0, INFINITY, c, h, 0, tc, -1)) return 0;
   W->hits++;
   if (T->s->nodes[h->id].kind == SC_ROUNDED) {
     W->rounded_hits++;
@@ -1160,7 +1174,8 @@ static inline void shade_hit(Worker *W, const double o[3], const double d[3],
       for (int i = 0; i < 3; i++) so[i] = p[i] + eps * n[i];
       Hit shh;
       W->shadow++;
-      if (trace(T, so, L, 0, dist, c, &shh, 1, sh ? sh[l] : NULL)) continue;
+      if (trace(T, so, L, 0, dist, c, &shh, 1, sh ? sh[l] : NULL, hp->prim))
+        continue;
     }
     double H[3] = {L[0] - d[0], L[1] - d[1], L[2] - d[2]};
     double hl = sqrt(vec3_dot(H, H));
@@ -1409,6 +1424,33 @@ static int tiles_setup(Tracer *T) {
   return 0;
 }
 
+/* Each rounded primitive's envelope (Tracer.env_n), unless the
+   environment says QCS_ENVELOPE=0. 0, or -1 without memory. */
+static int envelopes_setup(Tracer *T) {
+  const char *e = getenv("QCS_ENVELOPE");
+  if (e && !strcmp(e, "0")) return 0;
+  const Scene *s = T->s;
+  size_t total = 0;
+  for (int i = 0; i < T->nprims; i++) {
+    const ScNode *n = &s->nodes[T->prims[i].node];
+    if (n->kind == SC_ROUNDED) total += (size_t)n->tape->nleaves;
+  }
+  if (!total) return 0;
+  T->env_n = calloc((size_t)T->nprims, sizeof *T->env_n);
+  T->env_start = calloc((size_t)T->nprims, sizeof *T->env_start);
+  T->env_leaf = malloc(sizeof *T->env_leaf * total);
+  if (!T->env_n || !T->env_start || !T->env_leaf) return -1;
+  int m = 0;
+  for (int i = 0; i < T->nprims; i++) {
+    const ScNode *n = &s->nodes[T->prims[i].node];
+    if (n->kind != SC_ROUNDED) continue;
+    T->env_start[i] = m;
+    T->env_n[i] = dt_envelope(n->tape, T->env_leaf + m);
+    m += T->env_n[i];
+  }
+  return 0;
+}
+
 void render_defaults(RenderSettings *rs) {
   memset(rs, 0, sizeof *rs);
   rs->width = 600;
@@ -1620,6 +1662,7 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
   if (T.nbounded && build_bvh(&T)) goto oom;
   if (setup_camera(&T, err, errlen)) goto fail;
   if (tiles_setup(&T)) goto oom;
+  if (envelopes_setup(&T)) goto oom;
   im = img_new(cx1 - cx0, cy1 - cy0, rs->aovs);
   if (!im) goto oom;
   im->x0 = cx0;
@@ -1716,6 +1759,9 @@ done:
   free(T.rbox);
   free(T.prim_r);
   free(T.prim_r0);
+  free(T.env_n);
+  free(T.env_start);
+  free(T.env_leaf);
   bvh_free(&T.bvh);
   pthread_mutex_destroy(&T.lock);
   return im;

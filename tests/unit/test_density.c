@@ -591,6 +591,212 @@ static void test_prune_class(void) {
         bad_same == 0 && same_said > 100);
 }
 
+
+/* dt_envelope and dt_envelope_clear (the shadow ray's self-test, render.c).
+ * The reference is the tape's own leaves (its doubles n, d and inv_r, the
+ * density the tracer defines) evaluated in MPFR with the cap formula, the
+ * tree walked from the tape's code: a claim "clear" must leave the solid's
+ * density at or below 0.5 at every point of the ray tried, exactly. */
+static double ref_tape_ray(const dt_tape *t, const double o[3],
+                           const double dir[3], double s) {
+  mpfr_t st[DT_STACK_MAX], p[3], dist, a, tmp;
+  for (int i = 0; i < DT_STACK_MAX; i++) mpfr_init2(st[i], REF_PREC);
+  mpfr_inits2(REF_PREC, p[0], p[1], p[2], dist, a, tmp, (mpfr_ptr)0);
+  for (int i = 0; i < 3; i++) {
+    mpfr_set_d(tmp, dir[i], MPFR_RNDN);
+    mpfr_mul_d(tmp, tmp, s, MPFR_RNDN);
+    mpfr_add_d(p[i], tmp, o[i], MPFR_RNDN);
+  }
+  int sp = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      const dt_leaf *lf = &t->leaves[in->arg];
+      mpfr_set_zero(dist, 1);
+      for (int k = 0; k < 3; k++) {
+        mpfr_set_d(tmp, lf->n[k], MPFR_RNDN);
+        mpfr_fma(dist, tmp, p[k], dist, MPFR_RNDN);
+      }
+      mpfr_sub_d(dist, dist, lf->d, MPFR_RNDN);
+      if (lf->r <= 0) {
+        int c = mpfr_sgn(dist);
+        mpfr_set_d(st[sp], c < 0 ? 1.0 : (c > 0 ? 0.0 : 0.5), MPFR_RNDN);
+      } else {
+        /* the cap fraction in a = dist * inv_r: h/r = 1 - a */
+        mpfr_mul_d(a, dist, lf->inv_r, MPFR_RNDN);
+        mpfr_ui_sub(tmp, 1, a, MPFR_RNDN);            /* h/r */
+        if (mpfr_sgn(tmp) <= 0) mpfr_set_zero(st[sp], 1);
+        else if (mpfr_cmp_ui(tmp, 2) >= 0) mpfr_set_ui(st[sp], 1, MPFR_RNDN);
+        else {                        /* (h/r)^2 (3 - h/r) / 4 */
+          mpfr_ui_sub(a, 3, tmp, MPFR_RNDN);
+          mpfr_mul(a, a, tmp, MPFR_RNDN);
+          mpfr_mul(a, a, tmp, MPFR_RNDN);
+          mpfr_div_ui(st[sp], a, 4, MPFR_RNDN);
+        }
+      }
+      sp++;
+    } else {
+      sp--;
+      mpfr_ptr x = st[sp - 1], y = st[sp];
+      switch (in->op) {
+      case DT_SUM: mpfr_add(x, x, y, MPFR_RNDN); break;
+      case DT_PRODUCT: mpfr_mul(x, x, y, MPFR_RNDN); break;
+      case DT_DIFF: mpfr_sub(x, x, y, MPFR_RNDN); break;
+      case DT_RDIFF: mpfr_sub(x, y, x, MPFR_RNDN); break;
+      default:
+        mpfr_mul(tmp, x, y, MPFR_RNDN);
+        mpfr_add(x, x, y, MPFR_RNDN);
+        mpfr_sub(x, x, tmp, MPFR_RNDN);
+      }
+    }
+  }
+  /* the sign of rho - 0.5, exactly: +1 inside, 0 on, -1 outside */
+  double r = (double)mpfr_cmp_d(st[0], 0.5);
+  for (int i = 0; i < DT_STACK_MAX; i++) mpfr_clear(st[i]);
+  mpfr_clears(p[0], p[1], p[2], dist, a, tmp, (mpfr_ptr)0);
+  return r;
+}
+
+static void test_envelope(void) {
+  /* what dt_envelope keeps: a box's six leaves; a box minus a box, the
+     first box's; none for a sum, a union, or a product with a factor
+     that may exceed 1 or go negative */
+  static const double lo1[3] = {0, 0, 0}, hi1[3] = {1, 1, 1};
+  static const double lo2[3] = {0.25, 0.8, 0.25}, hi2[3] = {0.75, 1.3, 0.75};
+  static const double lo3[3] = {0.5, 0, 0}, hi3[3] = {2, 1, 1};
+  double r6[6] = {0.1, 0.1, 0.1, 0.1, 0.1, 0.1};
+  struct { int op2, op3, want; const char *name; } kinds[] = {
+    {-1, -1, 6, "a box: its six leaves"},
+    {R_DIFF, -1, 6, "a box minus a box: the first box's six"},
+    {R_SUM, -1, 0, "a sum: none"},
+    {R_UNION, -1, 0, "a union: none"},
+    {R_PROD, -1, 12, "a product of boxes: all twelve"},
+    {R_PROD, R_SUM, 0, "a product with a sum (up to 2): none"},
+    {R_PROD, R_DIFF, 0, "a product with a difference (down to -1): none"},
+    {R_DIFF, R_PROD, 6, "a box minus a product: the first box's six"},
+  };
+  for (size_t k = 0; k < sizeof kinds / sizeof *kinds; k++) {
+    rtree t = {.n = 0};
+    int a = rt_box(&t, lo1, hi1, r6), root = a;
+    if (kinds[k].op2 >= 0) {
+      int b = rt_box(&t, lo2, hi2, r6);
+      if (kinds[k].op3 >= 0) b = rt_op(&t, kinds[k].op3, b, rt_box(&t, lo3, hi3, r6));
+      root = rt_op(&t, kinds[k].op2, a, b);
+    }
+    dt_tape *tp = rt_tape(&t, root);
+    int env[64];
+    int n = dt_envelope(tp, env);
+    /* the leaves kept are the first box's (planes at 0 or 1) unless all */
+    int first_box = 1;
+    for (int i = 0; i < n; i++) {
+      const dt_leaf *lf = &tp->leaves[env[i]];
+      double off = fabs(lf->d);
+      if (!(off == 0 || off == 1)) first_box = 0;
+    }
+    char name[160];
+    snprintf(name, sizeof name, "envelope of %s (%d)", kinds[k].name, n);
+    CHECK(name, n == kinds[k].want && (n == 12 || first_box));
+    dt_tape_free(tp);
+  }
+
+  /* soundness on random objects: a rounded convex polytope, a box with a
+     notch (a difference), far from the origin and with stiff radii; the
+     ray starts just outside a surface point, in a random direction */
+  rng_t g = {20261127};
+  int tried = 0, clear = 0, bad = 0, entering = 0, entering_clear = 0;
+  for (int it = 0; it < 1500; it++) {
+    rtree t = {.n = 0};
+    double scale = pow(10, rng_range(&g, -2, 2));
+    double off = (it % 3 == 0) ? pow(10, rng_range(&g, 0, 6)) : 0;
+    double rr = scale * pow(10, rng_range(&g, -6, -0.5));
+    int kind = (int)(rng_u64(&g) % 3), root = -1;
+    double c[3] = {off, -off * 0.5, off * 0.25};
+    if (kind < 2) {
+      double lo[3], hi[3], r[6];
+      for (int j = 0; j < 3; j++) {
+        lo[j] = c[j] - scale * rng_range(&g, 0.3, 1);
+        hi[j] = c[j] + scale * rng_range(&g, 0.3, 1);
+      }
+      for (int j = 0; j < 6; j++) r[j] = rr * rng_range(&g, 0.5, 2);
+      root = rt_box(&t, lo, hi, r);
+      if (kind == 1) {   /* a notch through the top */
+        double nlo[3] = {c[0] - 0.2 * scale, hi[1] - 0.3 * scale, c[2] - 0.2 * scale};
+        double nhi[3] = {c[0] + 0.2 * scale, hi[1] + 0.3 * scale, c[2] + 0.2 * scale};
+        root = rt_op(&t, R_DIFF, root, rt_box(&t, nlo, nhi, r));
+      }
+    } else {             /* 5 to 9 random planes around c */
+      int np = 5 + (int)(rng_u64(&g) % 5);
+      for (int j = 0; j < np; j++) {
+        double n[3];
+        for (int q = 0; q < 3; q++) n[q] = rng_range(&g, -1, 1);
+        if (j < 3) { n[0] = n[1] = n[2] = 0; n[j] = 1; }
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        double d = (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / len +
+                   scale * rng_range(&g, 0.4, 1);
+        for (int q = 0; q < 3; q++) n[q] /= len;
+        int l = rt_leaf(&t, n[0], n[1], n[2], d, rr * rng_range(&g, 0.5, 2));
+        root = root < 0 ? l : rt_op(&t, R_PROD, root, l);
+      }
+      /* close it below: -n for the first three */
+      for (int j = 0; j < 3; j++) {
+        double n[3] = {0, 0, 0};
+        n[j] = -1;
+        int l = rt_leaf(&t, n[0], n[1], n[2], -c[j] + scale * 0.5, rr);
+        root = rt_op(&t, R_PROD, root, l);
+      }
+    }
+    dt_tape *tp = rt_tape(&t, root);
+    int env[64], n = dt_envelope(tp, env);
+    if (n == 0) { dt_tape_free(tp); continue; }
+    /* a surface point: bisection on the exact sign along a random line
+       from the centre (inside) outwards */
+    double u[3];
+    for (int q = 0; q < 3; q++) u[q] = rng_range(&g, -1, 1);
+    double ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int q = 0; q < 3; q++) u[q] /= ul;
+    if (ref_tape_ray(tp, c, u, 0) <= 0) { dt_tape_free(tp); continue; }
+    double s0 = 0, s1 = 4 * scale;
+    if (ref_tape_ray(tp, c, u, s1) > 0) { dt_tape_free(tp); continue; }
+    for (int k = 0; k < 80; k++) {
+      double m = 0.5 * (s0 + s1);
+      if (ref_tape_ray(tp, c, u, m) > 0) s0 = m; else s1 = m;
+    }
+    /* just outside: s1, moved further by up to 1e-6 of the scale, or in
+       one case of five by half to twice the scale (past every filter of
+       the planes it is outside of: their factors are 0 there) */
+    double o[3];
+    double push = it % 5 == 1 ? scale * rng_range(&g, 0.5, 2)
+                              : scale * pow(10, rng_range(&g, -14, -6));
+    for (int q = 0; q < 3; q++) o[q] = c[q] + (s1 + push) * u[q];
+    double d[3];
+    int aim = it % 4 == 0 || it % 20 == 1;   /* some aimed at the centre */
+    for (int q = 0; q < 3; q++)
+      d[q] = aim ? c[q] - o[q] : rng_range(&g, -1, 1);
+    double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int q = 0; q < 3; q++) d[q] /= dl;
+    int says = dt_envelope_clear(tp, env, n, o, d);
+    tried++;
+    clear += says;
+    /* the ray, densely: near its start on a log scale, then to 6 scales */
+    int inside = 0;
+    for (int k = 0; k <= 60 && !inside; k++) {
+      double sk = k < 30 ? scale * pow(10, -15 + 0.5 * k) : 6 * scale * (k - 29) / 31.0;
+      inside = ref_tape_ray(tp, o, d, sk) > 0;
+    }
+    if (aim) entering += inside, entering_clear += inside && says;
+    if (says && inside) bad++;
+    dt_tape_free(tp);
+  }
+  printf("# envelope: %d rays from surfaces, %d proven clear, %d of them "
+         "entering the solid; %d aimed rays entering, %d called clear\n",
+         tried, clear, bad, entering, entering_clear);
+  CHECK("envelope: no ray called clear enters the solid (MPFR)", bad == 0);
+  CHECK("envelope: a ray aimed into the solid is never called clear",
+        entering > 100 && entering_clear == 0);
+  CHECK("envelope: most rays leaving a surface are proven clear",
+        clear > tried / 4);
+}
+
 int main(void) {
   check_prefix = "density";
   test_paper_values();
@@ -605,5 +811,6 @@ int main(void) {
   test_deep_chain();
   test_prune();
   test_prune_class();
+  test_envelope();
   CHECK_DONE();
 }

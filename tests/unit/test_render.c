@@ -249,16 +249,20 @@ static void tolerance_test(void) {
 typedef struct TileCase {
   int width, height, spp, threads;
   int renders, same, counts_same;
-  long primary;
+  long primary, spared;
 } TileCase;
+
+/* The switch the two renders differ by: QCS_TILES, or QCS_ENVELOPE for
+   the shadow rays' envelope test (envelope_examples_test). */
+static const char *toggle = "QCS_TILES";
 
 static Image *render_tiles(const struct Scene *s, const RenderSettings *rs,
                            int tiled, RenderReport *rep, char *err,
                            size_t errlen) {
-  if (tiled) unsetenv("QCS_TILES");
-  else setenv("QCS_TILES", "0", 1);
+  if (tiled) unsetenv(toggle);
+  else setenv(toggle, "0", 1);
   Image *im = render_scene(s, rs, rep, NULL, err, errlen);
-  unsetenv("QCS_TILES");
+  unsetenv(toggle);
   return im;
 }
 
@@ -292,6 +296,18 @@ static int tiles_capture(void *ctx, const struct Scene *s,
                ra.segments == rb.segments && ra.steps == rb.steps &&
                ra.soft_solves == rb.soft_solves &&
                ra.max_ray_work == rb.max_ray_work;
+  if (strcmp(toggle, "QCS_TILES")) {
+    /* the envelope spares searches: the same rays and hits, no more
+       work, and (tc->spared) how much less; the cost AOV counts it */
+    counts = ra.primary == rb.primary && ra.shadow == rb.shadow &&
+             ra.hits == rb.hits && rb.evals <= ra.evals &&
+             rb.segments <= ra.segments;
+    same = a->width == b->width && a->height == b->height &&
+           !memcmp(a->rgba, b->rgba, n * 4 * sizeof(float)) &&
+           !memcmp(a->z, b->z, n * sizeof(float)) &&
+           !memcmp(a->n, b->n, n * 3 * sizeof(float));
+    tc->spared += ra.segments - rb.segments;
+  }
   if (getenv("QCS_TEST_VERBOSE"))
     printf("# tiles: %d same %d counts %d primary %ld shadow %ld evals %ld/%ld\n",
            tc->renders, same, counts, ra.primary, ra.shadow, ra.evals, rb.evals);
@@ -326,7 +342,7 @@ static void tiles_examples_test(void) {
        with 3 x 3 samples a pixel */
     for (int spp = 1; spp <= 9; spp += 8) {
       if (spp > 1 && i > 0) break;
-      TileCase tc = {150, 95, spp, 2, 0, 0, 0, 0};
+      TileCase tc = {150, 95, spp, 2, 0, 0, 0, 0, 0};
       tiles_run(&tc, ex, NULL);
       snprintf(name, sizeof name, "tiles: %s (%d spp) tiled = untiled, "
                "bit for bit", scenes[i], spp);
@@ -337,6 +353,30 @@ static void tiles_examples_test(void) {
       CHECK(name, tc.renders >= 1 && tc.counts_same == tc.renders);
     }
   }
+}
+
+/* The shadow rays' envelope test (render.c, dt_envelope_clear) against
+   the full search (QCS_ENVELOPE=0): the same pixels, depths and normals,
+   bit for bit, the same rays and hits, and no more root-search work; on
+   figure15a (one rounded cuboid, every self-test provable) it must spare
+   some. A clear the envelope gave wrongly would light a shadowed pixel. */
+static void envelope_examples_test(void) {
+  static const char *const scenes[] = {"figure12", "figure13", "figure15a",
+                                       "figure15b", "staplers", "mould"};
+  toggle = "QCS_ENVELOPE";
+  for (size_t i = 0; i < sizeof scenes / sizeof *scenes; i++) {
+    char ex[256], name[300];
+    snprintf(ex, sizeof ex, "examples/%s.qcs", scenes[i]);
+    TileCase tc = {150, 95, 1, 2, 0, 0, 0, 0, 0};
+    tiles_run(&tc, ex, NULL);
+    snprintf(name, sizeof name, "envelope: %s the same picture, rays and "
+             "hits with and without it, no more work (%ld segments spared)",
+             scenes[i], tc.spared);
+    CHECK(name, tc.renders >= 1 && tc.same == tc.renders &&
+                    tc.counts_same == tc.renders &&
+                    (strcmp(scenes[i], "figure15a") || tc.spared > 0));
+  }
+  toggle = "QCS_TILES";
 }
 
 /* xorshift64*: the random scenes' numbers in [0, 1) */
@@ -394,7 +434,7 @@ static void tiles_random_test(void) {
                           urand() - 0.5, urand(), urand() - 0.5, 20 + 50 * urand(),
                           12 * urand() - 6, 4 + 6 * urand(), 12 * urand() - 6);
     TileCase tc = {61 + (int)(40 * urand()), 37 + (int)(30 * urand()),
-                   urand() < 0.3 ? 4 : 1, 2, 0, 0, 0, 0};
+                   urand() < 0.3 ? 4 : 1, 2, 0, 0, 0, 0, 0};
     tiles_run(&tc, NULL, src);
     if (tc.renders == 1) ran++;
     if (tc.renders == 1 && tc.same == 1) ok++;
@@ -438,6 +478,7 @@ int main(void) {
     tolerance_test();
     determinism_test();
     tiles_examples_test();
+    envelope_examples_test();
     tiles_random_test();
     interrupt_test();
   }
