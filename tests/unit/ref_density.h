@@ -128,6 +128,20 @@ static inline void ref_dist(mpfr_t s, const rnode *x, mpfr_t p[3]) {
   mpfr_clears(len, tmp, (mpfr_ptr)0);
 }
 
+/* out = a op b for the ops R_SUM .. R_UNION (out may be a; tmp is
+ * scratch), in MPFR. */
+static inline void ref_op(mpfr_t out, int op, mpfr_t a, mpfr_t b, mpfr_t tmp) {
+  switch (op) {
+  case R_SUM: mpfr_add(out, a, b, MPFR_RNDN); break;
+  case R_PROD: mpfr_mul(out, a, b, MPFR_RNDN); break;
+  case R_DIFF: mpfr_sub(out, a, b, MPFR_RNDN); break;
+  default:
+    mpfr_mul(tmp, a, b, MPFR_RNDN);
+    mpfr_add(out, a, b, MPFR_RNDN);
+    mpfr_sub(out, out, tmp, MPFR_RNDN);
+  }
+}
+
 static inline void ref_eval(mpfr_t out, const rtree *t, int i, mpfr_t p[3]) {
   const rnode *x = &t->nodes[i];
   if (x->op == R_LEAF) {
@@ -142,15 +156,7 @@ static inline void ref_eval(mpfr_t out, const rtree *t, int i, mpfr_t p[3]) {
   mpfr_inits2(REF_PREC, a, b, ab, (mpfr_ptr)0);
   ref_eval(a, t, x->a, p);
   ref_eval(b, t, x->b, p);
-  switch (x->op) {
-  case R_SUM: mpfr_add(out, a, b, MPFR_RNDN); break;
-  case R_PROD: mpfr_mul(out, a, b, MPFR_RNDN); break;
-  case R_DIFF: mpfr_sub(out, a, b, MPFR_RNDN); break;
-  default:
-    mpfr_mul(ab, a, b, MPFR_RNDN);
-    mpfr_add(out, a, b, MPFR_RNDN);
-    mpfr_sub(out, out, ab, MPFR_RNDN);
-  }
+  ref_op(out, x->op, a, b, ab);
   mpfr_clears(a, b, ab, (mpfr_ptr)0);
 }
 

@@ -637,17 +637,11 @@ static double ref_tape_ray(const dt_tape *t, const double o[3],
       sp++;
     } else {
       sp--;
-      mpfr_ptr x = st[sp - 1], y = st[sp];
-      switch (in->op) {
-      case DT_SUM: mpfr_add(x, x, y, MPFR_RNDN); break;
-      case DT_PRODUCT: mpfr_mul(x, x, y, MPFR_RNDN); break;
-      case DT_DIFF: mpfr_sub(x, x, y, MPFR_RNDN); break;
-      case DT_RDIFF: mpfr_sub(x, y, x, MPFR_RNDN); break;
-      default:
-        mpfr_mul(tmp, x, y, MPFR_RNDN);
-        mpfr_add(x, x, y, MPFR_RNDN);
-        mpfr_sub(x, x, tmp, MPFR_RNDN);
-      }
+      /* the tape's ops as the reference tree's (y - x: a swap) */
+      int op = in->op == DT_SUM ? R_SUM : in->op == DT_PRODUCT ? R_PROD
+             : in->op == DT_DIFF || in->op == DT_RDIFF ? R_DIFF : R_UNION;
+      if (in->op == DT_RDIFF) ref_op(st[sp - 1], op, st[sp], st[sp - 1], tmp);
+      else ref_op(st[sp - 1], op, st[sp - 1], st[sp], tmp);
     }
   }
   /* the sign of rho - 0.5, exactly: +1 inside, 0 on, -1 outside */
