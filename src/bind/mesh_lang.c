@@ -51,6 +51,25 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           "%.2g of the surface); measured %.3g (the largest distance to "
           "the surface along the normal or an axis from %d points of the triangles)\n", r->certified, e, r->vtol,
           r->measured, r->samples);
+  if (r->cover_unproven)
+    fprintf(f, "  surface to mesh: NOT proven within %.4g of the mesh in %ld "
+            "cells, where a part or gap thinner than the cells may be lost or "
+            "closed (the first near (%.6g, %.6g, %.6g)); every other part "
+            "proven within it", e, r->cover_unproven, r->cover_at[0],
+            r->cover_at[1], r->cover_at[2]);
+  else
+    fprintf(f, "  surface to mesh: every part proven within %.4g of the mesh",
+            r->cover);
+  fprintf(f, " (%ld boxes, %.2f s", r->cover_boxes, r->cover_seconds);
+  if (r->cover_rounds)
+    fprintf(f, "; meshed %d more time%s, %ld cells split where it was not "
+            "proven%s", r->cover_rounds, r->cover_rounds == 1 ? "" : "s",
+            r->cover_split, r->cover_kept
+            ? "; the last of them was not kept (it proved no more, or "
+              "changed the components or Euler characteristic, as opening "
+              "a gap narrowing to nothing in places does)"
+            : "");
+  fprintf(f, ")\n");
   fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",
           r->crossings - r->bisected, r->bisected);
 }

@@ -2,6 +2,7 @@
    exact (sharp) tetrahedra, the checks and the writers (see mesh.h). */
 #include "render/mesh.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -15,6 +16,7 @@
 #include "core/vec.h"
 #include "render/image.h"
 #include "render/mesh_check.h"
+#include "render/mesh_cover.h"
 #include "render/render.h"
 #include "scene/ray.h"
 
@@ -22,6 +24,11 @@
 /* Cells where two surfaces, each one sheet, are not proven one sheet
    together split this many levels below the finest at most (walk). */
 #define TWO_LEVELS 2
+/* Rounds of splitting the cells where the surface is not proven within
+   the tolerance of the mesh (mesh_rounds). */
+#define COVER_ROUNDS 4
+/* mesh_run's answer: mesh again (cover_check split cells) */
+#define MESH_RECOVER 100
 
 /* ---- a hash map from 64-bit keys to ints ------------------------------ */
 
@@ -193,8 +200,10 @@ static int same_surface(const Scene *s, int a, int b) {
    (every operation has a constant operand), not constant (the node is
    undecided), so its 0.5 level is where the leaf is 0.5: its plane. */
 static int node_plane(const Scene *s, int x, const double lo[3],
-                      const double hi[3], const double **n, double *d) {
+                      const double hi[3], const double **n, double *d,
+                      int *side) {
   const ScNode *nd = &s->nodes[x];
+  *side = 1;
   if (nd->kind == SC_HALFSPACE) {
     *n = nd->n;
     *d = nd->d;
@@ -220,25 +229,35 @@ static int node_plane(const Scene *s, int x, const double lo[3],
   if (seen != 1 || vl != 0.5 || vh != 0.5) return 0;
   *n = t->leaves[live].n;
   *d = t->leaves[live].d;
+  /* the density is affine in the leaf, 0.5 where it is 0.5: inside is
+     where the leaf is above 0.5 (n . x < d) if it rises with the leaf */
+  dt_range_box_fix(t, lo, hi, live, 0.75, &vl, &vh);
+  *side = vl > 0.5 ? 1 : vh < 0.5 ? -1 : 0;
   return 1;
 }
 
 /* Nodes a and b (not both halfspaces: same_surface has them) have one
-   plane for their surface over [lo, hi] (node_plane), either side. */
+   plane for their surface over [lo, hi] (node_plane), either side: 1 if
+   their insides are on one side of it, 2 if on opposite sides (they
+   complement each other over the box), 3 if that is not known; else 0. */
 static int same_plane_box(const Scene *s, int a, int b, const double lo[3],
                           const double hi[3]) {
   const double *na, *nb;
   double da, db;
+  int sa, sb;
   if (s->nodes[a].kind == SC_HALFSPACE && s->nodes[b].kind == SC_HALFSPACE)
     return 0;
-  if (!node_plane(s, a, lo, hi, &na, &da) || !node_plane(s, b, lo, hi, &nb, &db))
+  if (!node_plane(s, a, lo, hi, &na, &da, &sa) ||
+      !node_plane(s, b, lo, hi, &nb, &db, &sb))
     return 0;
   int same = 1, opp = 1;
   for (int i = 0; i < 3; i++) {
     same &= na[i] == nb[i];
     opp &= na[i] == -nb[i];
   }
-  return (same && da == db) || (opp && da == -db);
+  if (!((same && da == db) || (opp && da == -db))) return 0;
+  if (!sa || !sb) return 3;
+  return (sa == sb) == same ? 1 : 2; /* b's side in a's frame */
 }
 
 /* A set operation on classes. T_ONE (undecided, but the solid in the box
@@ -248,7 +267,10 @@ static int same_plane_box(const Scene *s, int a, int b, const double lo[3],
    (same_plane_box: a rounded node with one live leaf, a halfspace) count
    as the same surface, as two halfspaces on one plane do: a rounded box
    resting flush on another is then one surface there (none, or the
-   plane), not two sheets facing each other. */
+   plane), not two sheets facing each other. With flush 2 (the cover
+   proof's), two such nodes whose insides complement each other over the
+   box decide it: their union is full there, their intersection empty,
+   the difference a - b is a. */
 static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
                   int *o, const double *lo, const double *hi, int flush) {
   int ra, rb; /* the classes that decide alone */
@@ -278,8 +300,15 @@ static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
     *o = ob;
     return b;
   }
-  if (a == T_ONE && b == T_ONE &&
-      (same_surface(s, oa, ob) || (flush && same_plane_box(s, oa, ob, lo, hi)))) {
+  int sp = a == T_ONE && b == T_ONE && !same_surface(s, oa, ob) && flush
+               ? same_plane_box(s, oa, ob, lo, hi)
+               : 0;
+  if (sp == 2 && flush == 2 && k != SC_DIFF) return k == SC_UNION ? T_IN : T_OUT;
+  if (sp == 2 && flush == 2) {
+    *o = oa;
+    return T_ONE;
+  }
+  if (a == T_ONE && b == T_ONE && (same_surface(s, oa, ob) || sp)) {
     *o = oa;
     return T_ONE;
   }
@@ -598,6 +627,10 @@ typedef struct {
   size_t nleaves, capleaves;
   size_t max_cells;
   hmap split;              /* (level, cell) -> 1 for every split cell */
+  hmap *force;             /* (level, cell) -> 1 for cells that must split:
+                              the surface in them was not proven within
+                              the tolerance of the mesh (cover_check) */
+  hmap two_near;           /* near_two's table */
   hmap pt;                 /* point (doubled finest coordinates) -> index */
   uint32_t *pc;            /* its coordinates */
   unsigned char *ps;       /* its sign: 1 inside */
@@ -1108,6 +1141,11 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
       m->err = MESH_ETHIN;
       return -1;
     } else m->rep->thin++;
+  }
+  if (leaf && level < m->depth && m->force->n &&
+      hget(m->force, ckey(level, i, j, k)) >= 0) {
+    leaf = 0;
+    m->rep->cover_split++;
   }
   if (leaf) {
     if (level > m->rep->deepest) m->rep->deepest = level;
@@ -2095,10 +2133,10 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
   /* with no cell split below the finest level, a finest cell's faces
      are plain (no smaller neighbour) */
   if (count)
-    lf->plain = (unsigned char)(l == m->depth || (l == m->fine && !m->rep->thin) ||
+    lf->plain = (unsigned char)(l == m->depth || (l == m->fine && !m->rep->thin && !m->rep->cover_split) ||
                                 plain_cell(m, l, q));
   if (lf->plain) {
-    if (count && l < m->depth && !(l == m->fine && !m->rep->thin) &&
+    if (count && l < m->depth && !(l == m->fine && !m->rep->thin && !m->rep->cover_split) &&
         plain_points(m, l, q) < 0)
       return -1;
   } else {
@@ -2322,12 +2360,154 @@ static int self_check(const Mesh *me, MeshReport *rep, char *err,
   return -1;
 }
 
+/* The cover proof's classifier (mesh_cover.h): 0 when the closed box is
+   proven wholly outside or inside the clipped solid, as walk does. */
+typedef struct {
+  const Mesher *m;
+  unsigned char *st;
+  int *one;
+} CoverCtx;
+
+static int cover_class(void *ctx, const double lo[3], const double hi[3]) {
+  CoverCtx *c = ctx;
+  const Mesher *m = c->m;
+  int clip_in = 1, one;
+  for (int a = 0; a < 3; a++) {
+    if (hi[a] <= m->clo[a] || lo[a] >= m->chi[a]) return 0;
+    if (lo[a] <= m->clo[a] || hi[a] >= m->chi[a]) clip_in = 0;
+  }
+  int k = scene_box_g(m->s, m->node, lo, hi, c->st, c->one, &one, 2);
+  return !(k == T_OUT || (k == T_IN && clip_in));
+}
+
+/* Whether leaf lf lies within one finest cell of a leaf with two
+   surfaces not proven one sheet together (Leaf.two): 1 or 0. op 0 makes
+   the table (finest cells holding such a leaf), op 2 frees it; -1 out of
+   memory. */
+static int near_two(Mesher *m, const Leaf *lf, int op) {
+  hmap *tw = &m->two_near;
+  if (op == 2) {
+    hfree(tw);
+    memset(tw, 0, sizeof *tw);
+    return 0;
+  }
+  if (op == 0) {
+    hfree(tw);
+    memset(tw, 0, sizeof *tw);
+    for (size_t l = 0; l < m->nleaves; l++) {
+      const Leaf *t = &m->leaves[l];
+      if (!t->two) continue;
+      int sh = t->level - m->fine; /* the finest cell holding it */
+      uint64_t q[3];
+      for (int a = 0; a < 3; a++) q[a] = sh >= 0 ? t->q[a] >> sh : t->q[a] << -sh;
+      if (hput(tw, ckey(m->fine, q[0], q[1], q[2]), 1) < 0) return -1;
+    }
+    return 0;
+  }
+  if (!tw->n) return 0;
+  int sh = lf->level - m->fine;
+  int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; a++) {
+    lo[a] = sh >= 0 ? (int64_t)(lf->q[a] >> sh) : (int64_t)lf->q[a] << -sh;
+    hi[a] = sh >= 0 ? lo[a] : lo[a] + ((int64_t)1 << -sh) - 1;
+  }
+  int64_t n = (int64_t)1 << m->fine;
+  for (int64_t i = lo[0] - 1; i <= hi[0] + 1; i++)
+    for (int64_t j = lo[1] - 1; j <= hi[1] + 1; j++)
+      for (int64_t k = lo[2] - 1; k <= hi[2] + 1; k++)
+        if (i >= 0 && j >= 0 && k >= 0 && i < n && j < n && k < n &&
+            hget(tw, ckey(m->fine, (uint64_t)i, (uint64_t)j, (uint64_t)k)) >= 0)
+          return 1;
+  return 0;
+}
+
+/* Every part of the surface within the tolerance of the mesh: proven by
+   construction in plane and sharp cells (the mesh there is the surface),
+   and by mesh_cover over the smooth and finest cells. 0, or -1 out of
+   memory. */
+static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
+  size_t n = 0;
+  for (size_t l = 0; l < m->nleaves; l++)
+    n += m->leaves[l].kind == LEAF_FINE || m->leaves[l].kind == LEAF_SMOOTH;
+  if (!n) return 0;
+  double *bx = malloc(6 * n * sizeof *bx);
+  size_t *ix = malloc(n * sizeof *ix);
+  unsigned char *bad = malloc(n);
+  size_t nsub = (size_t)(m->node - m->s->nodes[m->node].first + 1);
+  int rc = -1;
+  CoverCtx cc[2] = {{m, malloc(nsub), malloc(nsub * sizeof(int))},
+                    {m, malloc(nsub), malloc(nsub * sizeof(int))}};
+  void *ctx[2] = {&cc[0], &cc[1]};
+  if (!bx || !ix || !bad || !cc[0].st || !cc[0].one || !cc[1].st || !cc[1].one)
+    goto done;
+  n = 0;
+  for (size_t l = 0; l < m->nleaves; l++) {
+    const Leaf *lf = &m->leaves[l];
+    if (lf->kind != LEAF_FINE && lf->kind != LEAF_SMOOTH) continue;
+    ix[n] = l;
+    double side = ldexp(m->h, m->depth - lf->level);
+    for (size_t a = 0; a < 3; a++) {
+      bx[6 * n + a] = m->org[a] + side * lf->q[a];
+      bx[6 * n + 3 + a] = m->org[a] + side * (lf->q[a] + 1);
+    }
+    n++;
+  }
+  double scale = 0;
+  for (size_t i = 0; i < 3 * me->nv; i++) scale = fmax(scale, fabs(me->v[i]));
+  MeshCover mc;
+  /* a computed distance is a distance to a convex combination of the
+     vertices, computed to a few ulps of the coordinates */
+  if (mesh_cover(me, bx, n, m->tol, 0x1p-40 * scale, cover_class, ctx, 2, bad,
+                 &mc) < 0)
+    goto done;
+  rep->cover = mc.bound;
+  rep->cover_boxes += mc.boxes;
+  rep->cover_unproven = mc.unproven;
+  memcpy(rep->cover_at, mc.at, sizeof mc.at);
+  rep->cover_seconds += mc.seconds;
+  /* the cells not proven split in the next round, where they can and
+     are not beside a cell holding two surfaces not proven one sheet
+     together: those are refine_two's, taken in clusters (splitting some
+     cells of a groove narrowing to nothing and not the others opens it
+     in places and closes it between, which makes tunnels: figure12's
+     obj5 had Euler characteristic -4 instead of 2 that way) */
+  rep->cover_more = 0;
+  if (mc.unproven && near_two(m, NULL, 0) < 0) goto done;
+  for (size_t i = 0; i < n; i++) {
+    const Leaf *lf = &m->leaves[ix[i]];
+    if (!bad[i] || lf->level >= m->depth) continue;
+    int nt = near_two(m, lf, 1);
+    if (nt < 0) goto done;
+    if (nt) continue;
+    if (hput(m->force, ckey(lf->level, lf->q[0], lf->q[1], lf->q[2]), 1) < 0)
+      goto done;
+    rep->cover_more++;
+  }
+  near_two(m, NULL, 2);
+  rc = 0;
+done:
+  free(bx);
+  free(ix);
+  free(bad);
+  for (int t = 0; t < 2; t++) {
+    free(cc[t].st);
+    free(cc[t].one);
+  }
+  return rc;
+}
+
 static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
                     Mesh **out, MeshReport *rep, int *bad_node, char *err,
-                    size_t errlen, int sharp) {
+                    size_t errlen, int sharp, hmap *force) {
   struct timespec t0, t1;
   clock_gettime(CLOCK_MONOTONIC, &t0);
+  MeshReport keep = *rep;
   memset(rep, 0, sizeof *rep);
+  /* what the rounds before spent on the proof */
+  rep->cover_rounds = keep.cover_rounds;
+  rep->cover_last = keep.cover_last;
+  rep->cover_boxes = keep.cover_boxes;
+  rep->cover_seconds = keep.cover_seconds;
   *out = NULL;
   *bad_node = -1;
   double lo[3], hi[3];
@@ -2391,6 +2571,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.tol = e;
   m.vtol = vtol;
   m.sharp = sharp && !ms->uniform;
+  m.force = force;
   m.uniform = ms->uniform;
   m.rep = rep;
   m.max_cells = ms->max_cells ? ms->max_cells : (size_t)1 << 24;
@@ -2579,11 +2760,19 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     mesh_free(me);
     goto done;
   }
+  if (cover_check(&m, me, rep) < 0) {
+    mesh_free(me);
+    rc = MESH_ENOMEM;
+    goto done;
+  }
   rep->vertices = me->nv;
   rep->triangles = me->nt;
   rep->measured = measured_error(&m, me, 2 * fmax(rep->certified, e), 1000,
                                  &rep->samples);
   *out = me;
+  /* mesh again with the cells not proven split (mesh_rounds decides
+     which mesh is kept) */
+  if (rep->cover_more && !rep->cover_last) rc = MESH_RECOVER;
 done:
   if (rc == MESH_ENOMEM) snprintf(err, errlen, "out of memory while meshing");
   free(m.st);
@@ -2607,6 +2796,7 @@ done:
   free(m.fl);
   free(m.ft);
   hfree(&m.split);
+  hfree(&m.two_near);
   hfree(&m.crease);
   free(m.poly);
   free(m.fpath.k);
@@ -3119,9 +3309,74 @@ int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
   return rc;
 }
 
+/* mesh_run, again while the proof that the surface is within the
+   tolerance of the mesh finds cells it cannot prove, those cells split
+   (cover_check; at most COVER_ROUNDS times). */
+static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
+                       Mesh **out, MeshReport *rep, int *bad_node, char *err,
+                       size_t errlen, int sharp, hmap *force) {
+  double t = 0;
+  int rc;
+  Mesh *prev = NULL;
+  MeshReport prep;
+  MeshCheck pck = {0};
+  for (;;) {
+    rep->cover_last = rep->cover_rounds >= COVER_ROUNDS;
+    rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, sharp, force);
+    t += rep->seconds;
+    if (prev) {
+      /* a round is kept only when it proved more of the surface and left
+         the mesh's components and Euler characteristic as they were:
+         splitting some cells of a gap narrowing to nothing (under the
+         edge of a box resting flush on another) and not others opens it
+         in places and closes it between, a bubble or a tunnel (figure12's
+         obj5 at 0.01 had 2 components that way); then, or if the round
+         failed (a limit), the mesh before it is kept */
+      MeshCheck ck = {0};
+      int keep = rc == MESH_OK || rc == MESH_RECOVER;
+      if (keep && mesh_check(*out, &ck) == -2) {
+        mesh_free(*out);
+        *out = NULL;
+        mesh_free(prev);
+        return MESH_ENOMEM;
+      }
+      if (!keep || rep->cover_unproven >= prep.cover_unproven ||
+          ck.components != pck.components || ck.euler != pck.euler) {
+        mesh_free(*out);
+        *out = prev;
+        int rounds = rep->cover_rounds;
+        long boxes = rep->cover_boxes;
+        double cs = rep->cover_seconds;
+        *rep = prep;
+        rep->cover_rounds = rounds;
+        rep->cover_boxes = boxes;
+        rep->cover_seconds = cs;
+        rep->cover_kept = 1;
+        rc = MESH_OK;
+        break;
+      }
+      mesh_free(prev);
+      prev = NULL;
+    }
+    if (rc != MESH_RECOVER) break;
+    prev = *out;
+    *out = NULL;
+    prep = *rep;
+    if (mesh_check(prev, &pck) == -2) {
+      mesh_free(prev);
+      return MESH_ENOMEM;
+    }
+    rep->cover_rounds++;
+  }
+  rep->seconds = t;
+  return rc;
+}
+
 int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
                MeshReport *rep, int *bad_node, char *err, size_t errlen) {
-  int rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, 1);
+  hmap force = {0};
+  memset(rep, 0, sizeof *rep);
+  int rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 1, &force);
   if (rc == MESH_EINTERNAL || (rc == MESH_ESELF && rep->sharp)) {
     /* a degenerate case decided differently by two sharp cells, or a fan
        of a crease path reaching past its tetrahedron: the marching cells
@@ -3129,9 +3384,11 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
        tetrahedron */
     double t = rep->seconds;
     int why = rc == MESH_ESELF ? 2 : 1;
-    rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, 0);
+    rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 0, &force);
     rep->seconds += t;
     rep->sharp_off = why;
   }
+  hfree(&force);
+  if (rc == MESH_ENOMEM) snprintf(err, errlen, "out of memory while meshing");
   return rc;
 }

@@ -44,7 +44,10 @@
  * gradient bound in smooth cells, vtol plus the triangle's covering radius
  * in finest cells; the report gives the largest, and a measured error
  * (sample points to the surface along the normal or an axis). That every part of
- * the surface is near the mesh is proven in plane and sharp cells only.
+ * the surface is near the mesh is proven in plane and sharp cells by
+ * construction, and in the others after the mesh is made (mesh_cover.h);
+ * cells where that proof gives up are split and the object meshed again,
+ * a round kept only when it proves more and keeps the mesh's topology.
  * Closure is checked by edge counting before anything is returned, and
  * then self-intersection, exactly (mesh_check.h: every pair of triangles
  * whose boxes overlap, by exact orientation predicates); a failure of
@@ -117,6 +120,20 @@ typedef struct MeshReport {
                               triangle pairs tested exactly */
   long pairs_exact;        /* predicate signs decided in GMP */
   double check_seconds;    /* its time */
+  double cover;            /* every part of the surface proven within
+                              cover of the mesh (mesh_cover.h; 0 where no
+                              cell needs the proof) */
+  long cover_boxes;        /* boxes of the proof */
+  long cover_unproven;     /* cells where it failed in the last round */
+  double cover_at[3];      /* a place in the first */
+  double cover_seconds;    /* its time, over every round */
+  long cover_more;         /* cells of the last round split for the next */
+  int cover_rounds;        /* rounds meshed again with cells split */
+  long cover_split;        /* cells split for the proof in the last round */
+  int cover_last;          /* this round is the last (mesh.c, mesh_rounds) */
+  int cover_kept;          /* the last round was not kept (it proved no
+                              more, or changed the topology, or failed):
+                              the mesh is the round's before */
   double seconds;
 } MeshReport;
 
