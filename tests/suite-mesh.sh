@@ -12,12 +12,14 @@ cat > "$tmp/part.qcs" <<'Q'
 hole = Shift (0.25, -0.5, 0.25) (Scale (0.5, 2, 0.5) UnitCube);
 scene = Rounded 0.07 (Difference UnitCube hole);
 mesh "ring.obj" (SetDifference UnitCube hole)
-meshWith [Tolerance 0.03, Quiet] "soft.stl" (SoftObject 0.5 [Key (0, 0, 0) 1 1, Key (0.5, 0, 0) 0.5 (-1)])
+meshWith [Tolerance 0.03] "soft.stl" (SoftObject 0.5 [Key (0, 0, 0) 1 1, Key (0.5, 0, 0) 0.5 (-1)])
 Q
 if (cd "$tmp" && "$top/$QCS" part.qcs > out 2> err) && [ -s "$tmp/ring.obj" ] && [ -s "$tmp/soft.stl" ] &&
    grep -q "certified <=" "$tmp/err" &&
-   grep -q "checked: no self-intersections, [0-9]* triangle pairs tested exactly" "$tmp/err"; then
-  echo "ok mesh: mesh and meshWith write .obj and .stl with a report (the self-intersection check's line too)"
+   grep -q "checked: no self-intersections, [0-9]* triangle pairs tested exactly" "$tmp/err" &&
+   grep -q "surface to mesh: every part proven within 0.0001 of the mesh (0 boxes" "$tmp/err" &&
+   grep -q "surface to mesh: every part proven within 0.03 of the mesh ([1-9][0-9]* boxes" "$tmp/err"; then
+  echo "ok mesh: mesh and meshWith write .obj and .stl with a report (the self-intersection check's and the surface-to-mesh proof's lines too)"
 else echo "FAIL mesh: mesh/meshWith: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 if grep -q '^vn ' "$tmp/ring.obj" && grep -q '^f [0-9]*//[0-9]*' "$tmp/ring.obj"; then
   echo "ok mesh: .obj has vertex normals"; else echo "FAIL mesh: .obj without normals"; fi

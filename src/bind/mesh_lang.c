@@ -61,14 +61,16 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
     fprintf(f, "  surface to mesh: every part proven within %.4g of the mesh",
             r->cover);
   fprintf(f, " (%ld boxes, %.2f s", r->cover_boxes, r->cover_seconds);
-  if (r->cover_rounds)
+  if (r->cover_rounds && !r->cover_kept)
     fprintf(f, "; meshed %d more time%s, %ld cells split where it was not "
-            "proven%s", r->cover_rounds, r->cover_rounds == 1 ? "" : "s",
-            r->cover_split, r->cover_kept
-            ? "; the last of them was not kept (it proved no more, or "
-              "changed the components or Euler characteristic, as opening "
-              "a gap narrowing to nothing in places does)"
-            : "");
+            "proven", r->cover_rounds, r->cover_rounds == 1 ? "" : "s",
+            r->cover_split);
+  else if (r->cover_rounds)
+    fprintf(f, "; meshed %d more time%s with the cells not proven split "
+            "(%ld in the last), the last not kept: it proved no more, or "
+            "changed the components or Euler characteristic (a thin part "
+            "or gap opened in some cells and not beside them)",
+            r->cover_rounds, r->cover_rounds == 1 ? "" : "s", r->cover_split);
   fprintf(f, ")\n");
   fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",
           r->crossings - r->bisected, r->bisected);

@@ -2429,6 +2429,7 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
   size_t n = 0;
   for (size_t l = 0; l < m->nleaves; l++)
     n += m->leaves[l].kind == LEAF_FINE || m->leaves[l].kind == LEAF_SMOOTH;
+  rep->cover = m->vtol; /* plane and sharp cells: the mesh is the surface */
   if (!n) return 0;
   double *bx = malloc(6 * n * sizeof *bx);
   size_t *ix = malloc(n * sizeof *ix);
@@ -2460,7 +2461,7 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
   if (mesh_cover(me, bx, n, m->tol, 0x1p-40 * scale, cover_class, ctx, 2, bad,
                  &mc) < 0)
     goto done;
-  rep->cover = mc.bound;
+  rep->cover = fmax(mc.bound, m->vtol);
   rep->cover_boxes += mc.boxes;
   rep->cover_unproven = mc.unproven;
   memcpy(rep->cover_at, mc.at, sizeof mc.at);
@@ -3345,12 +3346,13 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
         mesh_free(*out);
         *out = prev;
         int rounds = rep->cover_rounds;
-        long boxes = rep->cover_boxes;
+        long boxes = rep->cover_boxes, split = rep->cover_split;
         double cs = rep->cover_seconds;
         *rep = prep;
         rep->cover_rounds = rounds;
         rep->cover_boxes = boxes;
         rep->cover_seconds = cs;
+        rep->cover_split = split;
         rep->cover_kept = 1;
         rc = MESH_OK;
         break;

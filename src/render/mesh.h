@@ -121,15 +121,17 @@ typedef struct MeshReport {
   long pairs_exact;        /* predicate signs decided in GMP */
   double check_seconds;    /* its time */
   double cover;            /* every part of the surface proven within
-                              cover of the mesh (mesh_cover.h; 0 where no
-                              cell needs the proof) */
+                              cover of the mesh (mesh_cover.h; vtol where
+                              no cell needs the proof: plane and sharp
+                              cells are the surface) */
   long cover_boxes;        /* boxes of the proof */
   long cover_unproven;     /* cells where it failed in the last round */
   double cover_at[3];      /* a place in the first */
   double cover_seconds;    /* its time, over every round */
   long cover_more;         /* cells of the last round split for the next */
   int cover_rounds;        /* rounds meshed again with cells split */
-  long cover_split;        /* cells split for the proof in the last round */
+  long cover_split;        /* cells split for the proof in the last round
+                              meshed (kept or not) */
   int cover_last;          /* this round is the last (mesh.c, mesh_rounds) */
   int cover_kept;          /* the last round was not kept (it proved no
                               more, or changed the topology, or failed):
