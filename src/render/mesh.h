@@ -45,9 +45,11 @@
  * in finest cells; the report gives the largest, and a measured error
  * (sample points to the surface along the normal or an axis). That every part of
  * the surface is near the mesh is proven in plane and sharp cells by
- * construction, and in the others after the mesh is made (mesh_cover.h);
- * cells where that proof gives up are split and the object meshed again,
- * a round kept only when it proves more and keeps the mesh's topology.
+ * construction, and in the finest cells and the smooth cells up to twice
+ * their side after the mesh is made (mesh_cover.h; wider smooth cells are
+ * counted, not proven); cells where that proof gives up, and the leaves
+ * beside them, are split and the object meshed again, a round kept only
+ * when it proves more and keeps the mesh's topology.
  * Closure is checked by edge counting before anything is returned, and
  * then self-intersection, exactly (mesh_check.h: every pair of triangles
  * whose boxes overlap, by exact orientation predicates); a failure of
@@ -126,6 +128,8 @@ typedef struct MeshReport {
                               cells are the surface) */
   long cover_boxes;        /* boxes of the proof */
   long cover_unproven;     /* cells where it failed in the last round */
+  long cover_skipped;      /* smooth cells too wide for it (mesh.c,
+                              cover_kind): not proven there */
   double cover_at[3];      /* a place in the first */
   double cover_seconds;    /* its time, over every round */
   long cover_more;         /* cells of the last round split for the next */

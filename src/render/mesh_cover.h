@@ -7,13 +7,14 @@
  * the proof recurses: a box whose centre has a triangle within e - r of it
  * (r the box's half diagonal) has every point within e of the mesh; a box
  * the classifier decides holds no surface; any other box is split into
- * eighths, down to a side of e / 16, where the proof gives up on it. The
- * nearest triangle comes from a bounding volume hierarchy built over the
- * triangles in their order (the mesher makes them cell by cell along the
- * octree's depth-first walk, so neighbours in the order are near in
- * space), and each distance is the exact point-triangle distance computed
- * in doubles, with margin added for its rounding. Boxes are taken by up to
- * two threads, each with its own classifier context.
+ * eighths, down to a side of e / 1024 (within a budget of boxes that
+ * grows with the given box's area over e^2), where the proof gives up on
+ * it. The nearest triangle comes from a bounding volume hierarchy over
+ * the triangles sorted by their centroids' Morton codes and split where
+ * the codes' highest differing bit turns on; each distance is to a point
+ * kept a convex combination of the triangle's vertices, with a margin
+ * added for its rounding. Boxes are taken by up to two threads, each
+ * with its own classifier context.
  *
  * Nothing here prints. The mesh and boxes are only read. */
 #ifndef QCS_MESH_COVER_H

@@ -1455,7 +1455,7 @@ static void property_scene(const char *name, int kind, const char *obj,
   int ok = closed && si == 0 && far == 0 && w <= tol && rep.certified <= tol &&
            rep.measured <= tol && (!strict || rep.cover_unproven == 0);
   st->good += ok;
-  if (!ok) printf("# %s\n", obj);
+  if (!ok || rep.cover_unproven) printf("# %s\n", obj);
   printf("# %s: %zu triangles (%ld plane, %ld smooth, %ld sharp cells%s; %ld "
          "with two surfaces not proven one sheet; certified %.5g, measured %.5g)\n",
          name, rep.triangles, rep.planar, rep.smooth, rep.sharp,
