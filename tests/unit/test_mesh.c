@@ -479,6 +479,31 @@ static double cover_place(const Scene *s, const Mesh *m, const MeshReport *rep,
   return worst;
 }
 
+/* meshWith [Uniform] stays the uniform grid where the cover proof gives
+   up (figure12's obj5: its flush contact's groove, closed): no round of
+   splitting, every surface cell at the finest level (before, the forced
+   cells split down to the octree's limit: obj5 at 0.015 ran for minutes). */
+static void cover_uniform(void) {
+  Scene *s = compile("Union (Rounded 0.07 UnitCube) (Rounded 0.07 (Shift "
+                     "(0.25, 1, 0.25) (Scale (0.5, 0.5, 0.5) UnitCube)))");
+  CHECK("cover, uniform: obj5 compiled", s != NULL);
+  if (!s) return;
+  MeshSettings ms = {0};
+  ms.tol = 0.02;
+  ms.uniform = 1;
+  Mesh *m = NULL;
+  MeshReport rep;
+  int bad;
+  char err[300], buf[300];
+  int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  snprintf(buf, sizeof buf, "cover, uniform: obj5 at 0.02 meshed (%ld cells not "
+           "proven, %d rounds, deepest level %d of %d)", rep.cover_unproven,
+           rep.cover_rounds, rep.deepest, rep.depth);
+  CHECK(buf, rc == 0 && rep.cover_rounds == 0 && rep.deepest == rep.depth);
+  mesh_free(m);
+  scene_free(s);
+}
+
 /* A soft object is meshed adaptively (soft_grad_box proves cells smooth
    above the finest level): far fewer triangles than the uniform grid at
    the same tolerance, and still within it both ways (triangle points by
@@ -1843,6 +1868,7 @@ int main(void) {
   one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
   predicates();
   cover_sphere();
+  cover_uniform();
   fast_pairs();
   hand_meshes();
   bad_input();
