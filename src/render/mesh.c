@@ -29,6 +29,10 @@
 #define COVER_ROUNDS 4
 /* Smooth cells up to 2^COVER_LEVELS finest sides get the cover proof. */
 #define COVER_LEVELS 1
+/* Failing cells within this many finest cells of a cell with two surfaces
+   not proven one sheet together are not split for the cover proof. */
+#define NEAR_TWO 2
+
 /* mesh_run's answer: mesh again (cover_check split cells) */
 #define MESH_RECOVER 100
 
@@ -2426,9 +2430,9 @@ static int near_two(Mesher *m, const Leaf *lf, int op) {
     hi[a] = sh >= 0 ? lo[a] : lo[a] + ((int64_t)1 << -sh) - 1;
   }
   int64_t n = (int64_t)1 << m->fine;
-  for (int64_t i = lo[0] - 1; i <= hi[0] + 1; i++)
-    for (int64_t j = lo[1] - 1; j <= hi[1] + 1; j++)
-      for (int64_t k = lo[2] - 1; k <= hi[2] + 1; k++)
+  for (int64_t i = lo[0] - NEAR_TWO; i <= hi[0] + NEAR_TWO; i++)
+    for (int64_t j = lo[1] - NEAR_TWO; j <= hi[1] + NEAR_TWO; j++)
+      for (int64_t k = lo[2] - NEAR_TWO; k <= hi[2] + NEAR_TWO; k++)
         if (i >= 0 && j >= 0 && k >= 0 && i < n && j < n && k < n &&
             hget(tw, ckey(m->fine, (uint64_t)i, (uint64_t)j, (uint64_t)k)) >= 0)
           return 1;
