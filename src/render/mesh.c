@@ -2423,12 +2423,8 @@ static int near_two(Mesher *m, const Leaf *lf, int op) {
     return 0;
   }
   if (!tw->n) return 0;
-  int sh = lf->level - m->fine;
   int64_t lo[3], hi[3];
-  for (int a = 0; a < 3; a++) {
-    lo[a] = sh >= 0 ? (int64_t)(lf->q[a] >> sh) : (int64_t)lf->q[a] << -sh;
-    hi[a] = sh >= 0 ? lo[a] : lo[a] + ((int64_t)1 << -sh) - 1;
-  }
+  fine_range(m, lf, lo, hi);
   int64_t n = (int64_t)1 << m->fine;
   for (int64_t i = lo[0] - NEAR_TWO; i <= hi[0] + NEAR_TWO; i++)
     for (int64_t j = lo[1] - NEAR_TWO; j <= hi[1] + NEAR_TWO; j++)

@@ -183,6 +183,27 @@ static long mesh_to_surface(const Scene *s, const Mesh *m, double e, int n) {
   return bad;
 }
 
+/* The farthest from the mesh (brute force) of the surface's crossings of
+   o + t d for t in (0, tmax), by the exact ray spans; -1 if none. */
+static double crossings_far(const Scene *s, const Mesh *m, RayCtx *c,
+                            const double o[3], const double d[3], double tmax) {
+  csg_span *sp;
+  ray_reset(c);
+  int n = ray_spans(s, s->root, o, d, 0, tmax, c, &sp);
+  double worst = -1;
+  for (int q = 0; q < n; q++)
+    for (int x = 0; x < 2; x++) {
+      double tt = x ? sp[q].t1 : sp[q].t0, p[3], best = 1e300;
+      if (!(tt > 0 && tt < tmax)) continue;
+      for (int j = 0; j < 3; j++) p[j] = o[j] + tt * d[j];
+      for (size_t i = 0; i < m->nt; i++)
+        best = fmin(best, d2_tri(p, m->v + 3 * m->t[3 * i], m->v + 3 * m->t[3 * i + 1],
+                                 m->v + 3 * m->t[3 * i + 2]));
+      worst = fmax(worst, sqrt(best));
+    }
+  return worst;
+}
+
 /* Surface points (crossings of random rays through the box) against the
    mesh: the largest distance found. */
 static double surface_to_mesh(const Scene *s, const Mesh *m, int nrays) {
@@ -199,21 +220,7 @@ static double surface_to_mesh(const Scene *s, const Mesh *m, int nrays) {
       t[j] = lo[j] + (hi[j] - lo[j]) * urand();
       d[j] = t[j] - o[j];
     }
-    csg_span *sp;
-    ray_reset(c);
-    int n = ray_spans(s, s->root, o, d, 0, 4, c, &sp);
-    for (int q = 0; q < n; q++)
-      for (int e = 0; e < 2; e++) {
-        double tt = e ? sp[q].t1 : sp[q].t0, p[3], best = 1e300;
-        if (!(tt > 0 && tt < 4)) continue;
-        for (int j = 0; j < 3; j++) p[j] = o[j] + tt * d[j];
-        for (size_t i = 0; i < m->nt; i++) {
-          double dd = d2_tri(p, m->v + 3 * m->t[3 * i], m->v + 3 * m->t[3 * i + 1],
-                             m->v + 3 * m->t[3 * i + 2]);
-          if (dd < best) best = dd;
-        }
-        if (sqrt(best) > worst) worst = sqrt(best);
-      }
+    worst = fmax(worst, crossings_far(s, m, c, o, d, 4));
   }
   ray_ctx_free(c);
   return worst;
@@ -461,19 +468,7 @@ static double cover_place(const Scene *s, const Mesh *m, const MeshReport *rep,
       d[j] *= 2 * e / l;
       o[j] = rep->cover_at[j] - 0.5 * d[j];
     }
-    csg_span *sp;
-    ray_reset(c);
-    int n = ray_spans(s, s->root, o, d, 0, 1, c, &sp);
-    for (int q = 0; q < n; q++)
-      for (int x = 0; x < 2; x++) {
-        double tt = x ? sp[q].t1 : sp[q].t0, p[3], best = 1e300;
-        if (!(tt > 0 && tt < 1)) continue;
-        for (int j = 0; j < 3; j++) p[j] = o[j] + tt * d[j];
-        for (size_t i = 0; i < m->nt; i++)
-          best = fmin(best, d2_tri(p, m->v + 3 * m->t[3 * i], m->v + 3 * m->t[3 * i + 1],
-                                   m->v + 3 * m->t[3 * i + 2]));
-        worst = fmax(worst, sqrt(best));
-      }
+    worst = fmax(worst, crossings_far(s, m, c, o, d, 1));
   }
   ray_ctx_free(c);
   return worst;
