@@ -57,17 +57,11 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "closed (the first near (%.6g, %.6g, %.6g)); every other part "
             "proven within it", e, r->cover_unproven, r->cover_at[0],
             r->cover_at[1], r->cover_at[2]);
-  else if (r->cover_skipped)
-    fprintf(f, "  surface to mesh: proven within %.4g of the mesh", r->cover);
   else
     fprintf(f, "  surface to mesh: every part proven within %.4g of the mesh",
             r->cover);
-  if (r->cover_skipped)
-    fprintf(f, " in every cell but the %ld smooth cells wider than two finest "
-            "cells (their triangles are within the certified bound; the "
-            "proof's boxes there would grow as their area over the tolerance "
-            "squared)", r->cover_skipped);
-  fprintf(f, " (%ld boxes, %.2f s", r->cover_boxes, r->cover_seconds);
+  fprintf(f, " (%ld smooth cells by %ld columns, the rest by %ld boxes; %.2f s",
+          r->cover_colcells, r->cover_columns, r->cover_boxes, r->cover_seconds);
   if (r->cover_rounds && !r->cover_kept)
     fprintf(f, "; meshed %d more time%s, %ld cells split where it was not "
             "proven", r->cover_rounds, r->cover_rounds == 1 ? "" : "s",

@@ -27,8 +27,6 @@
 /* Rounds of splitting the cells where the surface is not proven within
    the tolerance of the mesh (mesh_rounds). */
 #define COVER_ROUNDS 4
-/* Smooth cells up to 2^COVER_LEVELS finest sides get the cover proof. */
-#define COVER_LEVELS 1
 /* Failing cells within this many finest cells of a cell with two surfaces
    not proven one sheet together are not split for the cover proof. */
 #define NEAR_TWO 2
@@ -2373,6 +2371,7 @@ typedef struct {
   const Mesher *m;
   unsigned char *st;
   int *one;
+  GrIv *gst;               /* gr_tape's scratch */
 } CoverCtx;
 
 static int cover_class(void *ctx, const double lo[3], const double hi[3]) {
@@ -2385,6 +2384,84 @@ static int cover_class(void *ctx, const double lo[3], const double hi[3]) {
   }
   int k = scene_box_g(m->s, m->node, lo, hi, c->st, c->one, &one, 2);
   return !(k == T_OUT || (k == T_IN && clip_in));
+}
+
+/* The column proof's field (mesh_cover.h, MeshField): node x's density
+   or soft field less its level. */
+static double field_value(void *ctx, int x, const double p[3]) {
+  const ScNode *nd = &((CoverCtx *)ctx)->m->s->nodes[x];
+  if (nd->kind == SC_ROUNDED) return dt_density(nd->tape, p) - 0.5;
+  return soft_field(nd->soft, p) - soft_magic(nd->soft);
+}
+
+static void field_range(void *ctx, int x, const double lo[3],
+                        const double hi[3], double *l, double *h) {
+  const ScNode *nd = &((CoverCtx *)ctx)->m->s->nodes[x];
+  double fl, fh, lv = 0.5;
+  if (nd->kind == SC_ROUNDED) dt_range_box(nd->tape, lo, hi, &fl, &fh);
+  else {
+    soft_field_box(nd->soft, lo, hi, &fl, &fh);
+    lv = soft_magic(nd->soft);
+  }
+  *l = fl - lv;
+  *h = fh - lv;
+}
+
+/* Over [lo, hi]: with u, grad . u >= gmin, |grad across u| <= wperp,
+   |grad . u| <= gmax; without, g0 the middle of the gradient's bound.
+   A rounded node's gradient is sum_k c_k n_k (gr_tape: c_k in an
+   interval per leaf); a soft object's, per-axis intervals. */
+static int field_grad(void *ctx, int x, const double lo[3], const double hi[3],
+                      const double *u, double *gmin, double *wperp,
+                      double *gmax, double g0[3]) {
+  CoverCtx *c = ctx;
+  const ScNode *nd = &c->m->s->nodes[x];
+  double mid[3] = {0, 0, 0}, rad = 0, al = 0, ah = 0;
+  if (nd->kind == SC_ROUNDED) {
+    const GrIv *r = gr_tape(nd->tape, lo, hi, c->gst);
+    if (!r || r->n == 0) return -1;
+    for (int i = 0; i < r->n; i++) {
+      if (r->step[i]) return -1;
+      const double *n = nd->tape->leaves[r->leaf[i]].n;
+      double cm = 0.5 * (r->cl[i] + r->ch[i]), hw = 0.5 * (r->ch[i] - r->cl[i]);
+      if (!u) {
+        for (int q = 0; q < 3; q++) mid[q] += cm * n[q];
+        continue;
+      }
+      double k = vec3_dot(n, u), l, h;
+      iv_mul(k, k, r->cl[i], r->ch[i], &l, &h);
+      al += l;
+      ah += h;
+      for (int q = 0; q < 3; q++) mid[q] += cm * (n[q] - k * u[q]);
+      rad += hw * sqrt(fmax(0, 1 - k * k));
+    }
+  } else if (nd->kind == SC_SOFT) {
+    double dl[3], dh[3];
+    soft_grad_box(nd->soft, lo, hi, dl, dh);
+    double r2 = 0, mu = 0;
+    for (int q = 0; q < 3; q++) {
+      mid[q] = 0.5 * (dl[q] + dh[q]);
+      double hw = 0.5 * (dh[q] - dl[q]);
+      r2 += hw * hw;
+      if (u) {
+        al += u[q] > 0 ? u[q] * dl[q] : u[q] * dh[q];
+        ah += u[q] > 0 ? u[q] * dh[q] : u[q] * dl[q];
+        mu += u[q] * mid[q];
+      }
+    }
+    rad = sqrt(r2);
+    for (int q = 0; u && q < 3; q++) mid[q] -= mu * u[q];
+  } else
+    return -1;
+  if (!u) {
+    memcpy(g0, mid, sizeof mid);
+    return isfinite(vec3_dot(mid, mid)) ? 0 : -1;
+  }
+  /* the sums' rounding, relative, with room */
+  *gmin = al > 0 ? al * (1 - 1e-9) : al * (1 + 1e-9);
+  *gmax = fmax(fabs(al), fabs(ah)) * (1 + 1e-9) + 1e-300;
+  *wperp = (sqrt(vec3_dot(mid, mid)) + rad) * (1 + 1e-9) + 1e-300;
+  return isfinite(*gmax) && isfinite(*wperp) ? 0 : -1;
 }
 
 /* Whether leaf lf lies within one finest cell of a leaf with two
@@ -2435,14 +2512,12 @@ static int near_two(Mesher *m, const Leaf *lf, int op) {
   return 0;
 }
 
-/* Which proof a leaf's cell gets: 0 none needed (plane and sharp cells:
-   the mesh there is the surface), 1 mesh_cover's, 2 none made (a smooth
-   cell wider than COVER_SIDE finest cells: the boxes it would need grow
-   as its area over e^2, 1.5 billion for Rounded 0.1 UnitCube at 1e-4). */
+/* Whether a leaf's cell gets a proof: plane and sharp cells need none
+   (the mesh there is the surface); smooth cells get columns, finest cells
+   boxes (mesh_cover.h). */
 static int cover_kind(const Mesher *m, const Leaf *lf) {
-  if (lf->kind == LEAF_FINE) return 1;
-  if (lf->kind != LEAF_SMOOTH) return 0;
-  return lf->level + COVER_LEVELS >= m->fine ? 1 : 2;
+  (void)m;
+  return lf->kind == LEAF_FINE || lf->kind == LEAF_SMOOTH;
 }
 
 /* Every part of the surface within the tolerance of the mesh: proven by
@@ -2451,44 +2526,53 @@ static int cover_kind(const Mesher *m, const Leaf *lf) {
    memory. */
 static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
   size_t n = 0;
-  rep->cover_skipped = 0;
-  for (size_t l = 0; l < m->nleaves; l++) {
-    int k = cover_kind(m, &m->leaves[l]);
-    n += k == 1;
-    rep->cover_skipped += k == 2;
-  }
+  for (size_t l = 0; l < m->nleaves; l++) n += (size_t)cover_kind(m, &m->leaves[l]);
   rep->cover = m->vtol; /* plane and sharp cells: the mesh is the surface */
   if (!n) return 0;
   double *bx = malloc(6 * n * sizeof *bx);
   size_t *ix = malloc(n * sizeof *ix);
+  int *fnode = malloc(n * sizeof *fnode);
   unsigned char *bad = malloc(n);
   size_t nsub = (size_t)(m->node - m->s->nodes[m->node].first + 1);
   int rc = -1;
-  CoverCtx cc[2] = {{m, malloc(nsub), malloc(nsub * sizeof(int))},
-                    {m, malloc(nsub), malloc(nsub * sizeof(int))}};
+  CoverCtx cc[2] = {{m, malloc(nsub), malloc(nsub * sizeof(int)),
+                     malloc(DT_STACK_MAX * sizeof(GrIv))},
+                    {m, malloc(nsub), malloc(nsub * sizeof(int)),
+                     malloc(DT_STACK_MAX * sizeof(GrIv))}};
   void *ctx[2] = {&cc[0], &cc[1]};
-  if (!bx || !ix || !bad || !cc[0].st || !cc[0].one || !cc[1].st || !cc[1].one)
+  if (!bx || !ix || !fnode || !bad || !cc[0].st || !cc[0].one || !cc[0].gst ||
+      !cc[1].st || !cc[1].one || !cc[1].gst)
     goto done;
   n = 0;
   for (size_t l = 0; l < m->nleaves; l++) {
     const Leaf *lf = &m->leaves[l];
-    if (cover_kind(m, lf) != 1) continue;
+    if (!cover_kind(m, lf)) continue;
     ix[n] = l;
     double side = ldexp(m->h, m->depth - lf->level);
     for (size_t a = 0; a < 3; a++) {
       bx[6 * n + a] = m->org[a] + side * lf->q[a];
       bx[6 * n + 3 + a] = m->org[a] + side * (lf->q[a] + 1);
     }
+    /* a smooth cell's surface is one node's level set: its columns */
+    fnode[n] = -1;
+    int one = -1;
+    if (lf->kind == LEAF_SMOOTH &&
+        scene_box_g(m->s, m->node, bx + 6 * n, bx + 6 * n + 3, cc[0].st,
+                    cc[0].one, &one, 1) == T_ONE)
+      fnode[n] = one;
     n++;
   }
+  MeshField fld = {fnode, field_value, field_range, field_grad};
   double scale = 0;
   for (size_t i = 0; i < 3 * me->nv; i++) scale = fmax(scale, fabs(me->v[i]));
   MeshCover mc;
   /* a computed distance is a distance to a convex combination of the
      vertices, computed to a few ulps of the coordinates */
-  if (mesh_cover(me, bx, n, m->tol, 0x1p-40 * scale, cover_class, ctx, 2, bad,
-                 &mc) < 0)
+  if (mesh_cover(me, bx, n, m->tol, 0x1p-40 * scale, cover_class, ctx, 2, &fld,
+                 bad, &mc) < 0)
     goto done;
+  rep->cover_columns += mc.columns;
+  rep->cover_colcells = mc.col_boxes;
   rep->cover = fmax(mc.bound, m->vtol);
   rep->cover_boxes += mc.boxes;
   rep->cover_unproven = mc.unproven;
@@ -2541,10 +2625,12 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
 done:
   free(bx);
   free(ix);
+  free(fnode);
   free(bad);
   for (int t = 0; t < 2; t++) {
     free(cc[t].st);
     free(cc[t].one);
+    free(cc[t].gst);
   }
   return rc;
 }
@@ -2560,6 +2646,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   rep->cover_rounds = keep.cover_rounds;
   rep->cover_last = keep.cover_last;
   rep->cover_boxes = keep.cover_boxes;
+  rep->cover_columns = keep.cover_columns;
   rep->cover_seconds = keep.cover_seconds;
   *out = NULL;
   *bad_node = -1;

@@ -128,8 +128,8 @@ typedef struct MeshReport {
                               cells are the surface) */
   long cover_boxes;        /* boxes of the proof */
   long cover_unproven;     /* cells where it failed in the last round */
-  long cover_skipped;      /* smooth cells too wide for it (mesh.c,
-                              cover_kind): not proven there */
+  long cover_columns;      /* columns of the proof (smooth cells) */
+  long cover_colcells;     /* smooth cells proven by columns */
   double cover_at[3];      /* a place in the first */
   double cover_seconds;    /* its time, over every round */
   long cover_more;         /* cells of the last round split for the next */

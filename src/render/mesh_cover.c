@@ -2,6 +2,8 @@
    box by box (mesh_cover.h). */
 #include "render/mesh_cover.h"
 
+#include "render/mesh_check.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdint.h>
@@ -312,6 +314,7 @@ typedef struct {
   size_t nboxes;
   double e, margin;
   MeshCoverClass cl;
+  const MeshField *fld;
   unsigned char *bad;
   size_t next;             /* the next box to take (atomic) */
 } Job;
@@ -325,6 +328,11 @@ typedef struct {
   size_t first;            /* the least box index not proven */
   double at[3];            /* a part of it not proven */
   double last[3];          /* the last part not proven */
+  long columns, col_boxes;
+  long col_budget;         /* columns left for the given box */
+  const double **tv;       /* a prism's triangles: 3 vertices each */
+  size_t ntv, captv;
+  int nomem;
 } Part;
 
 /* 1 if every surface point in [lo, hi] is within e of the mesh. */
@@ -368,6 +376,366 @@ static int cover_box(Part *p, const double lo[3], const double hi[3]) {
   return ok;
 }
 
+/* ---- the column proof (MeshField boxes) --------------------------------- */
+
+/* The sign of det(a - d, b - d, c - d), exactly (mesh_check's filtered
+   predicate, GMP where the filter cannot tell): 0 only when degenerate. */
+static int orient(const double *a, const double *b, const double *c,
+                  const double *d) {
+  return mesh_orient3d(a, b, c, d, NULL);
+}
+
+/* Calls fn on each triangle whose box meets q and, if pl is not NULL,
+   comes within pl[3] of the plane x . pl = pl[4] (pl[0 .. 2]), until fn
+   returns nonzero (which is returned). */
+static int each_tri(const Bvh *h, const Bx *q, const double *pl,
+                    int (*fn)(void *arg, const double *a, const double *b,
+                              const double *c),
+                    void *arg) {
+  uint32_t st[128];
+  int sp = 0;
+  const Mesh *me = h->me;
+  if (!me->nt) return 0;
+  st[sp++] = 0;
+  while (sp) {
+    const Node *nd = &h->node[st[--sp]];
+    int apart = 0;
+    for (int k = 0; k < 3; k++)
+      apart |= nd->box.lo[k] > q->hi[k] || nd->box.hi[k] < q->lo[k];
+    if (apart) continue;
+    if (pl) { /* the box's extent along the plane's normal */
+      double c = 0, r = 0;
+      for (int k = 0; k < 3; k++) {
+        c += 0.5 * (nd->box.lo[k] + nd->box.hi[k]) * pl[k];
+        r += 0.5 * (nd->box.hi[k] - nd->box.lo[k]) * fabs(pl[k]);
+      }
+      if (c - r > pl[4] + pl[3] || c + r < pl[4] - pl[3]) continue;
+    }
+    if (nd->leaf) {
+      for (uint32_t t = nd->a; t < nd->b; t++) {
+        const int *tv = me->t + 3 * (size_t)h->tri[t];
+        int r = fn(arg, me->v + 3 * (size_t)(unsigned)tv[0],
+                   me->v + 3 * (size_t)(unsigned)tv[1],
+                   me->v + 3 * (size_t)(unsigned)tv[2]);
+        if (r) return r;
+      }
+      continue;
+    }
+    if (sp < 126) { /* the tree is under 100 deep */
+      st[sp++] = nd->a;
+      st[sp++] = nd->b;
+    }
+  }
+  return 0;
+}
+
+static void cross(const double *a, const double *b, double *r) {
+  r[0] = a[1] * b[2] - a[2] * b[1];
+  r[1] = a[2] * b[0] - a[0] * b[2];
+  r[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* The rectangle z + s e1 + t e2 (|s| <= ra, |t| <= rb), and a margin. */
+typedef struct {
+  const double *z, *e1, *e2;
+  double ra, rb, m;
+} Face;
+
+/* 1 unless an axis separates triangle abc from the face by more than
+   the margin (the separating axes of two convex polygons: their normals,
+   the edges' cross products, and the face's edge normals in its plane). */
+static int face_meets(void *arg, const double *a, const double *b,
+                      const double *c) {
+  const Face *f = arg;
+  double ax[3], ed[3][3];
+  for (int k = 0; k < 3; k++) {
+    ed[0][k] = b[k] - a[k];
+    ed[1][k] = c[k] - b[k];
+    ed[2][k] = a[k] - c[k];
+  }
+  /* the cheapest first: the face's normal and its edges' normals in its
+     plane, then the triangle's normal and the edges' cross products */
+  for (int i = 0; i < 10; i++) {
+    const double *l = ax;
+    if (i == 0) cross(f->e1, f->e2, ax);
+    else if (i == 1) l = f->e1;
+    else if (i == 2) l = f->e2;
+    else if (i == 3) cross(ed[0], ed[1], ax);
+    else cross(i & 1 ? f->e1 : f->e2, ed[(i - 4) >> 1], ax);
+    double len = sqrt(dot(l, l));
+    if (!(len > 0)) continue;
+    double zc = dot(f->z, l);
+    double fr = f->ra * fabs(dot(f->e1, l)) + f->rb * fabs(dot(f->e2, l)) + f->m * len;
+    double pa = dot(a, l), pb = dot(b, l), pc = dot(c, l);
+    double tl = fmin(pa, fmin(pb, pc)), th = fmax(pa, fmax(pb, pc));
+    if (tl > zc + fr || th < zc - fr) return 0;
+  }
+  return 1;
+}
+
+typedef struct {
+  const double *p, *q;
+  long n;                  /* crossings */
+} Seg;
+
+/* Counts a crossing of segment pq through triangle abc; 1 (stop) when
+   it passes through an edge or a vertex, or an end lies in the plane. */
+static int seg_meets(void *arg, const double *a, const double *b,
+                     const double *c) {
+  Seg *sg = arg;
+  int o1 = orient(a, b, c, sg->p), o2 = orient(a, b, c, sg->q);
+  if (o1 && o1 == o2) return 0; /* both ends on one side */
+  int t1 = orient(sg->p, sg->q, a, b), t2 = orient(sg->p, sg->q, b, c),
+      t3 = orient(sg->p, sg->q, c, a);
+  if ((t1 > 0 || t2 > 0 || t3 > 0) && (t1 < 0 || t2 < 0 || t3 < 0))
+    return 0; /* the line passes beside the triangle */
+  if (!o1 || !o2 || !t1 || !t2 || !t3) return 1;
+  sg->n++;
+  return 0;
+}
+
+/* Keeps triangle abc (Part's list). */
+static int keep_tri(void *arg, const double *a, const double *b,
+                    const double *c) {
+  Part *p = arg;
+  if (p->ntv + 3 > p->captv) {
+    size_t cap = p->captv ? 2 * p->captv : 768;
+    const double **t = realloc(p->tv, cap * sizeof *t);
+    if (!t) {
+      p->nomem = 1;
+      return 1;
+    }
+    p->tv = t;
+    p->captv = cap;
+  }
+  p->tv[p->ntv++] = a;
+  p->tv[p->ntv++] = b;
+  p->tv[p->ntv++] = c;
+  return 0;
+}
+
+/* 1 when the mesh may come within the margin of either face, or the
+   crossings of the segment zb zt between their centres cannot be told
+   or are even; the triangles are those whose boxes meet q (a box
+   holding the prism grown by twice the margin), found once. */
+static int prism_fails(Part *p, const Bx *q, Face *ft, Face *fb,
+                       const double *zb, const double *zt) {
+  p->ntv = 0;
+  if (each_tri(p->job->h, q, NULL, keep_tri, p)) return 1;
+  Seg sg = {zb, zt, 0};
+  for (size_t i = 0; i < p->ntv; i += 3) {
+    const double *a = p->tv[i], *b = p->tv[i + 1], *c = p->tv[i + 2];
+    if (face_meets(ft, a, b, c) || face_meets(fb, a, b, c) || seg_meets(&sg, a, b, c))
+      return 1;
+  }
+  return sg.n % 2 == 0;
+}
+
+/* A smooth box's frame and extent. */
+typedef struct {
+  const double *lo, *hi;
+  int node;
+  double c[3], n0[3], e1[3], e2[3];
+  double f0, f1;           /* the box's extent along n0 from c (grown) */
+  double skew;             /* bounds |n0 . v| / |v| for v in span(e1, e2) */
+  double pos;              /* bounds the rounding of a computed point */
+} Frame;
+
+static void frame_pt(const Frame *fr, double s, double t, double tau,
+                     double p[3]) {
+  for (int k = 0; k < 3; k++)
+    p[k] = fr->c[k] + s * fr->e1[k] + t * fr->e2[k] + tau * fr->n0[k];
+}
+
+/* The box of the points s, t in the rectangle, tau in [t0, t1], grown by
+   the margin. */
+static void frame_box(const Frame *fr, double s, double t, double ra,
+                      double rb, double t0, double t1, double m, Bx *b) {
+  bx_empty(b);
+  for (int i = 0; i < 8; i++) {
+    double p[3];
+    frame_pt(fr, s + (i & 1 ? ra : -ra), t + (i & 2 ? rb : -rb),
+             i & 4 ? t1 : t0, p);
+    bx_add(b, p);
+  }
+  for (int k = 0; k < 3; k++) {
+    b->lo[k] -= m;
+    b->hi[k] += m;
+  }
+}
+
+/* 1 if every surface point of the box on the column over the rectangle
+   (s, t) +- (ra, rb) lies within e of the mesh (see mesh_cover.h). */
+static int column(Part *p, const Frame *fr, double s, double t, double ra,
+                  double rb) {
+  const Job *j = p->job;
+  const MeshField *fd = j->fld;
+  double m = j->margin, e = j->e;
+  p->columns++;
+  if (--p->col_budget < 0) return 0;
+  /* the column's part in the box */
+  Bx in;
+  frame_box(fr, s, t, ra, rb, fr->f0, fr->f1, m, &in);
+  for (int k = 0; k < 3; k++) {
+    in.lo[k] = fmax(in.lo[k], fr->lo[k]);
+    in.hi[k] = fmin(in.hi[k], fr->hi[k]);
+    if (in.lo[k] > in.hi[k]) return 1;
+  }
+  if (!j->cl(p->ctx, in.lo, in.hi)) return 1;
+  /* the field's root on the centre line, by regula falsi (Illinois) */
+  double ta = fr->f0 - e, tb = fr->f1 + e, pt[3];
+  frame_pt(fr, s, t, ta, pt);
+  double va = fd->value(p->ctx, fr->node, pt);
+  frame_pt(fr, s, t, tb, pt);
+  double vb = fd->value(p->ctx, fr->node, pt);
+  int side = 0;
+  if (!(va < 0 && vb > 0)) goto split;
+  for (int it = 0; it < 60 && tb - ta > e / 64; it++) {
+    double tm = (ta * vb - tb * va) / (vb - va);
+    if (!(tm > ta && tm < tb)) tm = 0.5 * (ta + tb);
+    frame_pt(fr, s, t, tm, pt);
+    double vm = fd->value(p->ctx, fr->node, pt);
+    if (vm < 0) {
+      ta = tm;
+      va = vm;
+      if (side == -1) vb *= 0.5;
+      side = -1;
+    } else if (vm > 0) {
+      tb = tm;
+      vb = vm;
+      if (side == 1) va *= 0.5;
+      side = 1;
+    } else {
+      ta = tb = tm;
+    }
+  }
+  {
+    double tc = 0.5 * (ta + tb);
+    double hh = 0.5 * (e - 4 * m) * (1 - 1e-12); /* half the prism's height */
+    if (!(hh > 0)) goto split;
+    Bx q, u;
+    frame_box(fr, s, t, ra, rb, tc - hh, tc + hh, m, &q);
+    double gmin, wp, gmax, gminu, wpu, gmaxu;
+    if (fd->grad(p->ctx, fr->node, q.lo, q.hi, fr->n0, &gmin, &wp, &gmax, NULL) < 0 ||
+        !(gmin > 0))
+      goto split;
+    u = q; /* the hull of the prism and the column's part in the box */
+    bx_add(&u, in.lo);
+    bx_add(&u, in.hi);
+    if (fd->grad(p->ctx, fr->node, u.lo, u.hi, fr->n0, &gminu, &wpu, &gmaxu, NULL) < 0 ||
+        !(gminu > 0))
+      goto split;
+    /* the field over each face: its value at the face's centre (bounded
+       over a box holding the true point) moved by at most the face's
+       radius times the gradient's bound along the face */
+    double rad = sqrt(ra * ra + rb * rb) * (1 + 1e-12);
+    double dev = rad * (wp + gmax * fr->skew) * (1 + 1e-9) + 1e-300;
+    double zt[3], zb[3], l, hgh;
+    frame_pt(fr, s, t, tc + hh, zt);
+    frame_pt(fr, s, t, tc - hh, zb);
+    double bl[3], bh[3];
+    for (int k = 0; k < 3; k++) {
+      bl[k] = zt[k] - fr->pos;
+      bh[k] = zt[k] + fr->pos;
+    }
+    fd->range(p->ctx, fr->node, bl, bh, &l, &hgh);
+    if (!(l - dev > 0)) goto split;
+    for (int k = 0; k < 3; k++) {
+      bl[k] = zb[k] - fr->pos;
+      bh[k] = zb[k] + fr->pos;
+    }
+    fd->range(p->ctx, fr->node, bl, bh, &l, &hgh);
+    if (!(hgh + dev < 0)) goto split;
+    /* the mesh clear of both faces, and crossing the centre line an odd
+       number of times between them */
+    Face ft = {zt, fr->e1, fr->e2, ra, rb, m}, fb = {zb, fr->e1, fr->e2, ra, rb, m};
+    Bx qq = q;
+    for (int k = 0; k < 3; k++) {
+      qq.lo[k] -= 2 * m;
+      qq.hi[k] += 2 * m;
+    }
+    if (prism_fails(p, &qq, &ft, &fb, zb, zt)) goto split;
+    /* two points of one line of the prism: within its height */
+    p->bound = fmax(p->bound, 2 * hh * (1 + 1e-12) + 2 * fr->pos);
+    return 1;
+  }
+split:
+  if (ra <= e / 32 && rb <= e / 32) {
+    frame_pt(fr, s, t, 0.5 * (fr->f0 + fr->f1), p->last);
+    return 0;
+  }
+  {
+    int ok = 1;
+    double ha = ra > e / 32 ? 0.5 * ra : ra, hb = rb > e / 32 ? 0.5 * rb : rb;
+    int na = ra > e / 32 ? 2 : 1, nb = rb > e / 32 ? 2 : 1;
+    for (int a = 0; a < na && ok; a++)
+      for (int b = 0; b < nb && ok; b++)
+        ok &= column(p, fr, s + (na == 2 ? (a ? ha : -ha) : 0),
+                     t + (nb == 2 ? (b ? hb : -hb) : 0), ha, hb);
+    return ok;
+  }
+}
+
+/* 1 if every surface point in the box (node's level set there) is within
+   e of the mesh, proven by columns. */
+static int cover_columns(Part *p, const double lo[3], const double hi[3],
+                         int node) {
+  const Job *j = p->job;
+  Frame fr;
+  fr.lo = lo;
+  fr.hi = hi;
+  fr.node = node;
+  double g0[3], gmin, wp, gmax, a = 0, scale = 0;
+  for (int k = 0; k < 3; k++) {
+    fr.c[k] = 0.5 * (lo[k] + hi[k]);
+    a = fmax(a, hi[k] - lo[k]);
+    scale = fmax(scale, fmax(fabs(lo[k]), fabs(hi[k])));
+  }
+  if (j->fld->grad(p->ctx, node, lo, hi, NULL, &gmin, &wp, &gmax, g0) < 0)
+    return 0;
+  double len = sqrt(dot(g0, g0));
+  if (!(len > 0) || !isfinite(len)) return 0;
+  for (int k = 0; k < 3; k++) fr.n0[k] = g0[k] / len;
+  /* e1: n0 crossed with the axis least along it; e2 = n0 x e1 */
+  int ax = 0;
+  for (int k = 1; k < 3; k++)
+    if (fabs(fr.n0[k]) < fabs(fr.n0[ax])) ax = k;
+  double ea[3] = {0, 0, 0};
+  ea[ax] = 1;
+  cross(fr.n0, ea, fr.e1);
+  len = sqrt(dot(fr.e1, fr.e1));
+  for (int k = 0; k < 3; k++) fr.e1[k] /= len;
+  cross(fr.n0, fr.e1, fr.e2);
+  len = sqrt(dot(fr.e2, fr.e2));
+  for (int k = 0; k < 3; k++) fr.e2[k] /= len;
+  fr.skew = fabs(dot(fr.n0, fr.e1)) + fabs(dot(fr.n0, fr.e2)) + 1e-14;
+  /* computed points are within a few units in the last place of the
+     coordinates; the margin is far above that */
+  fr.pos = j->margin / 16 + 64 * 0x1p-52 * (scale + 4 * a);
+  /* the box's corners in the frame (the frame is orthonormal to 1e-15:
+     a relative 1e-9 and the margin hold the true coordinates) */
+  double sl = INFINITY, sh = -INFINITY, tl = INFINITY, th = -INFINITY;
+  fr.f0 = INFINITY;
+  fr.f1 = -INFINITY;
+  for (int i = 0; i < 8; i++) {
+    double d[3];
+    for (int k = 0; k < 3; k++) d[k] = (i >> k & 1 ? hi[k] : lo[k]) - fr.c[k];
+    double u = dot(d, fr.e1), v = dot(d, fr.e2), w = dot(d, fr.n0);
+    sl = fmin(sl, u);
+    sh = fmax(sh, u);
+    tl = fmin(tl, v);
+    th = fmax(th, v);
+    fr.f0 = fmin(fr.f0, w);
+    fr.f1 = fmax(fr.f1, w);
+  }
+  double gr = 1e-9 * a + j->margin;
+  fr.f0 -= gr;
+  fr.f1 += gr;
+  p->col_budget = 4096;
+  return column(p, &fr, 0.5 * (sl + sh), 0.5 * (tl + th), 0.5 * (sh - sl) + gr,
+                0.5 * (th - tl) + gr);
+}
+
 static void *scan(void *arg) {
   Part *p = arg;
   Job *j = p->job;
@@ -375,8 +743,16 @@ static void *scan(void *arg) {
     size_t i0 = __atomic_fetch_add(&j->next, 64, __ATOMIC_RELAXED);
     if (i0 >= j->nboxes) break;
     for (size_t i = i0; i < i0 + 64 && i < j->nboxes; i++) {
-      p->budget = BOX_BUDGET(j->boxes[6 * i + 3] - j->boxes[6 * i], j->e);
-      int ok = cover_box(p, j->boxes + 6 * i, j->boxes + 6 * i + 3);
+      int ok = 0;
+      if (j->fld && j->fld->node[i] >= 0) {
+        ok = cover_columns(p, j->boxes + 6 * i, j->boxes + 6 * i + 3,
+                           j->fld->node[i]);
+        p->col_boxes += ok;
+      }
+      if (!ok) {
+        p->budget = BOX_BUDGET(j->boxes[6 * i + 3] - j->boxes[6 * i], j->e);
+        ok = cover_box(p, j->boxes + 6 * i, j->boxes + 6 * i + 3);
+      }
       if (j->bad) j->bad[i] = (unsigned char)!ok;
       if (ok) continue;
       p->unproven++;
@@ -386,18 +762,19 @@ static void *scan(void *arg) {
       }
     }
   }
+  mesh_check_release(); /* the exact predicates' scratch */
   return NULL;
 }
 
 int mesh_cover(const Mesh *me, const double *boxes, size_t nboxes, double e,
                double margin, MeshCoverClass cl, void **ctx, int nctx,
-               unsigned char *bad, MeshCover *out) {
+               const MeshField *fld, unsigned char *bad, MeshCover *out) {
   struct timespec t0, t1;
   clock_gettime(CLOCK_MONOTONIC, &t0);
   memset(out, 0, sizeof *out);
   Bvh h;
   if (bvh_build(&h, me) < 0) return -1;
-  Job job = {&h, boxes, nboxes, e, margin, cl, bad, 0};
+  Job job = {&h, boxes, nboxes, e, margin, cl, fld, bad, 0};
   Part part[2];
   pthread_t th[2];
   if (nctx > 2) nctx = 2;
@@ -415,10 +792,17 @@ int mesh_cover(const Mesh *me, const double *boxes, size_t nboxes, double e,
   scan(&part[0]);
   for (int t = 1; t < started; t++) pthread_join(th[t], NULL);
   size_t first = SIZE_MAX;
+  int nomem = 0;
+  for (int t = 0; t < nctx; t++) {
+    free(part[t].tv);
+    nomem |= part[t].nomem;
+  }
   for (int t = 0; t < started; t++) {
     out->bound = fmax(out->bound, part[t].bound);
     out->boxes += part[t].boxes;
     out->unproven += part[t].unproven;
+    out->columns += part[t].columns;
+    out->col_boxes += part[t].col_boxes;
     if (part[t].unproven && part[t].first < first) {
       first = part[t].first;
       memcpy(out->at, part[t].at, sizeof out->at);
@@ -428,7 +812,7 @@ int mesh_cover(const Mesh *me, const double *boxes, size_t nboxes, double e,
   free(h.tri);
   clock_gettime(CLOCK_MONOTONIC, &t1);
   out->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
-  return 0;
+  return nomem ? -1 : 0;
 }
 
 int mesh_cover_nearest(const Mesh *me, const double *p, size_t np,

@@ -335,14 +335,21 @@ static Mesh *icosphere(int k, double R) {
 /* The sphere of radius *R about the origin over a closed box: 0 when the
    box is wholly inside or outside it (with a relative margin for the
    rounding of the squares), else 1. */
-static int sphere_class(void *ctx, const double lo[3], const double hi[3]) {
-  double R = *(double *)ctx, near = 0, far = 0;
+/* The least and largest |p|^2 over the box, as computed. */
+static void box_r2(const double lo[3], const double hi[3], double *near,
+                   double *far) {
+  *near = *far = 0;
   for (int i = 0; i < 3; i++) {
     double c = lo[i] > 0 ? lo[i] : hi[i] < 0 ? hi[i] : 0;
     double f = fmax(fabs(lo[i]), fabs(hi[i]));
-    near += c * c;
-    far += f * f;
+    *near += c * c;
+    *far += f * f;
   }
+}
+
+static int sphere_class(void *ctx, const double lo[3], const double hi[3]) {
+  double R = *(double *)ctx, near, far;
+  box_r2(lo, hi, &near, &far);
   return !(far < R * R * (1 - 1e-12) || near > R * R * (1 + 1e-12));
 }
 
@@ -362,6 +369,22 @@ static double *box_grid(double L, double a, size_t *n) {
       }
   *n = w;
   return b;
+}
+
+/* The sag of a mesh of the sphere of radius R (cover_sphere): the
+   largest distance from the sphere's point over a triangle's centroid to
+   that triangle. */
+static double sphere_sag(const Mesh *m, double R) {
+  double sag = 0;
+  for (size_t t = 0; t < m->nt; t++) {
+    const double *a = m->v + 9 * t;
+    double c[3];
+    for (int i = 0; i < 3; i++) c[i] = (a[i] + a[3 + i] + a[6 + i]) / 3;
+    double l = sqrt(vec3_dot(c, c));
+    for (int i = 0; i < 3; i++) c[i] *= R / l;
+    sag = fmax(sag, sqrt((double)ld_tri_d2(c, a, a + 3, a + 6)));
+  }
+  return sag;
 }
 
 /* mesh_cover on a sphere meshed by a split octahedron: the nearest
@@ -397,27 +420,19 @@ static void cover_sphere(void) {
      circumcentre... bounded above by the largest distance from the sphere
      point along the triangle's centroid direction to the triangle, and
      below by it; taken as the largest over triangles of that distance */
-  double sag = 0;
-  for (size_t t = 0; t < m->nt; t++) {
-    const double *a = m->v + 9 * t;
-    double c[3];
-    for (int i = 0; i < 3; i++) c[i] = (a[i] + a[3 + i] + a[6 + i]) / 3;
-    double l = sqrt(vec3_dot(c, c));
-    for (int i = 0; i < 3; i++) c[i] *= R / l;
-    sag = fmax(sag, sqrt((double)ld_tri_d2(c, a, a + 3, a + 6)));
-  }
+  double sag = sphere_sag(m, R);
   size_t nb;
   double *bx = box_grid(1.25, 0.1, &nb);
   void *ctx[2] = {&R, &R};
   MeshCover mc;
   unsigned char *bad = malloc(nb);
   double e = 4 * sag;
-  CHECK("cover: the proof ran", mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, bad, &mc) == 0);
+  CHECK("cover: the proof ran", mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, NULL, bad, &mc) == 0);
   snprintf(buf, sizeof buf, "cover: the sphere (sag %.3g) proven within %.3g of %zu "
            "triangles (%ld boxes, %ld not proven)", sag, e, m->nt, mc.boxes, mc.unproven);
   CHECK(buf, mc.unproven == 0 && mc.bound <= e);
   e = 0.5 * sag;
-  mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, bad, &mc);
+  mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, NULL, bad, &mc);
   snprintf(buf, sizeof buf, "cover: not proven within half the sag (%.3g): %ld boxes not",
            e, mc.unproven);
   CHECK(buf, mc.unproven > 0);
@@ -432,7 +447,7 @@ static void cover_sphere(void) {
   m->nt = w;
   m->nv = 3 * w;
   e = 0.05; /* the cap's rim is at z = 0.9, its top 0.1 above */
-  mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, bad, &mc);
+  mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, NULL, bad, &mc);
   snprintf(buf, sizeof buf, "cover: a cap cut away is found (%ld boxes not proven, "
            "the first near (%.3g, %.3g, %.3g))", mc.unproven, mc.at[0], mc.at[1], mc.at[2]);
   CHECK(buf, mc.unproven > 0 && mc.at[2] > 0.9);
@@ -443,6 +458,228 @@ static void cover_sphere(void) {
   free(bx);
   free(p);
   free(d);
+  mesh_free(m);
+}
+
+/* The sphere's field for the column proof, R^2 - |p|^2 (rising inward),
+   with its range and gradient -2 p bounded exactly over boxes. */
+static double sphere_value(void *ctx, int node, const double p[3]) {
+  double R = *(double *)ctx;
+  return R * R - vec3_dot(p, p);
+}
+
+static void sphere_range(void *ctx, int node, const double lo[3],
+                         const double hi[3], double *l, double *h) {
+  double R = *(double *)ctx, near, far;
+  box_r2(lo, hi, &near, &far);
+  *l = (R * R - far) - 1e-12 * (R * R + far);
+  *h = (R * R - near) + 1e-12 * (R * R + near);
+}
+
+static int sphere_grad(void *ctx, int node, const double lo[3],
+                       const double hi[3], const double *u, double *gmin,
+                       double *wperp, double *gmax, double g0[3]) {
+  double mid[3], rad = 0, al = 0, ah = 0, mu = 0;
+  for (int i = 0; i < 3; i++) { /* d/dx_i = -2 x_i over [-2 hi, -2 lo] */
+    mid[i] = -(lo[i] + hi[i]);
+    rad += (hi[i] - lo[i]) * (hi[i] - lo[i]);
+    if (u) {
+      al += u[i] > 0 ? -2 * hi[i] * u[i] : -2 * lo[i] * u[i];
+      ah += u[i] > 0 ? -2 * lo[i] * u[i] : -2 * hi[i] * u[i];
+      mu += u[i] * mid[i];
+    }
+  }
+  if (!u) {
+    memcpy(g0, mid, sizeof mid);
+    return 0;
+  }
+  for (int i = 0; i < 3; i++) mid[i] -= mu * u[i];
+  *gmin = al - 1e-12 * fabs(al) - 1e-300;
+  *gmax = fmax(fabs(al), fabs(ah)) * (1 + 1e-12);
+  *wperp = (sqrt(vec3_dot(mid, mid)) + sqrt(rad)) * (1 + 1e-12);
+  return 0;
+}
+
+/* Of the points of the sphere's upper half over a grid of x and y
+   within L of c's, those farther than e from m (brute force in long
+   double) into *nfar, and how many of them lie in a box not marked bad. */
+static int far_unproven(const Mesh *m, const double *bx, size_t nb,
+                        const unsigned char *bad, const double *cen, double L,
+                        double zc, double e, int *nfar) {
+  int far = 0, missed = 0;
+  for (int a = 0; a < 60; a++)
+    for (int b = 0; b < 60; b++) {
+      double x = cen[0] + L * (a / 29.5 - 1), y = cen[1] + L * (b / 29.5 - 1), q[3];
+      if (x * x + y * y > fmin(1 - zc * zc, 0.999)) continue;
+      q[0] = x;
+      q[1] = y;
+      q[2] = sqrt(1 - x * x - y * y);
+      long double best = 1e300L;
+      for (size_t t = 0; t < m->nt; t++) {
+        long double d2 = ld_tri_d2(q, m->v + 9 * t, m->v + 9 * t + 3, m->v + 9 * t + 6);
+        if (d2 < best) best = d2;
+      }
+      if (sqrtl(best) <= 1.001L * e) continue;
+      far++;
+      for (size_t i = 0; i < nb; i++) {
+        int in = 1;
+        for (int k = 0; k < 3; k++) in &= q[k] >= bx[6 * i + k] && q[k] <= bx[6 * i + 3 + k];
+        missed += in && !bad[i];
+      }
+    }
+  *nfar = far;
+  return missed;
+}
+
+/* cover_columns_sphere's cut: every triangle of m with a vertex above z
+   = zc cut away, the rim's edges (used by one triangle) fanned to apex
+   (their centroid if NULL): a closed mesh. Then every box holding a
+   point of the sphere farther than e from the mesh (brute force in long
+   double, on a grid over x and y within L of the apex) is not proven,
+   and with the flat lid every box not proven is at the cap. */
+static void cap_check(Mesh *m, const double *bx, size_t nb, const MeshField *fld,
+                      void **ctx, double zc, const double *apex, double e,
+                      double L) {
+  char buf[300];
+  MeshCover mc;
+  unsigned char *bad = malloc(nb);
+  size_t w = 0;
+  for (size_t t = 0; t < m->nt; t++) {
+    const double *a = m->v + 9 * t;
+    if (a[2] > zc || a[5] > zc || a[8] > zc) continue;
+    memmove(m->v + 9 * w, a, 9 * sizeof *a);
+    w++;
+  }
+  size_t rim = 0, cap = w + 4096;
+  double *v = malloc(9 * cap * sizeof *v), *edges = malloc(6 * 4096 * sizeof *edges), cen[3] = {0, 0, 0};
+  memcpy(v, m->v, 9 * w * sizeof *v);
+  for (size_t t = 0; t < w; t++)
+    for (int k = 0; k < 3; k++) {
+      const double *p = v + 9 * t + 3 * k, *q = v + 9 * t + 3 * ((k + 1) % 3);
+      int twin = 0;
+      for (size_t u = 0; u < w && !twin; u++)
+        for (int j = 0; j < 3 && !twin; j++)
+          twin = !memcmp(v + 9 * u + 3 * j, q, 3 * sizeof *q) &&
+                 !memcmp(v + 9 * u + 3 * ((j + 1) % 3), p, 3 * sizeof *p);
+      if (twin || rim == 4096) continue;
+      memcpy(edges + 6 * rim, p, 3 * sizeof *p);
+      memcpy(edges + 6 * rim + 3, q, 3 * sizeof *q);
+      for (int i = 0; i < 3; i++) cen[i] += p[i];
+      rim++;
+    }
+  for (int i = 0; i < 3; i++) cen[i] /= (double)rim;
+  if (apex) memcpy(cen, apex, sizeof cen);
+  for (size_t r = 0; r < rim; r++, w++) { /* (q, p, centre): the rim's twin */
+    memcpy(v + 9 * w, edges + 6 * r + 3, 3 * sizeof *v);
+    memcpy(v + 9 * w + 3, edges + 6 * r, 3 * sizeof *v);
+    memcpy(v + 9 * w + 6, cen, 3 * sizeof *v);
+  }
+  free(m->v);
+  free(m->t);
+  m->v = v;
+  m->nt = w;
+  m->nv = 3 * w;
+  m->t = malloc(3 * w * sizeof *m->t);
+  for (size_t i = 0; i < 3 * w; i++) m->t[i] = (int)i;
+  const char *how = apex ? "a cone" : "a flat lid";
+  snprintf(buf, sizeof buf, "cover by columns: %s closes the cut at z = %.2g (%zu rim edges)",
+           how, zc, rim);
+  CHECK(buf, rim >= 16);
+  mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, fld, bad, &mc);
+  snprintf(buf, sizeof buf, "cover by columns: a cap under %s is found (%ld boxes "
+           "not proven, the first near (%.3g, %.3g, %.3g))", how, mc.unproven, mc.at[0],
+           mc.at[1], mc.at[2]);
+  CHECK(buf, mc.unproven > 0 && mc.at[2] > zc - 0.05);
+  if (!apex) {
+    int outside = 0;
+    for (size_t i = 0; i < nb; i++) outside += bad[i] && bx[6 * i + 5] < zc;
+    CHECK("cover by columns: every box not proven is at the cap", outside == 0);
+  }
+  int far, missed = far_unproven(m, bx, nb, bad, cen, L, zc, e, &far);
+  snprintf(buf, sizeof buf, "cover by columns, %s: every box holding one of the cap's %d "
+           "points farther than e from the mesh (brute force) is not proven (%d are)",
+           how, far, missed);
+  CHECK(buf, far > 100 && missed == 0);
+  free(edges);
+  free(bad);
+}
+
+/* A pit: the sphere's vertex nearest (0.3, 0.2, 0.93) pushed in by 0.3
+   (every copy of it; the mesh stays closed). Columns beside it whose
+   centre lines miss the pit see the pit's sides leave through their
+   bottom faces; every box holding a point of the sphere farther than
+   0.05 from the mesh must stay not proven. */
+static void pit_check(Mesh *m, const double *bx, size_t nb, const MeshField *fld,
+                      void **ctx) {
+  char buf[300];
+  double dir[3] = {0.3, 0.2, 0.93}, best = -1, pv[3] = {0, 0, 0};
+  for (size_t i = 0; i < m->nv; i++) {
+    double d = vec3_dot(m->v + 3 * i, dir);
+    if (d > best) {
+      best = d;
+      memcpy(pv, m->v + 3 * i, sizeof pv);
+    }
+  }
+  int moved = 0;
+  for (size_t i = 0; i < m->nv; i++)
+    if (!memcmp(m->v + 3 * i, pv, sizeof pv)) {
+      for (int k = 0; k < 3; k++) m->v[3 * i + k] *= 0.7;
+      moved++;
+    }
+  unsigned char *bad = malloc(nb);
+  MeshCover mc;
+  double e = 0.05;
+  mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, fld, bad, &mc);
+  int far, missed = far_unproven(m, bx, nb, bad, pv, 0.15, 0, e, &far);
+  snprintf(buf, sizeof buf, "cover by columns, a pit (%d copies of a vertex pushed in): "
+           "every box holding one of its %d points farther than e from the mesh "
+           "is not proven (%d are; %ld boxes not proven)", moved, far, missed, mc.unproven);
+  CHECK(buf, moved >= 4 && far > 20 && missed == 0);
+  free(bad);
+}
+
+/* The same proof by columns (MeshField), on boxes of the sphere as wide
+   as 0.25 (many triangles each): proven within 4x the sag, by columns
+   alone; not within half; and where a cap is cut away and closed again
+   (cap_check), not proven wherever the sphere is farther than 0.05 from
+   the mesh. */
+static void cover_columns_sphere(void) {
+  char buf[300];
+  double R = 1;
+  Mesh *m = icosphere(4, R);
+  double sag = sphere_sag(m, R);
+  size_t nb;
+  double *bx = box_grid(1.25, 0.25, &nb);
+  int *node = calloc(nb, sizeof *node);
+  MeshField fld = {node, sphere_value, sphere_range, sphere_grad};
+  void *ctx[2] = {&R, &R};
+  MeshCover mc;
+  unsigned char *bad = malloc(nb);
+  double e = 4 * sag;
+  mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, &fld, bad, &mc);
+  snprintf(buf, sizeof buf, "cover by columns: the sphere (sag %.3g) proven within %.3g "
+           "(%ld of %zu boxes by %ld columns, %ld boxes of the box proof, %ld not proven)",
+           sag, e, mc.col_boxes, nb, mc.columns, mc.boxes, mc.unproven);
+  CHECK(buf, mc.unproven == 0 && mc.bound <= e && mc.col_boxes == (long)nb && mc.boxes == 0);
+  e = 0.5 * sag;
+  mesh_cover(m, bx, nb, e, 1e-12, sphere_class, ctx, 2, &fld, bad, &mc);
+  snprintf(buf, sizeof buf, "cover by columns: not proven within half the sag (%.3g): "
+           "%ld boxes not", e, mc.unproven);
+  CHECK(buf, mc.unproven > 0);
+  /* a cap cut away and closed flat (the rim fanned to its centre), and
+     cut lower and closed by a cone to the sphere's top, whose sides leave
+     the columns through their faces (its top at a column's centre) */
+  cap_check(m, bx, nb, &fld, ctx, 0.9, NULL, 0.05, 0.5);
+  Mesh *m2 = icosphere(4, R);
+  double top[3] = {0.125, 0.125, sqrt(1 - 2 * 0.125 * 0.125)};
+  cap_check(m2, bx, nb, &fld, ctx, 0, top, 0.02, 0.12);
+  mesh_free(m2);
+  m2 = icosphere(4, R);
+  pit_check(m2, bx, nb, &fld, ctx);
+  mesh_free(m2);
+  free(bad);
+  free(node);
+  free(bx);
   mesh_free(m);
 }
 
@@ -1863,6 +2100,7 @@ int main(void) {
   one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
   predicates();
   cover_sphere();
+  cover_columns_sphere();
   cover_uniform();
   fast_pairs();
   hand_meshes();
