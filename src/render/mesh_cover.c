@@ -476,6 +476,8 @@ static int face_meets(void *arg, const double *a, const double *b,
 typedef struct {
   const double *p, *q;
   long n;                  /* crossings */
+  const double *e1, *e2;   /* across the segment, and a margin: a */
+  double m;                /* triangle beside it by more is passed by */
 } Seg;
 
 /* Counts a crossing of segment pq through triangle abc; 1 (stop) when
@@ -483,6 +485,14 @@ typedef struct {
 static int seg_meets(void *arg, const double *a, const double *b,
                      const double *c) {
   Seg *sg = arg;
+  for (int k = 0; k < 2; k++) { /* the cheap test first: wholly beside */
+    const double *u = k ? sg->e2 : sg->e1;
+    double z = dot(sg->p, u), pa = dot(a, u) - z, pb = dot(b, u) - z,
+           pc = dot(c, u) - z;
+    if ((pa > sg->m && pb > sg->m && pc > sg->m) ||
+        (pa < -sg->m && pb < -sg->m && pc < -sg->m))
+      return 0;
+  }
   int o1 = orient(a, b, c, sg->p), o2 = orient(a, b, c, sg->q);
   if (o1 && o1 == o2) return 0; /* both ends on one side */
   int t1 = orient(sg->p, sg->q, a, b), t2 = orient(sg->p, sg->q, b, c),
@@ -522,7 +532,7 @@ static int prism_fails(Part *p, const Bx *q, Face *ft, Face *fb,
                        const double *zb, const double *zt) {
   p->ntv = 0;
   if (each_tri(p->job->h, q, NULL, keep_tri, p)) return 1;
-  Seg sg = {zb, zt, 0};
+  Seg sg = {zb, zt, 0, ft->e1, ft->e2, ft->m};
   for (size_t i = 0; i < p->ntv; i += 3) {
     const double *a = p->tv[i], *b = p->tv[i + 1], *c = p->tv[i + 2];
     if (face_meets(ft, a, b, c) || face_meets(fb, a, b, c) || seg_meets(&sg, a, b, c))
