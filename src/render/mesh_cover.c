@@ -386,8 +386,8 @@ static int orient(const double *a, const double *b, const double *c,
 }
 
 /* Calls fn on each triangle whose box meets q and, if pl is not NULL,
-   comes within pl[3] of the plane x . pl = pl[4] (pl[0 .. 2]), until fn
-   returns nonzero (which is returned). */
+   the slab pl[3] <= x . n <= pl[4] (n = pl[0 .. 2]), until fn returns
+   nonzero (which is returned). */
 static int each_tri(const Bvh *h, const Bx *q, const double *pl,
                     int (*fn)(void *arg, const double *a, const double *b,
                               const double *c),
@@ -409,7 +409,7 @@ static int each_tri(const Bvh *h, const Bx *q, const double *pl,
         c += 0.5 * (nd->box.lo[k] + nd->box.hi[k]) * pl[k];
         r += 0.5 * (nd->box.hi[k] - nd->box.lo[k]) * fabs(pl[k]);
       }
-      if (c - r > pl[4] + pl[3] || c + r < pl[4] - pl[3]) continue;
+      if (c - r > pl[4] || c + r < pl[3]) continue;
     }
     if (nd->leaf) {
       for (uint32_t t = nd->a; t < nd->b; t++) {
@@ -530,12 +530,29 @@ static int keep_tri(void *arg, const double *a, const double *b,
    holding the prism grown by twice the margin), found once. */
 static int prism_fails(Part *p, const Bx *q, Face *ft, Face *fb,
                        const double *zb, const double *zt) {
+  /* the faces' planes along their unit normal n; a triangle wholly
+     beyond either (by 4 margins: room for the dot products' rounding)
+     meets neither face nor the segment, one wholly between them only
+     the segment */
+  double pl[5], m4 = 4 * ft->m;
+  cross(ft->e1, ft->e2, pl);
+  double len = sqrt(dot(pl, pl)), lo, hi;
+  for (int k = 0; k < 3; k++) pl[k] /= len;
+  lo = fmin(dot(zb, pl), dot(zt, pl));
+  hi = fmax(dot(zb, pl), dot(zt, pl));
+  pl[3] = lo - m4;
+  pl[4] = hi + m4;
   p->ntv = 0;
-  if (each_tri(p->job->h, q, NULL, keep_tri, p)) return 1;
+  if (each_tri(p->job->h, q, pl, keep_tri, p)) return 1;
   Seg sg = {zb, zt, 0, ft->e1, ft->e2, ft->m};
   for (size_t i = 0; i < p->ntv; i += 3) {
     const double *a = p->tv[i], *b = p->tv[i + 1], *c = p->tv[i + 2];
-    if (face_meets(ft, a, b, c) || face_meets(fb, a, b, c) || seg_meets(&sg, a, b, c))
+    double da = dot(a, pl), db = dot(b, pl), dc = dot(c, pl);
+    double tl = fmin(da, fmin(db, dc)), th = fmax(da, fmax(db, dc));
+    if (th < pl[3] || tl > pl[4]) continue;
+    int inside = tl > lo + m4 && th < hi - m4;
+    if ((!inside && (face_meets(ft, a, b, c) || face_meets(fb, a, b, c))) ||
+        seg_meets(&sg, a, b, c))
       return 1;
   }
   return sg.n % 2 == 0;
