@@ -2,7 +2,7 @@
 # tsan.sh (make tsan): the threaded parts of qcs under ThreadSanitizer.
 # QCS and QCS_UNIT_DIR name a -fsanitize=thread build (build-tsan). Runs
 # the render and fast-path unit tests, every rendering example on 4
-# threads, the REPL, preview and viewer suites (the viewer: libmicrohttpd threads, the render thread, 10,000 requests from 50 clients); prints "ok NAME" / "FAIL NAME: why" lines
+# threads, three meshes (the proofs' threads), the REPL, preview and viewer suites (the viewer: libmicrohttpd threads, the render thread, 10,000 requests from 50 clients); prints "ok NAME" / "FAIL NAME: why" lines
 # and a closing "N passed, N failed". halt_on_error=1: the first report
 # ends the program with status 66, which is a failure here.
 cd "$(dirname "$0")/.." || exit 1
@@ -28,6 +28,16 @@ for a in "" --alpha; do
   if timeout 600 "$QCS" --threads 4 --size 300x190 $a -o "$tmp/png$a.png" examples/figure12.qcs >/dev/null 2>"$tmp/png.err" </dev/null &&
      ! grep -q ThreadSanitizer "$tmp/png.err"; then echo "ok tsan/png$a" >>"$log"
   else echo "FAIL tsan/png$a: $(grep -m3 -E 'ThreadSanitizer|error' "$tmp/png.err" | tr '\n' ' ')" >>"$log"; fi
+done
+# meshes: the cover proof's and the self-intersection check's threads
+# (rounded, soft, and a mix of the two with a sharp box)
+i=0
+for o in 'Rounded 0.1 UnitCube' 'SoftObject 0.5 [Key (0, 0, 0) 1 1, Key (0.5, 0, 0) 0.5 (-1)]' \
+         'SetDifference (Union (Rounded 0.1 UnitCube) (Shift (0.5, 0.5, 0.5) UnitCube)) (SoftObject 0.5 [Key (1, 1, 0.5) 0.7 1])'; do
+  i=$((i + 1))
+  if timeout 600 "$QCS" -e "meshWith [Tolerance 0.02] \"$tmp/m$i.stl\" ($o)" >/dev/null 2>"$tmp/m$i.err" </dev/null &&
+     ! grep -q ThreadSanitizer "$tmp/m$i.err" && grep -q "surface to mesh" "$tmp/m$i.err"; then echo "ok tsan/mesh-$i" >>"$log"
+  else echo "FAIL tsan/mesh-$i: $(grep -m3 -E 'ThreadSanitizer|error' "$tmp/m$i.err" | tr '\n' ' ')" >>"$log"; fi
 done
 for s in tests/suite-repl.sh tests/suite-preview.sh tests/suite-view.sh; do QCS_TSAN=1 sh "$s" 2>&1 | sed 's/^\(ok\|FAIL\|skip\) /\1 tsan\//' >>"$log"; done
 
