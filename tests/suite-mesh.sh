@@ -17,9 +17,11 @@ Q
 if (cd "$tmp" && "$top/$QCS" part.qcs > out 2> err) && [ -s "$tmp/ring.obj" ] && [ -s "$tmp/soft.stl" ] &&
    grep -q "certified <=" "$tmp/err" &&
    grep -q "checked: no self-intersections, [0-9]* triangle pairs tested exactly" "$tmp/err" &&
+   grep -q "topology: 1 component, Euler characteristic 0 (genus 1 in all)" "$tmp/err" &&
+   grep -q "topology: 1 component, Euler characteristic 2 (genus 0 in all)" "$tmp/err" &&
    grep -q "surface to mesh: every part proven within 0.0001 of the mesh (0 smooth cells by 0 columns, the rest by 0 boxes" "$tmp/err" &&
    grep -q "surface to mesh: every part proven within 0.03 of the mesh ([1-9][0-9]* smooth cells by [1-9][0-9]* columns" "$tmp/err"; then
-  echo "ok mesh: mesh and meshWith write .obj and .stl with a report (the self-intersection check's and the surface-to-mesh proof's lines too)"
+  echo "ok mesh: mesh and meshWith write .obj and .stl with a report (the topology's, the self-intersection check's and the surface-to-mesh proof's lines too: the cube with a hole genus 1, the soft pair genus 0)"
 else echo "FAIL mesh: mesh/meshWith: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 if grep -q '^vn ' "$tmp/ring.obj" && grep -q '^f [0-9]*//[0-9]*' "$tmp/ring.obj"; then
   echo "ok mesh: .obj has vertex normals"; else echo "FAIL mesh: .obj without normals"; fi

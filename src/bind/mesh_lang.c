@@ -44,6 +44,13 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
   else if (r->sharp_off)
     fprintf(f, "  sharp cells given up: the mesh made with them intersected "
             "itself; it was made again without them\n");
+  /* a closed orientable surface of c components has Euler
+     characteristic 2c - 2g, g the sum of their genera */
+  fprintf(f, "  topology: %ld component%s, Euler characteristic %ld (genus "
+          "%ld in all); the object's own is not proven: where it is thinner "
+          "than about twice the tolerance the mesh can pinch it or leave "
+          "islands\n", r->components, r->components == 1 ? "" : "s",
+          r->euler, r->components - r->euler / 2);
   fprintf(f, "  checked: no self-intersections, %ld triangle pairs tested "
           "exactly (%ld signs in exact arithmetic) in %.2f s\n", r->pairs,
           r->pairs_exact, r->check_seconds);

@@ -2894,6 +2894,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_EINTERNAL;
     goto done;
   }
+  rep->components = ck.components;
+  rep->euler = ck.euler;
   if (me->nv && (test_fault == 2 || (test_fault == 1 && sharp)))
     push_through(me);
   if (self_check(me, rep, err, errlen, &rc) != 0) {

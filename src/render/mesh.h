@@ -118,6 +118,8 @@ typedef struct MeshReport {
   int samples;             /* the sample points used */
   long crossings, bisected;/* edge vertices; of them found by bisection */
   size_t vertices, triangles;
+  long components;         /* the mesh's connected components and Euler */
+  long euler;              /* characteristic (mesh_check) */
   long pairs;              /* the self-intersection check (mesh_check.h):
                               triangle pairs tested exactly */
   long pairs_exact;        /* predicate signs decided in GMP */
