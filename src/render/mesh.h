@@ -45,9 +45,9 @@
  * in finest cells; the report gives the largest, and a measured error
  * (sample points to the surface along the normal or an axis). That every part of
  * the surface is near the mesh is proven in plane and sharp cells by
- * construction, and in the finest cells and the smooth cells up to twice
- * their side after the mesh is made (mesh_cover.h; wider smooth cells are
- * counted, not proven); cells where that proof gives up, and the leaves
+ * construction, and in the smooth cells (by columns along the gradient)
+ * and the finest cells (box by box) after the mesh is made
+ * (mesh_cover.h); cells where that proof gives up, and the leaves
  * beside them, are split and the object meshed again, a round kept only
  * when it proves more and keeps the mesh's topology.
  * Closure is checked by edge counting before anything is returned, and
