@@ -545,10 +545,13 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   /* the deviation from g0 along u = g0 / |g0| and across it */
   double wu = 0, wp = 0;
   for (int i = 0; i < r->n; i++) {
-    double k = vec3_dot(t->leaves[r->leaf[i]].n, g0) / len;
+    const double *n = t->leaves[r->leaf[i]].n;
+    double k = vec3_dot(n, g0) / len, p[3];
     double hw = 0.5 * (r->ch[i] - r->cl[i]);
     wu += hw * fabs(k);
-    wp += hw * sqrt(fmax(0, 1 - k * k));
+    /* n across u by components (1 - k^2 loses it when k rounds to 1) */
+    for (int q = 0; q < 3; q++) p[q] = n[q] - k * g0[q] / len;
+    wp += hw * (sqrt(vec3_dot(p, p)) + 1e-15);
   }
   /* chords of the surface are nearly across u: see tri_bound */
   double we = wp * (1 + wu / (gmin * (1 - 1e-9)));
@@ -2416,7 +2419,7 @@ static int field_grad(void *ctx, int x, const double lo[3], const double hi[3],
                       double *gmax, double g0[3]) {
   CoverCtx *c = ctx;
   const ScNode *nd = &c->m->s->nodes[x];
-  double mid[3] = {0, 0, 0}, rad = 0, al = 0, ah = 0;
+  double mid[3] = {0, 0, 0}, rad = 0, al = 0, ah = 0, mag = 0;
   if (nd->kind == SC_ROUNDED) {
     const GrIv *r = gr_tape(nd->tape, lo, hi, c->gst);
     if (!r || r->n == 0) return -1;
@@ -2428,12 +2431,16 @@ static int field_grad(void *ctx, int x, const double lo[3], const double hi[3],
         for (int q = 0; q < 3; q++) mid[q] += cm * n[q];
         continue;
       }
-      double k = vec3_dot(n, u), l, h;
+      double k = vec3_dot(n, u), l, h, p[3];
       iv_mul(k, k, r->cl[i], r->ch[i], &l, &h);
       al += l;
       ah += h;
-      for (int q = 0; q < 3; q++) mid[q] += cm * (n[q] - k * u[q]);
-      rad += hw * sqrt(fmax(0, 1 - k * k));
+      mag += fabs(l) + fabs(h) + fabs(cm) + hw;
+      /* n across u by components (1 - k^2 loses it when k rounds to 1),
+         with room for their rounding */
+      for (int q = 0; q < 3; q++) p[q] = n[q] - k * u[q];
+      for (int q = 0; q < 3; q++) mid[q] += cm * p[q];
+      rad += hw * (sqrt(vec3_dot(p, p)) + 1e-15);
     }
   } else if (nd->kind == SC_SOFT) {
     double dl[3], dh[3];
@@ -2447,6 +2454,7 @@ static int field_grad(void *ctx, int x, const double lo[3], const double hi[3],
         al += u[q] > 0 ? u[q] * dl[q] : u[q] * dh[q];
         ah += u[q] > 0 ? u[q] * dh[q] : u[q] * dl[q];
         mu += u[q] * mid[q];
+        mag += fabs(dl[q]) + fabs(dh[q]);
       }
     }
     rad = sqrt(r2);
@@ -2457,10 +2465,12 @@ static int field_grad(void *ctx, int x, const double lo[3], const double hi[3],
     memcpy(g0, mid, sizeof mid);
     return isfinite(vec3_dot(mid, mid)) ? 0 : -1;
   }
-  /* the sums' rounding, relative, with room */
-  *gmin = al > 0 ? al * (1 - 1e-9) : al * (1 + 1e-9);
-  *gmax = fmax(fabs(al), fabs(ah)) * (1 + 1e-9) + 1e-300;
-  *wperp = (sqrt(vec3_dot(mid, mid)) + rad) * (1 + 1e-9) + 1e-300;
+  /* the sums' rounding: relative, with room, and absolute against the
+     terms' magnitudes (the sums can cancel) */
+  double abs_err = 1e-14 * mag + 1e-300;
+  *gmin = (al > 0 ? al * (1 - 1e-9) : al * (1 + 1e-9)) - abs_err;
+  *gmax = fmax(fabs(al), fabs(ah)) * (1 + 1e-9) + abs_err;
+  *wperp = (sqrt(vec3_dot(mid, mid)) + rad) * (1 + 1e-9) + abs_err;
   return isfinite(*gmax) && isfinite(*wperp) ? 0 : -1;
 }
 
@@ -3488,11 +3498,13 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
         mesh_free(*out);
         *out = prev;
         int rounds = rep->cover_rounds;
-        long boxes = rep->cover_boxes, split = rep->cover_split;
+        long boxes = rep->cover_boxes, split = rep->cover_split,
+             columns = rep->cover_columns;
         double cs = rep->cover_seconds;
         *rep = prep;
         rep->cover_rounds = rounds;
         rep->cover_boxes = boxes;
+        rep->cover_columns = columns;
         rep->cover_seconds = cs;
         rep->cover_split = split;
         rep->cover_kept = 1;

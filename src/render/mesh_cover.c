@@ -421,10 +421,9 @@ static int each_tri(const Bvh *h, const Bx *q, const double *pl,
       }
       continue;
     }
-    if (sp < 126) { /* the tree is under 100 deep */
-      st[sp++] = nd->a;
-      st[sp++] = nd->b;
-    }
+    if (sp >= 126) return 1; /* never (the tree is under 100 deep): fail */
+    st[sp++] = nd->a;
+    st[sp++] = nd->b;
   }
   return 0;
 }
@@ -593,8 +592,12 @@ static void frame_box(const Frame *fr, double s, double t, double ra,
 
 /* 1 if every surface point of the box on the column over the rectangle
    (s, t) +- (ra, rb) lies within e of the mesh (see mesh_cover.h). */
-static int column(Part *p, const Frame *fr, double s, double t, double ra,
-                  double rb) {
+static int column(Part *p, const Frame *fr, double s0, double s1, double t0,
+                  double t1) {
+  /* the rectangle [s0, s1] x [t0, t1], its children sharing a computed
+     midpoint, so they tile it exactly; centre and half sides rounded up */
+  double s = 0.5 * (s0 + s1), t = 0.5 * (t0 + t1);
+  double ra = fmax(s - s0, s1 - s) * (1 + 0x1p-50), rb = fmax(t - t0, t1 - t) * (1 + 0x1p-50);
   const Job *j = p->job;
   const MeshField *fd = j->fld;
   double m = j->margin, e = j->e;
@@ -693,12 +696,12 @@ split:
   }
   {
     int ok = 1;
-    double ha = ra > e / 32 ? 0.5 * ra : ra, hb = rb > e / 32 ? 0.5 * rb : rb;
+    double se[3] = {s0, ra > e / 32 ? s : s1, s1}, te[3] = {t0, rb > e / 32 ? t : t1, t1};
     int na = ra > e / 32 ? 2 : 1, nb = rb > e / 32 ? 2 : 1;
     for (int a = 0; a < na && ok; a++)
       for (int b = 0; b < nb && ok; b++)
-        ok &= column(p, fr, s + (na == 2 ? (a ? ha : -ha) : 0),
-                     t + (nb == 2 ? (b ? hb : -hb) : 0), ha, hb);
+        ok &= column(p, fr, se[a], na == 2 ? se[a + 1] : s1, te[b],
+                     nb == 2 ? te[b + 1] : t1);
     return ok;
   }
 }
@@ -739,6 +742,8 @@ static int cover_columns(Part *p, const double lo[3], const double hi[3],
   /* computed points are within a few units in the last place of the
      coordinates; the margin is far above that */
   fr.pos = j->margin / 16 + 64 * 0x1p-52 * (scale + 4 * a);
+  /* the argument needs the margin well above the points' rounding */
+  if (!(fr.pos <= j->margin / 4)) return 0;
   /* the box's corners in the frame (the frame is orthonormal to 1e-15:
      a relative 1e-9 and the margin hold the true coordinates) */
   double sl = INFINITY, sh = -INFINITY, tl = INFINITY, th = -INFINITY;
@@ -759,8 +764,7 @@ static int cover_columns(Part *p, const double lo[3], const double hi[3],
   fr.f0 -= gr;
   fr.f1 += gr;
   p->col_budget = 4096;
-  return column(p, &fr, 0.5 * (sl + sh), 0.5 * (tl + th), 0.5 * (sh - sl) + gr,
-                0.5 * (th - tl) + gr);
+  return column(p, &fr, sl - gr, sh + gr, tl - gr, th + gr);
 }
 
 static void *scan(void *arg) {

@@ -86,7 +86,11 @@ typedef struct MeshCover {
    rounding of a computed distance (absolute). ctx holds nctx classifier
    contexts (one per thread, 1 or 2). bad, if not NULL, gets 1 for each
    box not proven, else 0. fld, if not NULL, names the boxes proven by
-   columns (a box whose columns fail gets the box proof, in its budget). 0, or -1 when memory runs out. */
+   columns (a box whose columns fail gets the box proof, in its budget);
+   the columns' parity argument needs a closed mesh (every edge, by its
+   ends' coordinates, in an even number of triangles: mesh.c checks that
+   before) and a margin at least 2^-46 times the coordinates' scale (a
+   box with less gets the box proof). 0, or -1 when memory runs out. */
 int mesh_cover(const Mesh *me, const double *boxes, size_t nboxes, double e,
                double margin, MeshCoverClass cl, void **ctx, int nctx,
                const MeshField *fld, unsigned char *bad, MeshCover *out);
