@@ -364,6 +364,7 @@ static const char *const lg_decisions[] = {
     [LG_SEG_EXCLUDED] = "miss",  [LG_SEG_FLAT] = "flat",
     [LG_SEG_NO_ROOT] = "none",   [LG_SEG_ROOT] = "root",
     [LG_SEG_SPLIT] = "split",    [LG_SEG_TINY] = "tiny",
+    [LG_SEG_PLANE] = "plane",
 };
 
 static void print_lg_trace(FILE *out, const TraceLog *t, int digits) {
@@ -378,7 +379,9 @@ static void print_lg_trace(FILE *out, const TraceLog *t, int digits) {
           " split: may hold 2 roots  root: 1 root, polished  none: no "
           "sign change\n"
           " miss: range misses 0.5  flat: L = 0  tiny: below the "
-          "tolerance\n");
+          "tolerance\n"
+          " plane: one leaf live, its plane is the 0.5 level: a root "
+          "by one division\n");
   static const char *const head[] = {"d", "t0", "t1", "f0", "f1", "L",
                                      "G", "A+B", "ops", "decision"};
   char (*cells)[CELL] = calloc(t->nlg * 10 + 1, CELL);
@@ -397,7 +400,7 @@ static void print_lg_trace(FILE *out, const TraceLog *t, int digits) {
     cell(c[7], e->lhs, digits, 0);
     snprintf(c[8], CELL, "%d", e->ncode);
     snprintf(c[9], CELL, "%s%s",
-             e->decision >= 0 && e->decision <= LG_SEG_TINY
+             e->decision >= 0 && e->decision <= LG_SEG_PLANE
                  ? lg_decisions[e->decision] : "?",
              e->nroots && e->decision == LG_SEG_TINY ? " -> root" : "");
   }

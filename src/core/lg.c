@@ -406,6 +406,41 @@ static void view_of(const dt_tape *t, const dt_ray_leaf *rl, double a,
   dt_prune_rl(t, rl, a, b, buf, view);
 }
 
+/* A segment whose view is one leaf: the density there is that leaf's
+ * smoothed halfspace of the distance along the ray, monotone, and eq.
+ * (2)'s kernel is 0.5 exactly at alpha = 0, so the inside predicate
+ * changes at most once, where the ray crosses the leaf's plane (for r = 0
+ * too: the step is at the plane; a ray along the plane is left to the
+ * search, which calls it flat or a miss). The ends' signs say whether it does;
+ * the crossing is -base / nd, in [a, b], within an ulp or so of where the
+ * computed density changes sign (polishing would stop within the
+ * tolerance of it). Most of a rounded polyhedron's faces are flat this
+ * way (Lobb, Section 2.3). The trace row keeps its LG bounds for the
+ * table and the plots. Returns what emit does (1 if there is none). */
+static int plane_segment(search *s, const dt_tape *t, const segment *sg) {
+  int pa = pos(sg->fa), nroots = pa != pos(sg->fb);
+  double x = 0;
+  if (nroots) {
+    if (s->first == 2 && sg->a > s->first_after) x = sg->b;
+    else if (!pa && sg->fa == 0) x = sg->a;   /* as polish has them */
+    else if (pa && sg->fb == 0) x = sg->b;
+    else {
+      const dt_ray_leaf *r = &s->rl[t->code[0].arg];
+      x = -r->base / r->nd;
+      if (!(x >= sg->a)) x = sg->a;
+      if (!(x <= sg->b)) x = sg->b;
+    }
+  }
+  if (s->hook && s->hook->fn) {
+    lg_bounds lb;
+    eval_bounds(t, s->rl, s->o, s->d, sg->a, sg->b, &lb);
+    trace(s, sg, &lb,
+          lg_multiroot_length(sg->fa, sg->dfa, sg->fb, sg->dfb, lb.L, lb.G),
+          LG_SEG_PLANE, t->ncode, nroots);
+  }
+  return nroots ? emit(s, t, x, pa ? LG_EXIT : LG_ENTER) : 1;
+}
+
 /* Figure 9 over [a, b] of the (span-pruned) tape t.  Returns 0 when the
  * output is full.  A segment's tape is pruned from its parent's, not from
  * t: the search is depth first, so when a segment of depth k is popped
@@ -433,6 +468,10 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
       vp = &lv[to];
     }
     int nc = vp->ncode;
+    if (nc == 1 && vp->code[0].op == DT_LEAF && s->rl[vp->code[0].arg].nd != 0) {
+      if (!plane_segment(s, vp, &sg)) return 0;
+      continue;
+    }
     lg_bounds lb;
     eval_bounds(vp, s->rl, s->o, s->d, sg.a, sg.b, &lb);
     double margin = 1e-12 * (1 + fabs(lb.lo) + fabs(lb.hi));

@@ -104,7 +104,12 @@ enum {
   LG_SEG_NO_ROOT,    /* at most one root (eq. 6 false), no sign change */
   LG_SEG_ROOT,       /* at most one root, sign change: regula falsi */
   LG_SEG_SPLIT,      /* eq. (6) true: subdivide */
-  LG_SEG_TINY        /* shorter than tol: decided by the tolerance rule */
+  LG_SEG_TINY,       /* shorter than tol: decided by the tolerance rule */
+  LG_SEG_PLANE       /* one leaf live: the density is monotone along the
+                        ray and its 0.5 level is the leaf's plane, so the
+                        crossing, if the ends' signs differ, is that
+                        plane's, by one division (no splitting, no
+                        polishing) */
 };
 
 typedef struct lg_trace_event {

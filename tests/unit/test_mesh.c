@@ -1887,14 +1887,27 @@ static void obj5_measured(void) {
 
 /* QCS_MESH_SEEDS=n: the generator on seeds 0 .. n - 1 as well (closure,
    the certified and the measured error checked), and the counts of
-   scenes over the tolerance; not run by default. */
+   scenes over the tolerance; QCS_MESH_SEED_LIST=a,b,...: those seeds with
+   the regression seeds' full checks. Not run by default. */
 static void property_long(void) {
   const char *env = getenv("QCS_MESH_SEEDS");
-  int n = env ? atoi(env) : 0;
+  const char *list = getenv("QCS_MESH_SEED_LIST");
+  int n = env ? atoi(env) : 0, full = 0;
+  if (list && *list) {
+    /* QCS_MESH_SEED_LIST=575,227: those seeds with the full checks */
+    n = 1;
+    for (const char *c = list; *c; c++) n += *c == ',';
+    full = 1;
+  }
   if (n <= 0) return;
   unsigned long long *seeds = malloc((size_t)n * sizeof *seeds);
   for (int i = 0; i < n; i++) seeds[i] = (unsigned long long)i;
-  PropStats st = property_seeds(seeds, n, 0);
+  if (full) {
+    char *e;
+    const char *c = list;
+    for (int i = 0; i < n; i++, c = *e ? e + 1 : e) seeds[i] = strtoull(c, &e, 10);
+  }
+  PropStats st = property_seeds(seeds, n, full);
   printf("# long property run: %d seeds, %d meshed, %d certified > tol, "
          "%d measured > tol, %d sharp given up, %d with cells not proven within "
          "tol of the mesh\n", n,

@@ -118,6 +118,74 @@ static void test_cube_axis(void) {
   }
 }
 
+static void count_plane(void *ctx, const lg_trace_event *ev) {
+  int *c = ctx;
+  if (ev->decision == LG_SEG_PLANE) c[0]++;
+  c[1]++;
+}
+
+/* Rays into the flat middle of a face of Rounded r UnitCube, searched as
+ * the tracer does (between the outer and the inner bound) up to 0.3 past
+ * the face: aimed at most 0.25 from the face's centre, at most 23 degrees
+ * off its normal, so only that face's leaf is live where the ray meets
+ * the shell between the bounds, and the crossing is the face plane's,
+ * found by one division (lg.c, plane_segment): no polishing step, a plane
+ * row in the trace. Reference: the plane crossing in long double from the
+ * cube's definition; allowed: 4 ulps of t, far below the root tolerance
+ * (1e-9), all the polished search would promise. At the origin and
+ * shifted to 1e6; 600 rays each, every other one traced. */
+static void test_plane_faces(void) {
+  rng_t g = {4242};
+  for (int shifted = 0; shifted < 2; shifted++) {
+    double sh = shifted ? 1e6 : 0, r = 0.1;
+    rtree t;
+    int root = unit_cube(&t, sh, r);
+    dt_tape *tp = rt_tape(&t, root);
+    csg_tape *ob = bnd_outer(tp, 0.5, NULL), *ib = bnd_inner(tp, 0.5, NULL);
+    int bad = 0, planes = 0, nrays = 600, hooked = 0, polished = 0;
+    double worst = 0;
+    for (int k = 0; k < nrays; k++) {
+      int axis = k % 3, side = (k / 3) % 2;
+      double p[3], d[3], o[3];
+      for (int i = 0; i < 3; i++) {
+        p[i] = sh + rng_range(&g, 0.25, 0.75);
+        d[i] = rng_range(&g, -0.3, 0.3);
+      }
+      p[axis] = sh + side;
+      d[axis] = side ? -1 : 1;
+      double len = rng_range(&g, 0.5, 2);
+      for (int i = 0; i < 3; i++) d[i] *= len, o[i] = p[i] - 2 * d[i];
+      lg_root out[8];
+      lg_stats st = {0};
+      int cnt[2] = {0, 0};
+      lg_hook hk = {count_plane, cnt};
+      long double ref = ((long double)sh + side - o[axis]) / d[axis];
+      int n = lg_roots_bounded(tp, ob, ib, o, d, 0, (double)ref + 0.3 / len, 1e-9,
+                               out, 8, &st, k % 2 ? &hk : NULL);
+      double err = n >= 1 ? (double)fabsl(out[0].t - ref) : INFINITY;
+      if (!(n == 1 && out[0].kind == LG_ENTER && err <= 4 * DBL_EPSILON * fabsl(ref)))
+        bad++;
+      if (err > worst) worst = err;
+      polished += st.rf_steps > 0;
+      if (k % 2) {
+        hooked++;
+        planes += cnt[0] > 0;
+      }
+    }
+    char name[200];
+    snprintf(name, sizeof name, "plane: 600 rays into the flat middles of Rounded "
+             "0.1 UnitCube's faces%s enter at the face plane within 4 ulps of t "
+             "(long double; worst %.3g)", shifted ? " shifted 1e6" : "", worst);
+    CHECK(name, bad == 0);
+    snprintf(name, sizeof name, "plane: none of them polished (%d were), each traced "
+             "one has a plane row (%d of %d)", polished, planes, hooked);
+    CHECK(name, polished == 0 && planes == hooked);
+    csg_tape_free(ob);
+    csg_tape_free(ib);
+    dt_tape_free(tp);
+  }
+}
+
 /* MPFR-free reference crossing by long double bisection of the reference
  * density on a bracket. */
 static long double ref_cross(const rtree *t, int root, const double o[3],
@@ -377,6 +445,7 @@ int main(void) {
   test_multiroot();
   test_lg_bounds();
   test_cube_axis();
+  test_plane_faces();
   test_grazing();
   test_thin_slab();
   test_sharp();
