@@ -1359,12 +1359,15 @@ static void pool_normal(rng_t *g, double n[3]) {
 }
 
 /* A random tree over planes of pool normals: two or three convex groups
-   (intersections of 3 to 6 planes) joined by random operations. */
+   (intersections of 3 to 6 planes, or of 9 to 30 as a chamfered bound
+   has: convex_span takes those 8 planes at a time) joined by random
+   operations. */
 static csg_tape *pool_tape(rng_t *g) {
   csg_builder *b = csg_builder_new();
   int ng = 2 + (int)(rng_u64(g) % 2);
   for (int k = 0; k < ng; k++) {
     int np = 3 + (int)(rng_u64(g) % 4);
+    if (rng_u64(g) % 4 == 0) np = 9 + (int)(rng_u64(g) % 22);
     for (int j = 0; j < np; j++) {
       double n[3];
       pool_normal(g, n);
