@@ -17,6 +17,7 @@
 #include "render/image.h"
 #include "render/mesh_check.h"
 #include "render/mesh_cover.h"
+#include "render/mesh_merge.h"
 #include "render/render.h"
 #include "scene/ray.h"
 
@@ -30,6 +31,8 @@
 /* Failing cells within this many finest cells of a cell with two surfaces
    not proven one sheet together are not split for the cover proof. */
 #define NEAR_TWO 2
+
+static Mesh *mesh_copy(const Mesh *m);
 
 /* mesh_run's answer: mesh again (cover_check split cells) */
 #define MESH_RECOVER 100
@@ -618,6 +621,7 @@ typedef struct {
   double org[3], h;        /* finest grid point (i, j, k) is org + h (i, j, k) */
   double clo[3], chi[3];   /* the clip box: outside it is outside */
   double tol, vtol;
+  double flat_moved;       /* how far merging flat regions moved the mesh */
   int depth;               /* the deepest level the octree may reach */
   int fine;                /* the level whose side the tolerance fixes */
   double bad[6];           /* MESH_ETHIN: the cell that was not settled */
@@ -2537,7 +2541,9 @@ static int cover_kind(const Mesher *m, const Leaf *lf) {
 static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
   size_t n = 0;
   for (size_t l = 0; l < m->nleaves; l++) n += (size_t)cover_kind(m, &m->leaves[l]);
-  rep->cover = m->vtol; /* plane and sharp cells: the mesh is the surface */
+  /* plane and sharp cells: the mesh is the surface (to what merging
+     flat regions moved it) */
+  rep->cover = m->vtol + m->flat_moved;
   if (!n) return 0;
   double *bx = malloc(6 * n * sizeof *bx);
   size_t *ix = malloc(n * sizeof *ix);
@@ -2583,7 +2589,7 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
     goto done;
   rep->cover_columns += mc.columns;
   rep->cover_colcells = mc.col_boxes;
-  rep->cover = fmax(mc.bound, m->vtol);
+  rep->cover = fmax(mc.bound, m->vtol + m->flat_moved);
   rep->cover_boxes += mc.boxes;
   rep->cover_unproven = mc.unproven;
   memcpy(rep->cover_at, mc.at, sizeof mc.at);
@@ -2889,8 +2895,33 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   me->t = t2 ? t2 : m.t;
   m.v = NULL;
   m.t = NULL;
+  /* flat regions triangulated again (mesh_merge.h), checked below with
+     the rest; if the checks fail with them, the mesh as made is checked
+     instead (kept aside until then) */
+  Mesh *made = NULL;
+  MeshMerge mm = {0};
+  double mscale = 0;
+  for (size_t i = 0; i < 3 * me->nv; i++) mscale = fmax(mscale, fabs(me->v[i]));
+  double mdelta = ldexp(fmax(mscale, size), -44);
+  if (!ms->uniform && !test_fault && me->nt && 4 * mdelta <= 1e-3 * e &&
+      (made = mesh_copy(me)) != NULL) {
+    if (mesh_merge_flat(me, mdelta, &mm) < 0) {
+      mesh_free(me);
+      me = made;
+      made = NULL;
+      memset(&mm, 0, sizeof mm);
+    }
+  }
   MeshCheck ck;
   int cr = mesh_check(me, &ck);
+  if (cr != 0 && made) {
+    mesh_free(me);
+    me = made;
+    made = NULL;
+    rep->flat_undone = 1;
+    memset(&mm, 0, sizeof mm);
+    cr = mesh_check(me, &ck);
+  }
   if (cr != 0) {
     mesh_free(me);
     if (cr == -2) {
@@ -2908,9 +2939,35 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   rep->euler = ck.euler;
   if (me->nv && (test_fault == 2 || (test_fault == 1 && sharp)))
     push_through(me);
-  if (self_check(me, rep, err, errlen, &rc) != 0) {
+  int sr = self_check(me, rep, err, errlen, &rc);
+  if (sr != 0 && made && rc == MESH_ESELF) {
+    mesh_free(me);
+    me = made;
+    made = NULL;
+    rep->flat_undone = 2;
+    memset(&mm, 0, sizeof mm);
+    rc = MESH_OK;
+    if (mesh_check(me, &ck) != 0) { /* the mesh as made was checked before */
+      mesh_free(me);
+      rc = MESH_EINTERNAL;
+      goto done;
+    }
+    rep->components = ck.components;
+    rep->euler = ck.euler;
+    sr = self_check(me, rep, err, errlen, &rc);
+  }
+  mesh_free(made);
+  made = NULL;
+  if (sr != 0) {
     mesh_free(me);
     goto done;
+  }
+  rep->flat_regions = mm.regions;
+  rep->flat_before = mm.before;
+  if (mm.regions) {
+    /* the surface moved by at most mm.moved (mesh_merge.h) */
+    rep->certified += mm.moved;
+    m.flat_moved = mm.moved;
   }
   if (cover_check(&m, me, rep) < 0) {
     mesh_free(me);
@@ -2963,6 +3020,23 @@ done:
   rep->seconds = (double)(t1.tv_sec - t0.tv_sec) +
                  1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
   return rc;
+}
+
+/* A copy of m's vertices and triangles (not its colours), or NULL. */
+static Mesh *mesh_copy(const Mesh *m) {
+  Mesh *c = calloc(1, sizeof *c);
+  if (!c) return NULL;
+  c->nv = m->nv;
+  c->nt = m->nt;
+  c->v = malloc((m->nv ? 3 * m->nv : 1) * sizeof *c->v);
+  c->t = malloc((m->nt ? 3 * m->nt : 1) * sizeof *c->t);
+  if (!c->v || !c->t) {
+    mesh_free(c);
+    return NULL;
+  }
+  memcpy(c->v, m->v, 3 * m->nv * sizeof *c->v);
+  memcpy(c->t, m->t, 3 * m->nt * sizeof *c->t);
+  return c;
 }
 
 void mesh_free(Mesh *m) {

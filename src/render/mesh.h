@@ -118,6 +118,11 @@ typedef struct MeshReport {
   int samples;             /* the sample points used */
   long crossings, bisected;/* edge vertices; of them found by bisection */
   size_t vertices, triangles;
+  long flat_regions;       /* flat regions triangulated again
+                              (mesh_merge.h) */
+  size_t flat_before;      /* the triangles before that */
+  int flat_undone;         /* the checks failed with them: 1 closure, 2
+                              self-intersection (the mesh as made kept) */
   long components;         /* the mesh's connected components and Euler */
   long euler;              /* characteristic (mesh_check) */
   long pairs;              /* the self-intersection check (mesh_check.h):
