@@ -26,6 +26,14 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           r->cells, r->empty, r->full, r->leaves, r->planar, r->smooth,
           r->sharp, r->leaves - r->planar - r->smooth - r->sharp, r->depth,
           r->h);
+  if (r->flat_regions)
+    fprintf(f, "  flat parts: %ld regions in one plane triangulated again "
+            "without their inner vertices, %zu -> %zu triangles\n",
+            r->flat_regions, r->flat_before, r->triangles);
+  else if (r->flat_undone)
+    fprintf(f, "  flat parts: triangulated again, the mesh failed its %s "
+            "check; the mesh as made was kept\n",
+            r->flat_undone == 1 ? "closure" : "self-intersection");
   if (r->thin)
     fprintf(f, "  thin parts: %ld cells split below the finest level (a "
             "surface in them, or the solid where surfaces meet, not proven "

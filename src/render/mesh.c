@@ -2903,7 +2903,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   double mscale = 0;
   for (size_t i = 0; i < 3 * me->nv; i++) mscale = fmax(mscale, fabs(me->v[i]));
   double mdelta = ldexp(fmax(mscale, size), -44);
-  if (!ms->uniform && !test_fault && me->nt && 4 * mdelta <= 1e-3 * e &&
+  if (!ms->uniform && !ms->keep_flat && !test_fault && me->nt &&
+      4 * mdelta <= 1e-3 * e &&
       (made = mesh_copy(me)) != NULL) {
     if (mesh_merge_flat(me, mdelta, &mm) < 0) {
       mesh_free(me);
@@ -2967,6 +2968,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   if (mm.regions) {
     /* the surface moved by at most mm.moved (mesh_merge.h) */
     rep->certified += mm.moved;
+    rep->flat_moved = mm.moved;
     m.flat_moved = mm.moved;
   }
   if (cover_check(&m, me, rep) < 0) {

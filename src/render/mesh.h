@@ -50,7 +50,11 @@
  * (mesh_cover.h); cells where that proof gives up, and the leaves
  * beside them, are split and the object meshed again, a round kept only
  * when it proves more and keeps the mesh's topology.
- * Closure is checked by edge counting before anything is returned, and
+ * The flat regions of the mesh made (a sharp face, a flat middle) are then
+ * triangulated again without their inner vertices (mesh_merge.h; the
+ * surface moves by at most flat_moved, added to the certified bound;
+ * MeshSettings.keep_flat leaves them). Closure is checked by edge
+ * counting before anything is returned, and
  * then self-intersection, exactly (mesh_check.h: every pair of triangles
  * whose boxes overlap, by exact orientation predicates); a failure of
  * either with sharp cells (two of them deciding a degenerate case apart,
@@ -75,6 +79,9 @@ typedef struct MeshSettings {
   size_t max_cells;        /* refuse an octree with more surface cells */
   int uniform;             /* every surface cell at the finest level, no
                               sharp cells: the uniform grid, to compare */
+  int keep_flat;           /* do not triangulate flat regions again
+                              (mesh_merge.h): the octree's triangles, to
+                              compare */
 } MeshSettings;
 
 typedef struct Mesh {
@@ -121,6 +128,8 @@ typedef struct MeshReport {
   long flat_regions;       /* flat regions triangulated again
                               (mesh_merge.h) */
   size_t flat_before;      /* the triangles before that */
+  double flat_moved;       /* how far that moved the surface at most
+                              (added to certified) */
   int flat_undone;         /* the checks failed with them: 1 closure, 2
                               self-intersection (the mesh as made kept) */
   long components;         /* the mesh's connected components and Euler */

@@ -1,6 +1,4 @@
-/* mesh_merge.c: flat regions of a mesh triangulated again (mesh_merge.h).
-   WORK IN PROGRESS (branch mesh-merge, 2026-11-27): see bench/NOTES.md
-   "Flat regions merged: tried, not landed". */
+/* mesh_merge.c: flat regions of a mesh triangulated again (mesh_merge.h). */
 #include "render/mesh_merge.h"
 
 #include <math.h>
@@ -23,10 +21,16 @@ typedef struct {
   const Mesh *m;
   size_t *vs;   /* triangles around vertex v: vt[vs[v] .. vs[v + 1]) */
   int *vt;
+  int *nb;      /* the triangle across each edge (across), or NULL */
 } Adj;
 
-/* The triangle across edge e (t[e] -> t[e + 1]) of triangle i, or -1. */
+/* The triangle across edge e (t[e] -> t[e + 1]) of triangle i, or -1
+   (from the table once made). */
+static int across_find(const Adj *A, int i, int e);
 static int across(const Adj *A, int i, int e) {
+  return A->nb ? A->nb[3 * i + e] : across_find(A, i, e);
+}
+static int across_find(const Adj *A, int i, int e) {
   const int *t = A->m->t;
   int a = t[3 * i + e], b = t[3 * i + (e + 1) % 3];
   for (size_t k = A->vs[b]; k < A->vs[b + 1]; k++) {
@@ -122,8 +126,15 @@ static int flat3(const Poly *P, int a, int b, int c) {
 static int is_ear(const Poly *P, int k) {
   int a = P->id[P->prev[k]], b = P->id[k], c = P->id[P->next[k]];
   if (orient(P, a, b, c) <= 0 || flat3(P, a, b, c)) return 0;
+  const double *x = P->v + 3 * a, *y = P->v + 3 * b, *z = P->v + 3 * c;
+  int i = P->ax, j2 = P->ay;
+  double lx = fmin(x[i], fmin(y[i], z[i])), hx = fmax(x[i], fmax(y[i], z[i]));
+  double ly = fmin(x[j2], fmin(y[j2], z[j2])), hy = fmax(x[j2], fmax(y[j2], z[j2]));
   for (int j = P->next[P->next[k]]; j != P->prev[k]; j = P->next[j]) {
     int q = P->id[j];
+    const double *w = P->v + 3 * q;
+    /* outside the ear's box: outside the ear (the box is exact) */
+    if (w[i] < lx || w[i] > hx || w[j2] < ly || w[j2] > hy) continue;
     if (q == a || q == b || q == c) continue;
     if (in_tri(P, a, b, c, q)) return 0;
   }
@@ -329,7 +340,7 @@ typedef struct {
 /* Region r's boundary as loops of the vertices not gone. 0, -1 when a
    loop is too short or the boundary does not close, -2 out of memory. */
 static int region_loops(const Ctx *C, int r, const unsigned char *gone,
-                        unsigned char *used, Loops *L, int *had_gone) {
+                        unsigned char *used, Loops *L) {
   size_t e0 = C->B.rs[r], e1 = C->B.rs[r + 1];
   L->nloops = 0;
   size_t n = 0;
@@ -349,8 +360,7 @@ static int region_loops(const Ctx *C, int r, const unsigned char *gone,
       long x = edge_at(&C->B, r, cur);
       if (x < 0 || used[(size_t)x - e0] || steps++ > (int)(e1 - e0)) return -1;
       used[(size_t)x - e0] = 1;
-      if (gone[cur]) *had_gone = 1;
-      else {
+      if (!gone[cur]) {
         if (grow_ints(&L->ids, &L->cap, n + 1) < 0) return -2;
         L->ids[n++] = cur;
       }
@@ -494,11 +504,10 @@ static void grow_regions(Ctx *C, const Adj *A, int *stack, const int *within,
   }
 }
 
-static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st, int remove,
-                          int *redo) {
+static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
   size_t nv = m->nv, nt = m->nt;
   int rc = -2;
-  Adj A = {m, malloc((nv + 1) * sizeof *A.vs), malloc(3 * nt * sizeof *A.vt)};
+  Adj A = {m, malloc((nv + 1) * sizeof *A.vs), malloc(3 * nt * sizeof *A.vt), NULL};
   Ctx C = {0};
   C.m = m;
   C.delta = delta;
@@ -525,6 +534,13 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st, int remove,
     for (size_t e = 0; e < 3; e++) A.vt[A.vs[m->t[3 * i + e]]++] = (int)i;
   for (size_t v = nv; v > 0; v--) A.vs[v] = A.vs[v - 1];
   A.vs[0] = 0;
+  {
+    int *nb = malloc(3 * nt * sizeof *nb);
+    if (!nb) goto out;
+    for (size_t i = 0; i < nt; i++)
+      for (int e = 0; e < 3; e++) nb[3 * i + (size_t)e] = across_find(&A, (int)i, e);
+    A.nb = nb;
+  }
   /* flat regions, grown across edges from a seed's plane; then a region
      whose boundary is long is grown again in patches of at most
      MERGE_PATCH triangles (a polygon of many boundary vertices and none
@@ -606,7 +622,7 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st, int remove,
   for (size_t k = 1; k < ne; k++)
     if (C.edges[k].r == C.edges[k - 1].r && C.edges[k].a == C.edges[k - 1].a)
       C.rbad[C.edges[k].r] = 1; /* a vertex twice on its boundary */
-  if (remove) straight(&C, &A, gone);
+  straight(&C, &A, gone);
   /* each region again, by ear clipping */
   merged = calloc((size_t)C.nreg, 1);
   used = malloc(ne ? ne : 1);
@@ -620,11 +636,20 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st, int remove,
   if (!merged || !used || !joined || !seq || !outt || !P.id || !P.prev || !P.next)
     goto out;
   P.v = m->v;
+  /* Passes: a region that fails with a straight vertex gone from its
+     boundary gets its boundary's vertices back (its neighbour's side
+     too), and the regions are done again; after 8 such passes, with no
+     vertex removed. */
+  for (int pass = 0;; pass++) {
+  int again = 0;
+  nnew = 0;
+  st->regions = st->kept = 0;
+  memset(merged, 0, (size_t)C.nreg);
   for (int r = 0; r < C.nreg; r++) {
     if (C.rcount[r] < 2 || C.rbad[r]) continue;
-    int had_gone = 0, lost = 0;
+    int had_gone = 0;
     for (size_t e = C.B.rs[r]; e < C.B.rs[r + 1]; e++) had_gone |= gone[C.edges[e].a];
-    int lr = region_loops(&C, r, gone, used, &L, &lost);
+    int lr = region_loops(&C, r, gone, used, &L);
     if (lr == -2) goto out;
     int ok = lr == 0;
     const double *n = C.rplane[r];
@@ -673,12 +698,15 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st, int remove,
         continue;
       }
     }
-    if (had_gone) { /* its neighbour lost the vertex too: without removals */
-      *redo = 1;
-      rc = 0;
-      goto out;
+    if (had_gone) { /* its neighbour lost the vertex too: both keep it */
+      for (size_t e = C.B.rs[r]; e < C.B.rs[r + 1]; e++) gone[C.edges[e].a] = 0;
+      again = 1;
+      continue;
     }
     st->kept += np < 3 || np - 2 < C.rcount[r]; /* else: no gain, not a failure */
+  }
+  if (!again) break;
+  if (pass == 8) memset(gone, 0, nv);
   }
   /* the mesh again: the triangles of regions not merged, then the new */
   size_t keep = 0;
@@ -723,6 +751,7 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st, int remove,
 out:
   free(A.vs);
   free(A.vt);
+  free(A.nb);
   free(C.reg);
   free(C.rcount);
   free(C.rplane);
@@ -751,14 +780,7 @@ int mesh_merge_flat(Mesh *m, double delta, MeshMerge *st) {
   memset(st, 0, sizeof *st);
   st->before = st->after = m->nt;
   if (!(delta > 0) || m->nt < 2 || m->nt > (size_t)INT32_MAX / 3) return 0;
-  int redo = 0;
-  int rc = mesh_merge_run(m, delta, st, 1, &redo);
-  if (rc == 0 && redo) {
-    memset(st, 0, sizeof *st);
-    st->before = st->after = m->nt;
-    redo = 0;
-    rc = mesh_merge_run(m, delta, st, 0, &redo);
-  }
+  int rc = mesh_merge_run(m, delta, st);
   mesh_check_release();
   return rc;
 }

@@ -5,7 +5,11 @@
  * comes out of the octree as many triangles, cut by the cells and their
  * tetrahedra. mesh_merge_flat finds the regions of edge-adjacent
  * triangles whose vertices all lie within delta of one plane (with
- * normals on the same side), drops their interior vertices, drops the
+ * normals on the same side; a region whose boundary has more than 96
+ * edges is taken in patches of at most 64 triangles, grown breadth
+ * first: a polygon of many boundary vertices and none inside would be
+ * cut into long thin triangles across it, whose boxes meet many others
+ * in the self-intersection check), drops their interior vertices, drops the
  * vertices on a straight edge between two such regions (within delta of
  * the chord between the edge's ends, used by those two regions alone),
  * and triangulates each region's boundary again by ear clipping in the
@@ -14,7 +18,11 @@
  * its edges. A region with holes has each hole joined to the outside by a
  * bridge that crosses no edge. A region whose boundary is not simple
  * (a vertex twice), or that the clipping cannot finish, keeps its
- * triangles.
+ * triangles; one that had lost a straight vertex gives it back (on both
+ * sides) and the regions are done again (after 8 such passes, with no
+ * vertex removed). An ear that is a sliver (twice its area under 1e-10
+ * of its longest side squared: vertices on one straight edge, not
+ * exactly collinear once rounded) is not taken.
  *
  * What it keeps. Every boundary edge between regions that are not both
  * merged stays as it was, and a removed straight vertex is removed from

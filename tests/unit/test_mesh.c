@@ -1915,6 +1915,131 @@ static void property_long(void) {
   free(seeds);
 }
 
+/* Vertices compared as bits (the merge keeps the vertices it keeps). */
+static int cmp_vertex(const void *x, const void *y) { return memcmp(x, y, 3 * sizeof(double)); }
+
+/* The largest distance from n random points of the triangles of a (kept
+   a thousandth of a side off their edges) to the triangles of b: for each
+   triangle of b whose projection along its normal's largest axis holds
+   the point's (exact signs, mesh_orient2d, itself checked against GMP
+   above), the point's distance from its plane along that axis (at least
+   the true distance); the least of them, INFINITY if none holds it. No
+   closest-point formula: those lose the sign of a sliver's barycentric
+   coordinates. */
+static double mesh_gap(const Mesh *a, const Mesh *b, int n) {
+  double worst = 0;
+  for (int k = 0; k < n; k++) {
+    size_t i = (size_t)(urand() * (double)a->nt);
+    const double *x = a->v + 3 * a->t[3 * i], *y = a->v + 3 * a->t[3 * i + 1],
+                 *z = a->v + 3 * a->t[3 * i + 2];
+    double u = urand(), v = urand(), p[3];
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    u = 1e-3 + u * (1 - 3e-3);
+    v = 1e-3 + v * (1 - 3e-3);
+    for (int c = 0; c < 3; c++) p[c] = x[c] + u * (y[c] - x[c]) + v * (z[c] - x[c]);
+    double best = INFINITY;
+    for (size_t j = 0; j < b->nt; j++) {
+      const double *t0 = b->v + 3 * b->t[3 * j], *t1 = b->v + 3 * b->t[3 * j + 1],
+                   *t2 = b->v + 3 * b->t[3 * j + 2];
+      int out = 0;
+      for (int c = 0; c < 3 && !out; c++)
+        out = p[c] < fmin(t0[c], fmin(t1[c], t2[c])) - 1e-9 ||
+              p[c] > fmax(t0[c], fmax(t1[c], t2[c])) + 1e-9;
+      if (out) continue;
+      double e1[3], e2[3], nn[3];
+      for (int c = 0; c < 3; c++) e1[c] = t1[c] - t0[c], e2[c] = t2[c] - t0[c];
+      vec3_cross(e1, e2, nn);
+      int ax = fabs(nn[0]) >= fabs(nn[1]) && fabs(nn[0]) >= fabs(nn[2]) ? 0
+             : fabs(nn[1]) >= fabs(nn[2]) ? 1 : 2;
+      if (nn[ax] == 0) continue;
+      int i1 = (ax + 1) % 3, i2 = (ax + 2) % 3;
+      int s1 = mesh_orient2d(t0, t1, p, i1, i2, NULL), s2 = mesh_orient2d(t1, t2, p, i1, i2, NULL),
+          s3 = mesh_orient2d(t2, t0, p, i1, i2, NULL);
+      if (!((s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0))) continue;
+      double w[3] = {p[0] - t0[0], p[1] - t0[1], p[2] - t0[2]};
+      best = fmin(best, fabs(vec3_dot(nn, w) / nn[ax]));
+    }
+    if (best > 1e-12 && getenv("FLAT_DEBUG"))
+      printf("# gap %.3g at %.17g %.17g %.17g\n", best, p[0], p[1], p[2]);
+    worst = fmax(worst, best);
+  }
+  return worst;
+}
+
+/* Flat regions triangulated again (mesh_merge.h), against the octree's
+   own triangles (MeshSettings.keep_flat) of the same object: fewer
+   triangles (a unit cube 12, figure12's sharp obj1 28, OpenSCAD's count
+   for it); the same components and Euler characteristic; every vertex
+   one of the octree's, to the bit; and the same surface: 1500 points of
+   either mesh within the stated bound (MeshReport.flat_moved) of the
+   other, by brute force over its triangles. */
+static void flat_merge(void) {
+  static const struct { const char *name, *src; double tol; long want; } objs[] = {
+    {"UnitCube", "UnitCube", 0.01, 12},
+    {"figure12 obj1 (sharp)", "SetDifference UnitCube (Shift (0.25, 0.8, 0.25) "
+     "(Scale (0.5, 0.5, 0.5) UnitCube))", 0.001, 28},
+    {"a rotated cube", "Rotate \"z\" 30 (Rotate \"x\" 20 UnitCube)", 0.001, 12},
+    {"Rounded 0.1 UnitCube", "Rounded 0.1 UnitCube", 0.02, -1},
+    {"sharp cube with a hole", "SetDifference UnitCube (Shift (0.3, -0.5, 0.3) "
+     "(Scale (0.4, 2, 0.4) UnitCube))", 0.01, -1},
+    {"a box minus soft keys (random seed 835)", "SetDifference (Union (Rounded "
+     "0.05944437258005722 (Rotate \"z\" 51.936 (Shift (0.269, 0.396, 0.119) (Scale "
+     "(0.373, 0.448, 0.501) UnitCube)))) (Rotate \"x\" 24.969 (Shift (-0.396, "
+     "-0.200, -0.148) (Scale (0.812, 0.783, 0.580) UnitCube)))) (SoftObject 0.5 "
+     "[Key (0.185, 0.335, 0.423) 0.601 1, Key (0.310, 0.172, 0.359) 0.797 1, Key "
+     "(-0.146, -0.465, 0.158) 0.872 1, Key (0.463, -0.194, 0.031) 0.764 (-1)])", 0.03, -1},
+  };
+  unsigned long long keep = rng;
+  for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
+    Scene *s = compile(objs[k].src);
+    CHECK(objs[k].name, s != NULL);
+    if (!s) continue;
+    MeshSettings ms = {0};
+    ms.tol = objs[k].tol;
+    Mesh *a = NULL, *b = NULL;
+    MeshReport ra, rb;
+    char err[300], buf[400];
+    int bad;
+    ms.keep_flat = 1;
+    int rc = mesh_scene(s, s->root, &ms, &a, &ra, &bad, err, sizeof err);
+    ms.keep_flat = 0;
+    rc |= mesh_scene(s, s->root, &ms, &b, &rb, &bad, err, sizeof err);
+    snprintf(buf, sizeof buf, "flat: %s meshed both ways", objs[k].name);
+    CHECK(buf, rc == 0);
+    if (rc) {
+      mesh_free(a);
+      mesh_free(b);
+      scene_free(s);
+      continue;
+    }
+    snprintf(buf, sizeof buf, "flat: %s: %zu -> %zu triangles%s", objs[k].name,
+             a->nt, b->nt, objs[k].want > 0 ? " (as many as expected)" : " (fewer)");
+    CHECK(buf, objs[k].want > 0 ? b->nt == (size_t)objs[k].want : b->nt < a->nt);
+    snprintf(buf, sizeof buf, "flat: %s: components %ld, Euler %ld both", objs[k].name,
+             rb.components, rb.euler);
+    CHECK(buf, ra.components == rb.components && ra.euler == rb.euler &&
+               rb.flat_regions > 0 && !rb.flat_undone);
+    double *va = malloc(3 * a->nv * sizeof *va);
+    memcpy(va, a->v, 3 * a->nv * sizeof *va);
+    qsort(va, a->nv, 3 * sizeof *va, cmp_vertex);
+    size_t missing = 0;
+    for (size_t v = 0; v < b->nv; v++)
+      missing += !bsearch(b->v + 3 * v, va, a->nv, 3 * sizeof *va, cmp_vertex);
+    free(va);
+    snprintf(buf, sizeof buf, "flat: %s: every vertex one of the octree's (%zu not)",
+             objs[k].name, missing);
+    CHECK(buf, missing == 0);
+    double ab = mesh_gap(a, b, 1500), ba = mesh_gap(b, a, 1500);
+    snprintf(buf, sizeof buf, "flat: %s: the same surface, 1500 points each way within "
+             "%.3g (%.3g, %.3g)", objs[k].name, rb.flat_moved, ab, ba);
+    CHECK(buf, ab <= rb.flat_moved && ba <= rb.flat_moved);
+    mesh_free(a);
+    mesh_free(b);
+    scene_free(s);
+  }
+  rng = keep;
+}
+
 /* A rotated sharp cube: its 8 corners, computed here from the definition
    (Rotate's convention: about x, y towards z; about z, x towards y), are
    vertices of the mesh, and every vertex lies on one of its 6 planes. */
@@ -2120,6 +2245,7 @@ int main(void) {
   bad_input();
   self_check_failures();
   sharp_corners();
+  flat_merge();
   thin_parts();
   property();
   sharp_kept();
