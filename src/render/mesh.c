@@ -2906,16 +2906,19 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   if (!ms->uniform && !ms->keep_flat && !test_fault && me->nt &&
       4 * mdelta <= 1e-3 * e &&
       (made = mesh_copy(me)) != NULL) {
-    if (mesh_merge_flat(me, mdelta, &mm) < 0) {
+    if (mesh_merge_flat(me, mdelta, &mm) < 0) { /* out of memory: as made */
       mesh_free(me);
       me = made;
       made = NULL;
       memset(&mm, 0, sizeof mm);
+    } else if (!mm.regions) { /* nothing merged: no copy to keep */
+      mesh_free(made);
+      made = NULL;
     }
   }
   MeshCheck ck;
   int cr = mesh_check(me, &ck);
-  if (cr != 0 && made) {
+  if (cr == -1 && made) {
     mesh_free(me);
     me = made;
     made = NULL;
@@ -2925,6 +2928,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   }
   if (cr != 0) {
     mesh_free(me);
+    mesh_free(made);
     if (cr == -2) {
       rc = MESH_ENOMEM;
       goto done;
@@ -2942,14 +2946,26 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     push_through(me);
   int sr = self_check(me, rep, err, errlen, &rc);
   if (sr != 0 && made && rc == MESH_ESELF) {
+    /* the mesh as made, checked for closure and self-intersection in
+       its turn */
     mesh_free(me);
     me = made;
     made = NULL;
     rep->flat_undone = 2;
     memset(&mm, 0, sizeof mm);
     rc = MESH_OK;
-    if (mesh_check(me, &ck) != 0) { /* the mesh as made was checked before */
+    err[0] = 0;
+    cr = mesh_check(me, &ck);
+    if (cr != 0) {
       mesh_free(me);
+      if (cr == -2) {
+        rc = MESH_ENOMEM;
+        goto done;
+      }
+      snprintf(err, errlen, "internal error: the mesh failed its closure "
+               "check (%ld boundary, %ld non-manifold edges, %ld non-manifold "
+               "vertices); nothing was written", ck.boundary_edges,
+               ck.nonmanifold_edges, ck.nonmanifold_verts);
       rc = MESH_EINTERNAL;
       goto done;
     }

@@ -137,14 +137,19 @@ static int is_ear(const Poly *P, int k) {
     if (w[i] < lx || w[i] > hx || w[j2] < ly || w[j2] > hy) continue;
     if (q == a || q == b || q == c) continue;
     if (in_tri(P, a, b, c, q)) return 0;
+    /* nor within rounding of its diagonal, outside: cut off, it would
+       leave a spike that flat3 refuses */
+    double dx = z[i] - x[i], dy = z[j2] - x[j2], qx = w[i] - x[i], qy = w[j2] - x[j2];
+    double l2 = dx * dx + dy * dy, t = qx * dx + qy * dy;
+    if (t > 0 && t < l2 && !(fabs(dx * qy - dy * qx) > 1e-10 * l2)) return 0;
   }
   return 1;
 }
 
-/* Triangulate P (counter-clockwise, n >= 3) into out (3 (n - 2) ints).
-   0, or -1 when no ear is left (the region keeps its triangles). */
-static int clip(Poly *P, int *out) {
-  int n = P->n, k = 0, made = 0, stall = 0;
+/* Triangulate P (counter-clockwise, n >= 3) into out (3 (n - 2) ints),
+   looking for ears from position k0 on. 0, or -1 when no ear is left. */
+static int clip_from(Poly *P, int *out, int k0) {
+  int n = P->n, k = k0, made = 0, stall = 0;
   for (int i = 0; i < n; i++) {
     P->prev[i] = (i + n - 1) % n;
     P->next[i] = (i + 1) % n;
@@ -172,6 +177,17 @@ static int clip(Poly *P, int *out) {
   out[3 * made + 1] = b;
   out[3 * made + 2] = c;
   return 0;
+}
+
+/* clip_from from up to 8 starting places spread around the polygon (the
+   first ear found is taken, and on a face whose straight runs are
+   collinear only to rounding one start can leave a run no ear can cut
+   where another does not). 0, or -1: the region keeps its triangles. */
+static int clip(Poly *P, int *out) {
+  int tries = P->n < 8 ? P->n : 8;
+  for (int t = 0; t < tries; t++)
+    if (clip_from(P, out, (int)((long)t * P->n / tries)) == 0) return 0;
+  return -1;
 }
 
 /* Do the closed segments pq and cd meet? */
@@ -485,6 +501,14 @@ static void grow_regions(Ctx *C, const Adj *A, int *stack, const int *within,
     memcpy(C->rplane[r], n, sizeof n);
     C->rplane[r][3] = d;
     if (n[0] == 0 && n[1] == 0 && n[2] == 0) continue;
+    /* a thin seed's normal is rounding: its own vertices must be within
+       delta of its plane too, else it stays alone */
+    int off = 0;
+    for (int k = 1; k < 3; k++) {
+      const double *q = m->v + 3 * m->t[3 * i + (size_t)k];
+      off |= !(fabs(n[0] * q[0] + n[1] * q[1] + n[2] * q[2] - d) <= C->delta);
+    }
+    if (off) continue;
     size_t sp = 0;
     stack[sp++] = (int)i;
     /* breadth first (the stack read from its bottom): compact patches */
@@ -706,7 +730,11 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
     st->kept += np < 3 || np - 2 < C.rcount[r]; /* else: no gain, not a failure */
   }
   if (!again) break;
-  if (pass == 8) memset(gone, 0, nv);
+  if (pass == 7) memset(gone, 0, nv); /* 8 passes with removals, then none */
+  }
+  if (!st->regions) { /* nothing merged: m as it was */
+    rc = 0;
+    goto out;
   }
   /* the mesh again: the triangles of regions not merged, then the new */
   size_t keep = 0;
@@ -725,7 +753,7 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
       memcpy(t2 + 3 * w, m->t + 3 * i, 3 * sizeof *t2);
       w++;
     }
-  memcpy(t2 + 3 * w, newt, 3 * nnew * sizeof *t2);
+  if (nnew) memcpy(t2 + 3 * w, newt, 3 * nnew * sizeof *t2);
   for (size_t i = 0; i < 3 * tot; i++) vused[t2[i]] = 1;
   size_t nv2 = 0;
   for (size_t v = 0; v < nv; v++) {

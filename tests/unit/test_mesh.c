@@ -1969,7 +1969,8 @@ static double mesh_gap(const Mesh *a, const Mesh *b, int n) {
 /* Flat regions triangulated again (mesh_merge.h), against the octree's
    own triangles (MeshSettings.keep_flat) of the same object: fewer
    triangles (a unit cube 12, figure12's sharp obj1 28, OpenSCAD's count
-   for it); the same components and Euler characteristic; every vertex
+   for it; a rotated plate with a sunk square, the case a review found
+   the clipping giving up on, 1746 -> 72); the same components and Euler characteristic; every vertex
    one of the octree's, to the bit; and the same surface: 1500 points of
    either mesh within the stated bound (MeshReport.flat_moved) of the
    other, by brute force over its triangles. */
@@ -1982,6 +1983,10 @@ static void flat_merge(void) {
     {"Rounded 0.1 UnitCube", "Rounded 0.1 UnitCube", 0.02, -1},
     {"sharp cube with a hole", "SetDifference UnitCube (Shift (0.3, -0.5, 0.3) "
      "(Scale (0.4, 2, 0.4) UnitCube))", 0.01, -1},
+    {"a rotated union of plates (faces collinear only to rounding)",
+     "Rotate \"y\" 17 (Union (Scale (3, 3, 1) UnitCube) (SetDifference (Shift "
+     "(0.5, 0.5, 1) (Scale (2, 2, 1) UnitCube)) (Shift (1, 1, 0.9) (Scale (1, 1, 2) "
+     "UnitCube))))", 0.01, -1},
     {"a box minus soft keys (random seed 835)", "SetDifference (Union (Rounded "
      "0.05944437258005722 (Rotate \"z\" 51.936 (Shift (0.269, 0.396, 0.119) (Scale "
      "(0.373, 0.448, 0.501) UnitCube)))) (Rotate \"x\" 24.969 (Shift (-0.396, "
