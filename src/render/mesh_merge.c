@@ -179,6 +179,56 @@ static int clip_from(Poly *P, int *out, int k0) {
   return 0;
 }
 
+/* Is d inside the circle through a, b, c (counter-clockwise), by more
+   than rounding? In doubles: it only chooses among valid triangulations. */
+static int in_circle(const Poly *P, int a, int b, int c, int d) {
+  const double *A = P->v + 3 * a, *B = P->v + 3 * b, *C = P->v + 3 * c,
+               *D = P->v + 3 * d;
+  int i = P->ax, j = P->ay;
+  double ax = A[i] - D[i], ay = A[j] - D[j], bx = B[i] - D[i], by = B[j] - D[j];
+  double cx = C[i] - D[i], cy = C[j] - D[j];
+  double a2 = ax * ax + ay * ay, b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+  double det = a2 * (bx * cy - by * cx) - b2 * (ax * cy - ay * cx) +
+               c2 * (ax * by - ay * bx);
+  double mag = a2 * (fabs(bx * cy) + fabs(by * cx)) + b2 * (fabs(ax * cy) + fabs(ay * cx)) +
+               c2 * (fabs(ax * by) + fabs(ay * bx));
+  return det > 1e-12 * mag;
+}
+
+/* Lawson's flips over the n triangles of one region (out, counter-
+   clockwise): an inner edge whose opposite vertex lies inside the other
+   triangle's circumcircle is flipped when both new triangles are
+   strictly convex by the exact signs and no sliver (flat3), so the
+   triangulation stays one of the same polygon, with fatter triangles
+   (ear clipping makes fans). At most 16 n flips. */
+static void flip_region(const Poly *P, int *out, int n) {
+  int budget = 16 * n;
+  for (int changed = 1; changed && budget > 0;) {
+    changed = 0;
+    for (int x = 0; x < n && budget > 0; x++)
+      for (int e = 0; e < 3 && budget > 0; e++) {
+        int u = out[3 * x + e], v = out[3 * x + (e + 1) % 3], c = out[3 * x + (e + 2) % 3];
+        for (int y = 0; y < n; y++) {
+          if (y == x) continue;
+          int f = -1;
+          for (int g = 0; g < 3; g++)
+            if (out[3 * y + g] == v && out[3 * y + (g + 1) % 3] == u) f = g;
+          if (f < 0) continue;
+          int d = out[3 * y + (f + 2) % 3];
+          if (d != c && in_circle(P, u, v, c, d) && orient(P, u, d, c) > 0 &&
+              orient(P, v, c, d) > 0 && !flat3(P, u, d, c) && !flat3(P, v, c, d)) {
+            out[3 * x] = u, out[3 * x + 1] = d, out[3 * x + 2] = c;
+            out[3 * y] = v, out[3 * y + 1] = c, out[3 * y + 2] = d;
+            changed = 1;
+            budget--;
+            e = 3; /* x changed: on to the next */
+          }
+          break;
+        }
+      }
+  }
+}
+
 /* clip_from from up to 8 starting places spread around the polygon (the
    first ear found is taken, and on a face whose straight runs are
    collinear only to rounding one start can leave a run no ear can cut
@@ -714,6 +764,7 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
       /* taken when it has fewer triangles, or must be (a straight
          vertex gone from its boundary) */
       if (clip(&P, outt) == 0 && (had_gone || np - 2 < C.rcount[r])) {
+        flip_region(&P, outt, np - 2);
         if (grow_ints(&newt, &newcap, 3 * (nnew + (size_t)np - 2)) < 0) goto out;
         memcpy(newt + 3 * nnew, outt, 3 * (size_t)(np - 2) * sizeof *outt);
         nnew += (size_t)np - 2;

@@ -15,7 +15,8 @@
  * and triangulates each region's boundary again by ear clipping in the
  * plane, with exact orientation predicates (mesh_check.h): an ear is
  * strictly convex and holds no other vertex of the polygon, inside or on
- * its edges. A region with holes has each hole joined to the outside by a
+ * its edges; then Lawson's flips, each keeping both triangles strictly
+ * convex, make the fans of the clipping fatter. A region with holes has each hole joined to the outside by a
  * bridge that crosses no edge. A region whose boundary is not simple
  * (a vertex twice), or that the clipping cannot finish, keeps its
  * triangles; one that had lost a straight vertex gives it back (on both
