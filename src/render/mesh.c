@@ -2651,6 +2651,17 @@ done:
   return rc;
 }
 
+/* mesh_check's failure cr (-2 out of memory, -1 not closed) as mesh_run's
+   answer, the error naming what the count found. */
+static int closure_failed(int cr, const MeshCheck *ck, char *err, size_t errlen) {
+  if (cr == -2) return MESH_ENOMEM;
+  snprintf(err, errlen, "internal error: the mesh failed its closure check "
+           "(%ld boundary, %ld non-manifold edges, %ld non-manifold "
+           "vertices); nothing was written", ck->boundary_edges,
+           ck->nonmanifold_edges, ck->nonmanifold_verts);
+  return MESH_EINTERNAL;
+}
+
 static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
                     Mesh **out, MeshReport *rep, int *bad_node, char *err,
                     size_t errlen, int sharp, hmap *force) {
@@ -2929,15 +2940,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   if (cr != 0) {
     mesh_free(me);
     mesh_free(made);
-    if (cr == -2) {
-      rc = MESH_ENOMEM;
-      goto done;
-    }
-    snprintf(err, errlen, "internal error: the mesh failed its closure check "
-             "(%ld boundary, %ld non-manifold edges, %ld non-manifold "
-             "vertices); nothing was written", ck.boundary_edges,
-             ck.nonmanifold_edges, ck.nonmanifold_verts);
-    rc = MESH_EINTERNAL;
+    rc = closure_failed(cr, &ck, err, errlen);
     goto done;
   }
   rep->components = ck.components;
@@ -2958,15 +2961,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     cr = mesh_check(me, &ck);
     if (cr != 0) {
       mesh_free(me);
-      if (cr == -2) {
-        rc = MESH_ENOMEM;
-        goto done;
-      }
-      snprintf(err, errlen, "internal error: the mesh failed its closure "
-               "check (%ld boundary, %ld non-manifold edges, %ld non-manifold "
-               "vertices); nothing was written", ck.boundary_edges,
-               ck.nonmanifold_edges, ck.nonmanifold_verts);
-      rc = MESH_EINTERNAL;
+      rc = closure_failed(cr, &ck, err, errlen);
       goto done;
     }
     rep->components = ck.components;

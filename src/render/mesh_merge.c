@@ -73,15 +73,22 @@ typedef struct {
   size_t *rs;   /* region r's edges: e[rs[r] .. rs[r + 1]) */
 } Bound;
 
-/* The vertex after a on region r's boundary, or -1. */
-static int next_on(const Bound *B, int r, int a) {
+/* Index of region r's boundary edge leaving a, or -1 (binary search: the
+   edges are sorted by region, then by a). */
+static long edge_at(const Bound *B, int r, int a) {
   size_t lo = B->rs[r], hi = B->rs[r + 1];
   while (lo < hi) {
     size_t mid = lo + (hi - lo) / 2;
     if (B->e[mid].a < a) lo = mid + 1;
     else hi = mid;
   }
-  return lo < B->rs[r + 1] && B->e[lo].a == a ? B->e[lo].b : -1;
+  return lo < B->rs[r + 1] && B->e[lo].a == a ? (long)lo : -1;
+}
+
+/* The vertex after a on region r's boundary, or -1. */
+static int next_on(const Bound *B, int r, int a) {
+  long k = edge_at(B, r, a);
+  return k < 0 ? -1 : B->e[k].b;
 }
 
 /* ---- ear clipping in a plane, exact signs ------------------------------ */
@@ -383,17 +390,6 @@ static int grow_ints(int **p, size_t *cap, size_t need) {
   *p = q;
   *cap = c;
   return 0;
-}
-
-/* Index of region r's boundary edge leaving a (as next_on), or -1. */
-static long edge_at(const Bound *B, int r, int a) {
-  size_t lo = B->rs[r], hi = B->rs[r + 1];
-  while (lo < hi) {
-    size_t mid = lo + (hi - lo) / 2;
-    if (B->e[mid].a < a) lo = mid + 1;
-    else hi = mid;
-  }
-  return lo < B->rs[r + 1] && B->e[lo].a == a ? (long)lo : -1;
 }
 
 typedef struct {
