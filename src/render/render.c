@@ -427,11 +427,15 @@ typedef struct RaySlab {
 
 static void ray_slab(RaySlab *r, const double o[3], const double d[3]) {
   r->o = o;
+  int any = 0;   /* from registers: reading flat[] back as one word right
+                    after its byte stores stalls store forwarding */
   for (int k = 0; k < 3; k++) {
+    int f = !(fabs(d[k]) > 0);
     r->inv[k] = 1 / d[k];
-    r->flat[k] = !(fabs(d[k]) > 0);
+    r->flat[k] = (unsigned char)f;
+    any |= f;
   }
-  r->any_flat = r->flat[0] || r->flat[1] || r->flat[2];
+  r->any_flat = (unsigned char)any;
 }
 
 /* Slab test: the part of [t0, t1] inside the box, its start in *enter.
@@ -1009,19 +1013,27 @@ static inline __attribute__((always_inline)) int
 trace(const Tracer *T, const double o[3], const double d[3],
                  double t0, double t1, RayCtx *c, Hit *best, int any,
                  const TileCull *tc, int self) {
-  int found = 0;
+  /* Hits go to *cur, one of *best and tmp (a primitive may write there
+     and then miss), and the other becomes cur: at most one copy a ray,
+     none when the nearest hit is the first. Copying each hit as found
+     read the fields back whole right after their stores, which stalls
+     store forwarding (a 48-byte rep movs on most primary rays). */
+  Hit tmp, *cur = best, *won = NULL;
   c->tapes = tc ? tc->tape : NULL;
+#define TRACE_WON                            \
+  do {                                       \
+    won = cur;                               \
+    cur = cur == best ? &tmp : best;         \
+    t1 = won->t;                             \
+  } while (0)
   for (int i = 0; i < T->nunbounded; i++) {
-    Hit h;
     int pi = T->unbounded[i], node = T->prims[pi].node;
     const ScNode *n = &T->s->nodes[node];
     if (n->kind == SC_HALFSPACE
-            ? halfspace_hit(n, node, pi, o, d, t0, t1, &h)
-            : prim_hit(T, pi, o, d, t0, t1, c, &h,
+            ? halfspace_hit(n, node, pi, o, d, t0, t1, cur)
+            : prim_hit(T, pi, o, d, t0, t1, c, cur,
                        any && pi == self ? 2 : any)) {
-      *best = h;
-      t1 = h.t;
-      found = 1;
+      TRACE_WON;
       if (any) goto out;
     }
   }
@@ -1032,12 +1044,9 @@ trace(const Tracer *T, const double o[3], const double d[3],
     int pi = T->bounded[tc->one];
     const Box *pb = &T->prims[pi].box;
     double e2;
-    Hit h;
     if (slab_hit(pb->lo, pb->hi, &rs, t0, t1, &e2) &&
-        prim_hit(T, pi, o, d, t0, t1, c, &h, any && pi == self ? 2 : any)) {
-      *best = h;
-      found = 1;
-    }
+        prim_hit(T, pi, o, d, t0, t1, c, cur, any && pi == self ? 2 : any))
+      TRACE_WON;
     goto out;
   }
   int stack[BVH_STACK], sp = 0;   /* enough for any tree (core/bvh.h) */
@@ -1055,11 +1064,8 @@ trace(const Tracer *T, const double o[3], const double d[3],
         const Box *pb = &T->prims[pi].box;
         double e2;
         if (!slab_hit(pb->lo, pb->hi, &rs, t0, t1, &e2)) continue;
-        Hit h;
-        if (prim_hit(T, pi, o, d, t0, t1, c, &h, any && pi == self ? 2 : any)) {
-          *best = h;
-          t1 = h.t;
-          found = 1;
+        if (prim_hit(T, pi, o, d, t0, t1, c, cur, any && pi == self ? 2 : any)) {
+          TRACE_WON;
           if (any) goto out;
         }
       }
@@ -1085,8 +1091,10 @@ trace(const Tracer *T, const double o[3], const double d[3],
     }
   }
 out:
+#undef TRACE_WON
   c->tapes = NULL;
-  return found;
+  if (won == &tmp) *best = tmp;
+  return won != NULL;
 }
 
 static long ray_work(const RayCtx *c) {
@@ -1236,6 +1244,21 @@ static inline double sample_off(int s, int g) {
    its colour (unless it missed and the picture has alpha), whether it hit,
    and the depth and normal AOVs from the central sample. The tiled and
    the untiled paths both use it, so they fill pixels alike. */
+/* *p as one scalar load. rgb and nrm are stored a component at a time
+   by shade_hit just before add_sample reads them; read as one 16-byte
+   vector (what the compiler makes of the sums) they stall store
+   forwarding, about 12 cycles a sample. The empty asm keeps each value
+   its own register, so its load stays a scalar one. */
+static inline double scalar_load(const double *p) {
+  double v = *p;
+#if defined(__x86_64__) || defined(__i386__)
+  __asm__("" : "+x"(v));
+#elif defined(__aarch64__)
+  __asm__("" : "+w"(v));
+#endif
+  return v;
+}
+
 static inline void add_sample(Worker *W, long work, const double rgb[3],
                               double z, const double nrm[3], int central,
                               double sum[3], int *hits, double *zmin,
@@ -1243,10 +1266,10 @@ static inline void add_sample(Worker *W, long work, const double rgb[3],
   if (work > W->max_work) W->max_work = work;
   if (z < INFINITY) (*hits)++;
   if (z < INFINITY || !W->T->rs->alpha)
-    for (int i = 0; i < 3; i++) sum[i] += rgb[i];
+    for (int i = 0; i < 3; i++) sum[i] += scalar_load(&rgb[i]);
   if (central) {
     *zmin = z;
-    memcpy(nrm0, nrm, 3 * sizeof *nrm0);
+    for (int i = 0; i < 3; i++) nrm0[i] = scalar_load(&nrm[i]);
   }
 }
 
