@@ -1093,7 +1093,14 @@ trace(const Tracer *T, const double o[3], const double d[3],
 out:
 #undef TRACE_WON
   c->tapes = NULL;
-  if (won == &tmp) *best = tmp;
+  if (won == &tmp) { /* by fields: a struct copy here is a rep movs */
+    best->t = tmp.t;
+    best->prim = tmp.prim;
+    best->id = tmp.id;
+    best->flip = tmp.flip;
+    best->has_grad = tmp.has_grad;
+    if (tmp.has_grad) memcpy(best->grad, tmp.grad, sizeof tmp.grad);
+  }
   return won != NULL;
 }
 
