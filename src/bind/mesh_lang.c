@@ -46,6 +46,12 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "be lost or closed there (the first at (%.6g, %.6g, %.6g))\n",
             r->two, r->two_side, r->h / r->two_side, r->two_at[0],
             r->two_at[1], r->two_at[2]);
+  if (r->sharp_apart && !r->sharp_off)
+    fprintf(f, "  sharp cells given up locally: %ld about a crack or a "
+            "self-intersection that two sharp cells left between them were "
+            "meshed again by their tetrahedra (their edges there within the "
+            "tolerance, not exact); the other sharp cells were kept\n",
+            r->sharp_apart);
   if (r->sharp_off == 1)
     fprintf(f, "  sharp cells given up: two of them decided a degenerate "
             "case apart; the mesh was made again without them\n");

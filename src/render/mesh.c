@@ -36,6 +36,11 @@ static Mesh *mesh_copy(const Mesh *m);
 
 /* mesh_run's answer: mesh again (cover_check split cells) */
 #define MESH_RECOVER 100
+/* mesh_run's answer: mesh again, the sharp cells at a crack or a
+   self-intersection meshed by their tetrahedra (sharp_apart) */
+#define MESH_RESHARP 101
+/* Times mesh_scene meshes again so (then every sharp cell is given up) */
+#define RESHARP_TRIES 6
 
 /* ---- a hash map from 64-bit keys to ints ------------------------------ */
 
@@ -641,6 +646,11 @@ typedef struct {
   hmap *force;             /* (level, cell) -> 1 for cells that must split:
                               the surface in them was not proven within
                               the tolerance of the mesh (cover_check) */
+  hmap *plainc;            /* (level, cell) -> 1 for cells, and their
+                              parts, meshed by their tetrahedra's
+                              crossings rather than exactly: two sharp
+                              cells left a crack between them there
+                              (sharp_apart) */
   hmap two_near;           /* near_two's table */
   hmap ring;               /* cover_check: finest cells whose leaves split */
   hmap pt;                 /* point (doubled finest coordinates) -> index */
@@ -1038,6 +1048,16 @@ static int resolvable(Mesher *m, const double lo[3], const double hi[3],
   return 1;
 }
 
+/* Whether the cell (level, q) is in m->plainc (2) or a cell holding it
+   is (1), or neither (0). */
+static int plain_cell_set(const Mesher *m, int level, const uint32_t q[3]) {
+  if (!m->plainc || !m->plainc->n) return 0;
+  for (int up = 0; up <= level; up++)
+    if (hget(m->plainc, ckey(level - up, q[0] >> up, q[1] >> up, q[2] >> up)) >= 0)
+      return up ? 1 : 2;
+  return 0;
+}
+
 /* Classify the cell (i, j, k) of the level (in units of its side) and
    either drop it (proven empty or full), keep it as a surface leaf, or
    split it. A leaf is kept above the finest level when its error is
@@ -1112,7 +1132,9 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
       }
     }
   }
-  if (c == T_PL && clip_in && m->sharp) {
+  int pset = c == T_PL && clip_in && m->sharp ? plain_cell_set(m, level, q) : 0;
+  if (pset == 2) m->rep->sharp_apart++;
+  if (c == T_PL && clip_in && m->sharp && !pset) {
     /* the distinct planes of the undecided halfspaces */
     int f = m->s->nodes[m->node].first, n0 = (int)m->npls, n = 0;
     for (int x = f; x <= m->node && n <= PL_MAX; x++) {
@@ -2349,12 +2371,87 @@ static void push_through(Mesh *me) {
   }
 }
 
+/* The sharp cells (LEAF_EXACT) whose box, grown by a finest cell on
+   every side, holds p go to m->plainc. The count added, or -1 out of
+   memory. */
+static int plain_at(Mesher *m, const double p[3]) {
+  double g = ldexp(m->h, m->depth - m->fine);
+  int added = 0;
+  for (size_t l = 0; l < m->nleaves; l++) {
+    const Leaf *lf = &m->leaves[l];
+    if (lf->kind != LEAF_EXACT) continue;
+    double side = ldexp(m->h, m->depth - lf->level);
+    int in = 1;
+    for (int a = 0; a < 3 && in; a++) {
+      double lo = m->org[a] + side * lf->q[a];
+      in = p[a] >= lo - g && p[a] <= lo + side + g;
+    }
+    uint64_t k = ckey(lf->level, lf->q[0], lf->q[1], lf->q[2]);
+    if (!in || hget(m->plainc, k) >= 0) continue;
+    if (hput(m->plainc, k, 1) < 0) return -1;
+    added++;
+  }
+  return added;
+}
+
+/* Two sharp cells can decide a degenerate case apart (a crease point on
+   the face between them placed by each its own way: a crack), or a fan
+   of a crease path can reach past its tetrahedron (a self-intersection).
+   The sharp cells about such a place are then meshed again by their
+   tetrahedra's crossings (m->plainc) and the rest stay sharp. For the
+   closure check's failure (sc NULL), the places are the midpoints of
+   the edges not used once each way; for the self-intersection check's,
+   the first pair's box centre and its two triangles' centroids. The
+   count of cells added (0: nothing to do here), or -1 out of memory. */
+static int sharp_apart(Mesher *m, const Mesh *me, const MeshSelfCheck *sc) {
+  int added = 0, r;
+  if (sc) {
+    if ((r = plain_at(m, sc->at)) < 0) return -1;
+    added += r;
+    for (int k = 0; k < 2; k++) {
+      double c[3] = {0, 0, 0};
+      for (int v = 0; v < 3; v++)
+        for (int a = 0; a < 3; a++)
+          c[a] += me->v[3 * (size_t)me->t[3 * sc->tri[k] + (size_t)v] + (size_t)a] / 3;
+      if ((r = plain_at(m, c)) < 0) return -1;
+      added += r;
+    }
+    return added;
+  }
+  hmap e = {0};   /* directed edge (a << 32 | b) -> its count */
+  for (size_t t = 0; t < me->nt; t++)
+    for (int k = 0; k < 3; k++) {
+      uint64_t a = (uint32_t)me->t[3 * t + (size_t)k],
+               b = (uint32_t)me->t[3 * t + (size_t)(k + 1) % 3];
+      int c = hget(&e, a << 32 | b);
+      if (hput(&e, a << 32 | b, c < 0 ? 1 : c + 1) < 0) goto oom;
+    }
+  for (size_t t = 0; t < me->nt; t++)
+    for (int k = 0; k < 3; k++) {
+      uint64_t a = (uint32_t)me->t[3 * t + (size_t)k],
+               b = (uint32_t)me->t[3 * t + (size_t)(k + 1) % 3];
+      if (hget(&e, a << 32 | b) == 1 && hget(&e, b << 32 | a) == 1) continue;
+      double mid[3];
+      for (int x = 0; x < 3; x++)
+        mid[x] = 0.5 * (me->v[3 * a + (uint64_t)x] + me->v[3 * b + (uint64_t)x]);
+      if ((r = plain_at(m, mid)) < 0) goto oom;
+      added += r;
+    }
+  hfree(&e);
+  return added;
+oom:
+  hfree(&e);
+  return -1;
+}
+
 /* No two triangles meet other than in what they share, checked exactly
-   (mesh_check.c); else *rc is set and the error names the place. */
+   (mesh_check.c); else *rc is set and the error names the place (the
+   check's answer in *out, if out is not NULL). */
 static int self_check(const Mesh *me, MeshReport *rep, char *err,
-                      size_t errlen, int *rc) {
+                      size_t errlen, int *rc, MeshSelfCheck *out) {
   MeshSelfCheck sc;
   int r = mesh_self_check(me, &sc);
+  if (out) *out = sc;
   rep->pairs = sc.pairs;
   rep->pairs_exact = sc.exact;
   rep->check_seconds = sc.seconds;
@@ -2664,7 +2761,7 @@ static int closure_failed(int cr, const MeshCheck *ck, char *err, size_t errlen)
 
 static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
                     Mesh **out, MeshReport *rep, int *bad_node, char *err,
-                    size_t errlen, int sharp, hmap *force) {
+                    size_t errlen, int sharp, hmap *force, hmap *plainc) {
   struct timespec t0, t1;
   clock_gettime(CLOCK_MONOTONIC, &t0);
   MeshReport keep = *rep;
@@ -2739,6 +2836,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.vtol = vtol;
   m.sharp = sharp && !ms->uniform;
   m.force = force;
+  m.plainc = plainc;
   m.uniform = ms->uniform;
   m.rep = rep;
   m.max_cells = ms->max_cells ? ms->max_cells : (size_t)1 << 24;
@@ -2938,16 +3036,19 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     cr = mesh_check(me, &ck);
   }
   if (cr != 0) {
+    int sa = cr == -1 && m.sharp && m.plainc ? sharp_apart(&m, me, NULL) : 0;
     mesh_free(me);
     mesh_free(made);
-    rc = closure_failed(cr, &ck, err, errlen);
+    rc = sa < 0 ? MESH_ENOMEM : closure_failed(cr, &ck, err, errlen);
+    if (sa > 0) rc = MESH_RESHARP;
     goto done;
   }
   rep->components = ck.components;
   rep->euler = ck.euler;
   if (me->nv && (test_fault == 2 || (test_fault == 1 && sharp)))
     push_through(me);
-  int sr = self_check(me, rep, err, errlen, &rc);
+  MeshSelfCheck sck;
+  int sr = self_check(me, rep, err, errlen, &rc, &sck);
   if (sr != 0 && made && rc == MESH_ESELF) {
     /* the mesh as made, checked for closure and self-intersection in
        its turn */
@@ -2960,18 +3061,24 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     err[0] = 0;
     cr = mesh_check(me, &ck);
     if (cr != 0) {
+      int sa = cr == -1 && m.sharp && m.plainc ? sharp_apart(&m, me, NULL) : 0;
       mesh_free(me);
-      rc = closure_failed(cr, &ck, err, errlen);
+      rc = sa < 0 ? MESH_ENOMEM : closure_failed(cr, &ck, err, errlen);
+      if (sa > 0) rc = MESH_RESHARP;
       goto done;
     }
     rep->components = ck.components;
     rep->euler = ck.euler;
-    sr = self_check(me, rep, err, errlen, &rc);
+    sr = self_check(me, rep, err, errlen, &rc, &sck);
   }
   mesh_free(made);
   made = NULL;
   if (sr != 0) {
+    int sa = sr == 1 && rc == MESH_ESELF && m.sharp && m.plainc && rep->sharp
+                 ? sharp_apart(&m, me, &sck) : 0;
     mesh_free(me);
+    if (sa < 0) rc = MESH_ENOMEM;
+    if (sa > 0) rc = MESH_RESHARP;
     goto done;
   }
   rep->flat_regions = mm.regions;
@@ -3554,7 +3661,7 @@ int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
    (cover_check; at most COVER_ROUNDS times). */
 static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
                        Mesh **out, MeshReport *rep, int *bad_node, char *err,
-                       size_t errlen, int sharp, hmap *force) {
+                       size_t errlen, int sharp, hmap *force, hmap *plainc) {
   double t = 0;
   int rc;
   Mesh *prev = NULL;
@@ -3562,7 +3669,8 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
   MeshCheck pck = {0};
   for (;;) {
     rep->cover_last = rep->cover_rounds >= COVER_ROUNDS;
-    rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, sharp, force);
+    rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, sharp, force,
+                  plainc);
     t += rep->seconds;
     if (prev) {
       /* a round is kept only when it proved more of the surface and left
@@ -3617,21 +3725,39 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
 
 int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
                MeshReport *rep, int *bad_node, char *err, size_t errlen) {
-  hmap force = {0};
+  hmap force = {0}, plainc = {0};
   memset(rep, 0, sizeof *rep);
-  int rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 1, &force);
+  /* sharp cells about a crack or a self-intersection meshed by their
+     tetrahedra and the rest kept (sharp_apart), a few times; then every
+     sharp cell given up */
+  double t0 = 0;
+  int rc, tries = 0;
+  for (;;) {
+    rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 1, &force,
+                     &plainc);
+    if (rc != MESH_RESHARP) break;
+    t0 += rep->seconds;
+    if (++tries == RESHARP_TRIES) {
+      rc = MESH_EINTERNAL;
+      break;
+    }
+    memset(rep, 0, sizeof *rep);
+  }
+  if (rc != MESH_EINTERNAL && rc != MESH_ESELF) rep->seconds += t0;
   if (rc == MESH_EINTERNAL || (rc == MESH_ESELF && rep->sharp)) {
     /* a degenerate case decided differently by two sharp cells, or a fan
        of a crease path reaching past its tetrahedron: the marching cells
        alone are closed by construction, each triangle in its own
        tetrahedron */
-    double t = rep->seconds;
+    double t = rep->seconds + t0;
     int why = rc == MESH_ESELF ? 2 : 1;
-    rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 0, &force);
+    rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 0, &force,
+                     &plainc);
     rep->seconds += t;
     rep->sharp_off = why;
   }
   hfree(&force);
+  hfree(&plainc);
   if (rc == MESH_ENOMEM) snprintf(err, errlen, "out of memory while meshing");
   return rc;
 }

@@ -58,8 +58,10 @@
  * then self-intersection, exactly (mesh_check.h: every pair of triangles
  * whose boxes overlap, by exact orientation predicates); a failure of
  * either with sharp cells (two of them deciding a degenerate case apart,
- * or a crease fan reaching through a neighbour) remakes the mesh without
- * them (MeshReport.sharp_off), and that mesh is checked again.
+ * or a crease fan reaching through a neighbour) remakes the mesh with
+ * the sharp cells about the place meshed by their tetrahedra
+ * (MeshReport.sharp_apart), up to six times, then without any sharp cell
+ * (MeshReport.sharp_off); every mesh is checked again.
  *
  * Memory: mesh_scene mallocs the mesh (mesh_free). Nothing here prints.
  * The scene is only read. */
@@ -102,6 +104,10 @@ typedef struct MeshReport {
   long sharp;              /* of them meshed exactly: the solid there is a
                               CSG of at most 8 planes (edges and corners
                               kept) */
+  long sharp_apart;        /* sharp cells meshed by their tetrahedra's
+                              crossings instead, where two sharp cells
+                              left a crack or a self-intersection between
+                              them (the rest stay sharp; see mesh.c) */
   int sharp_off;           /* sharp cells were given up (see mesh.c): 1
                               closure failed with them, 2 the mesh made
                               with them intersected itself */
