@@ -85,8 +85,9 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           r->cover_colcells, r->cover_columns, r->cover_boxes, r->cover_seconds);
   if (r->cover_rounds && !r->cover_kept)
     fprintf(f, "; meshed %d more time%s, %ld cells split where it was not "
-            "proven", r->cover_rounds, r->cover_rounds == 1 ? "" : "s",
-            r->cover_split);
+            "proven%s", r->cover_rounds, r->cover_rounds == 1 ? "" : "s",
+            r->cover_split, r->cover_wide ? ", beside cells with two "
+            "surfaces too" : "");
   else if (r->cover_rounds)
     fprintf(f, "; meshed %d more time%s with the cells not proven split "
             "(%ld in the last), the last not kept: it proved no more, or "

@@ -31,6 +31,8 @@
 /* Failing cells within this many finest cells of a cell with two surfaces
    not proven one sheet together are not split for the cover proof. */
 #define NEAR_TWO 2
+/* ... unless at most this many are left and no others (cover_check) */
+#define WIDE_MAX 64
 
 static Mesh *mesh_copy(const Mesh *m);
 
@@ -2704,20 +2706,33 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
      opened in a split cell and not in the cell beside it is pinched at
      their face, which makes tunnels (seed 207 at 0.03: Euler
      characteristic -2 for 2 with the failing cells alone split) */
-  for (size_t i = 0; i < n && !m->uniform; i++) {
-    const Leaf *lf = &m->leaves[ix[i]];
-    if (!bad[i] || lf->level >= m->depth) continue;
-    int nt = near_two(m, lf, 1);
-    if (nt < 0) goto done;
-    if (nt) continue;
-    int64_t lo[3], hi[3];
-    fine_range(m, lf, lo, hi);
-    for (int64_t a = lo[0] - 1; a <= hi[0] + 1; a++)
-      for (int64_t b = lo[1] - 1; b <= hi[1] + 1; b++)
-        for (int64_t c = lo[2] - 1; c <= hi[2] + 1; c++)
-          if (a >= 0 && b >= 0 && c >= 0 &&
-              hput(&m->ring, ckey(m->fine, (uint64_t)a, (uint64_t)b, (uint64_t)c), 1) < 0)
-            goto done;
+  /* When the failing cells left are all beside such cells and few
+     (WIDE_MAX), they are split too, from then on (MeshReport.cover_wide):
+     a round that opens a groove in places and closes it between is not
+     kept (mesh_rounds), and few cells cost one round, where figure12's
+     obj5 at 0.0015 (thousands of them) took 3 times the time */
+  long skipped = 0;
+  for (int pass = 0; pass < 2; pass++) {
+    for (size_t i = 0; i < n && !m->uniform; i++) {
+      const Leaf *lf = &m->leaves[ix[i]];
+      if (!bad[i] || lf->level >= m->depth) continue;
+      int nt = rep->cover_wide ? 0 : near_two(m, lf, 1);
+      if (nt < 0) goto done;
+      if (nt) {
+        skipped++;
+        continue;
+      }
+      int64_t lo[3], hi[3];
+      fine_range(m, lf, lo, hi);
+      for (int64_t a = lo[0] - 1; a <= hi[0] + 1; a++)
+        for (int64_t b = lo[1] - 1; b <= hi[1] + 1; b++)
+          for (int64_t c = lo[2] - 1; c <= hi[2] + 1; c++)
+            if (a >= 0 && b >= 0 && c >= 0 &&
+                hput(&m->ring, ckey(m->fine, (uint64_t)a, (uint64_t)b, (uint64_t)c), 1) < 0)
+              goto done;
+    }
+    if (m->ring.n || !skipped || skipped > WIDE_MAX) break;
+    rep->cover_wide = 1;
   }
   for (size_t l = 0; m->ring.n && l < m->nleaves; l++) {
     const Leaf *lf = &m->leaves[l];
@@ -2772,6 +2787,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   rep->cover_boxes = keep.cover_boxes;
   rep->cover_columns = keep.cover_columns;
   rep->cover_seconds = keep.cover_seconds;
+  rep->cover_wide = keep.cover_wide;
   *out = NULL;
   *bad_node = -1;
   double lo[3], hi[3];

@@ -159,6 +159,9 @@ typedef struct MeshReport {
   long cover_split;        /* cells split for the proof in the last round
                               meshed (kept or not) */
   int cover_last;          /* this round is the last (mesh.c, mesh_rounds) */
+  int cover_wide;          /* the cells not proven beside cells with two
+                              surfaces were split too (few were left and
+                              no others: mesh.c, cover_check) */
   int cover_kept;          /* the last round was not kept (it proved no
                               more, or changed the topology, or failed):
                               the mesh is the round's before */
