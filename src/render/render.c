@@ -1109,11 +1109,23 @@ static long ray_work(const RayCtx *c) {
 }
 
 /* One camera sample of a tile, between its two passes. */
+/* The lights' part of a camera sample's shading, between its shadow rays
+   and its colour (shade_geom, shade_colour). */
+typedef struct Lit {
+  const double *col;             /* the primitive's colour; NULL: missed */
+  double n[3];                   /* the normal, facing the ray */
+  double L[RENDER_MAX_LIGHTS][3];/* towards light l, unit length */
+  double ndl[RENDER_MAX_LIGHTS]; /* n . L */
+  unsigned char lit[RENDER_MAX_LIGHTS]; /* light l reaches the point */
+} Lit;
+
 typedef struct Sample {
   Hit h;
   double d[3];
-  long work;                  /* the primary ray's (ray_work) */
+  long work;                  /* the primary ray's (ray_work), then its
+                                 shadow rays' added */
   int found;
+  double z, nrm[3];           /* its AOVs (shade_geom) */
 } Sample;
 
 typedef struct Worker {
@@ -1125,6 +1137,7 @@ typedef struct Worker {
   TileCull tc;                /* the current tile's primary rays' */
   TileCull sh[RENDER_MAX_LIGHTS]; /* its shadow rays', per light */
   Sample *samples;            /* CULL_BLOCK^2 x grid^2 */
+  Lit *lits;                  /* their shade_geom, as many */
 } Worker;
 
 /* The primary ray of one camera sample: its hit, if any (counted). */
@@ -1144,17 +1157,19 @@ primary_hit(Worker *W, const double o[3], const double d[3], Hit *h,
   return 1;
 }
 
-/* A camera sample's radiance from its primary hit h (found, else the
-   background), and for the AOVs the hit's distance and normal; sh[l]:
-   the culling of shadow rays towards light l, or NULL. */
-static inline void shade_hit(Worker *W, const double o[3], const double d[3],
-                      int found, const Hit *hp, double rgb[3], double *z,
-                      double nrm[3], const TileCull *const *sh) {
+
+/* A camera sample's geometry from its primary hit h (found, else the
+   background): for the AOVs the hit's distance and normal, and in *lt
+   what shade_colour needs, its shadow rays traced; sh[l]: the culling of
+   shadow rays towards light l, or NULL. */
+static inline void shade_geom(Worker *W, const double o[3], const double d[3],
+                              int found, const Hit *hp, Lit *lt, double *z,
+                              double nrm[3], const TileCull *const *sh) {
   const Tracer *T = W->T;
   RayCtx *c = W->c;
   const RenderSettings *rs = T->rs;
   if (!found) {
-    memcpy(rgb, rs->background, 3 * sizeof(double));
+    lt->col = NULL;
     *z = INFINITY;
     nrm[0] = nrm[1] = nrm[2] = 0;
     return;
@@ -1171,13 +1186,14 @@ static inline void shade_hit(Worker *W, const double o[3], const double d[3],
     for (int i = 0; i < 3; i++) n[i] = -n[i];
   *z = hp->t; /* d is unit length: t is the distance */
   memcpy(nrm, n, sizeof n);
-  const double *col = T->prims[hp->prim].colour;
-  for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
+  memcpy(lt->n, n, sizeof n);
+  lt->col = T->prims[hp->prim].colour;
   double pp = sqrt(vec3_dot(p, p));   /* fmax(1, pp) without a libm call */
   double scale = isnan(pp) || 1.0 > pp ? 1.0 : pp;
   double eps = T->eps * scale;
   for (int l = 0; l < T->nlights; l++) {
-    double L[3];
+    double *L = lt->L[l];
+    lt->lit[l] = 0;
     for (int i = 0; i < 3; i++) L[i] = T->lights[l][i] - p[i];
     double dist = sqrt(vec3_dot(L, L));
     if (!(dist > 0)) continue;
@@ -1192,6 +1208,27 @@ static inline void shade_hit(Worker *W, const double o[3], const double d[3],
       if (trace(T, so, L, 0, dist, c, &shh, 1, sh ? sh[l] : NULL, hp->prim))
         continue;
     }
+    lt->ndl[l] = ndl;
+    lt->lit[l] = 1;
+  }
+}
+
+/* The sample's radiance from shade_geom's *lt (d: its ray). Apart from
+   the tracing, so that a block's samples' colours are one loop of
+   independent arithmetic (its square roots and divisions overlap). */
+static inline void shade_colour(const Tracer *T, const double d[3],
+                                const Lit *lt, double rgb[3]) {
+  const RenderSettings *rs = T->rs;
+  if (!lt->col) {
+    memcpy(rgb, rs->background, 3 * sizeof(double));
+    return;
+  }
+  const double *col = lt->col, *n = lt->n;
+  for (int i = 0; i < 3; i++) rgb[i] = rs->ambient * col[i];
+  for (int l = 0; l < T->nlights; l++) {
+    if (!lt->lit[l]) continue;
+    const double *L = lt->L[l];
+    double ndl = lt->ndl[l];
     double H[3] = {L[0] - d[0], L[1] - d[1], L[2] - d[2]};
     double hl = sqrt(vec3_dot(H, H));
     double spec = 0;
@@ -1205,6 +1242,17 @@ static inline void shade_hit(Worker *W, const double o[3], const double d[3],
     double I = T->intensity[l];
     for (int i = 0; i < 3; i++) rgb[i] += I * (col[i] * ndl + spec);
   }
+}
+
+/* A camera sample's radiance from its primary hit h, and its AOVs
+   (shade_geom, then shade_colour). */
+static inline void shade_hit(Worker *W, const double o[3], const double d[3],
+                             int found, const Hit *hp, double rgb[3],
+                             double *z, double nrm[3],
+                             const TileCull *const *sh) {
+  Lit lt;
+  shade_geom(W, o, d, found, hp, &lt, z, nrm, sh);
+  shade_colour(W->T, d, &lt, rgb);
 }
 
 static void progress(Tracer *T) {
@@ -1334,21 +1382,30 @@ tile_culled(Worker *W, int x0, int x1, int y0, int y1, int g) {
         sh[l] = &W->sh[l];
     }
   }
+  /* the shadow rays of every sample, then the colours: one loop of
+     independent arithmetic, no tracing between */
+  size_t ns = (size_t)(x1 - x0) * (size_t)(y1 - y0) * (size_t)g * (size_t)g;
+  for (size_t k = 0; k < ns; k++) {
+    sp = &W->samples[k];
+    long w0 = ray_work(W->c);
+    shade_geom(W, T->cam.eye, sp->d, sp->found, &sp->h, &W->lits[k], &sp->z,
+               sp->nrm, sh);
+    sp->work += ray_work(W->c) - w0;
+  }
   sp = W->samples;
+  const Lit *lt = W->lits;
   for (int y = y0; y < y1; y++)
     for (int x = x0; x < x1; x++) {
       double sum[3] = {0, 0, 0}, zmin = INFINITY, nrm0[3] = {0, 0, 0};
       long cost = 0;
       int hits = 0;
       for (int sy = 0; sy < g; sy++)
-        for (int sx = 0; sx < g; sx++, sp++) {
-          double rgb[3], z, nrm[3];
-          long w0 = ray_work(W->c);
-          shade_hit(W, T->cam.eye, sp->d, sp->found, &sp->h, rgb, &z, nrm, sh);
-          long w = ray_work(W->c) - w0 + sp->work;
-          cost += w;
-          add_sample(W, w, rgb, z, nrm, sx == g / 2 && sy == g / 2, sum,
-                     &hits, &zmin, nrm0);
+        for (int sx = 0; sx < g; sx++, sp++, lt++) {
+          double rgb[3];
+          shade_colour(T, sp->d, lt, rgb);
+          cost += sp->work;
+          add_sample(W, sp->work, rgb, sp->z, sp->nrm,
+                     sx == g / 2 && sy == g / 2, sum, &hits, &zmin, nrm0);
         }
       put_pixel(T, g, x, y, sum, hits, zmin, nrm0, cost);
     }
@@ -1718,7 +1775,9 @@ Image *render_scene(const Scene *s, const RenderSettings *rs,
     if (T.tiled) {
       size_t ns = (size_t)CULL_BLOCK * CULL_BLOCK * (size_t)grid * (size_t)grid;
       workers[i].samples = malloc(sizeof *workers[i].samples * ns);
-      if (!workers[i].samples || tile_cull_init(&T, &workers[i].tc, 1))
+      workers[i].lits = malloc(sizeof *workers[i].lits * ns);
+      if (!workers[i].samples || !workers[i].lits ||
+          tile_cull_init(&T, &workers[i].tc, 1))
         goto oom;
       for (int l = 0; l < T.nlights; l++)
         if (tile_cull_init(&T, &workers[i].sh[l], 1)) goto oom;
@@ -1780,6 +1839,7 @@ done:
       tile_cull_free(&workers[i].tc);
       for (int l = 0; l < RENDER_MAX_LIGHTS; l++) tile_cull_free(&workers[i].sh[l]);
       free(workers[i].samples);
+      free(workers[i].lits);
     }
   free(workers);
   free(threads);
