@@ -92,7 +92,8 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
     fprintf(f, "; meshed %d more time%s with the cells not proven split "
             "(%ld in the last), the last not kept: it proved no more, or "
             "changed the components or Euler characteristic (a thin part "
-            "or gap opened in some cells and not beside them)",
+            "or gap opened in some cells and not beside them), or failed "
+            "its checks",
             r->cover_rounds, r->cover_rounds == 1 ? "" : "s", r->cover_split);
   fprintf(f, ")\n");
   fprintf(f, "  crossings: %ld by ray spans, %ld by bisection\n",

@@ -2716,7 +2716,7 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
     for (size_t i = 0; i < n && !m->uniform; i++) {
       const Leaf *lf = &m->leaves[ix[i]];
       if (!bad[i] || lf->level >= m->depth) continue;
-      int nt = rep->cover_wide ? 0 : near_two(m, lf, 1);
+      int nt = rep->cover_wide_next ? 0 : near_two(m, lf, 1);
       if (nt < 0) goto done;
       if (nt) {
         skipped++;
@@ -2732,7 +2732,7 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
               goto done;
     }
     if (m->ring.n || !skipped || skipped > WIDE_MAX) break;
-    rep->cover_wide = 1;
+    rep->cover_wide_next = 1;
   }
   for (size_t l = 0; m->ring.n && l < m->nleaves; l++) {
     const Leaf *lf = &m->leaves[l];
@@ -2787,7 +2787,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   rep->cover_boxes = keep.cover_boxes;
   rep->cover_columns = keep.cover_columns;
   rep->cover_seconds = keep.cover_seconds;
-  rep->cover_wide = keep.cover_wide;
+  /* the cells split for this round were chosen wide (cover_check) */
+  rep->cover_wide = rep->cover_wide_next = keep.cover_wide_next;
   *out = NULL;
   *bad_node = -1;
   double lo[3], hi[3];
@@ -3056,7 +3057,10 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     mesh_free(me);
     mesh_free(made);
     rc = sa < 0 ? MESH_ENOMEM : closure_failed(cr, &ck, err, errlen);
-    if (sa > 0) rc = MESH_RESHARP;
+    if (sa > 0) {
+      rc = MESH_RESHARP;
+      rep->resharp = 1;
+    }
     goto done;
   }
   rep->components = ck.components;
@@ -3080,7 +3084,10 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
       int sa = cr == -1 && m.sharp && m.plainc ? sharp_apart(&m, me, NULL) : 0;
       mesh_free(me);
       rc = sa < 0 ? MESH_ENOMEM : closure_failed(cr, &ck, err, errlen);
-      if (sa > 0) rc = MESH_RESHARP;
+      if (sa > 0) {
+        rc = MESH_RESHARP;
+        rep->resharp = 1;
+      }
       goto done;
     }
     rep->components = ck.components;
@@ -3090,11 +3097,14 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   mesh_free(made);
   made = NULL;
   if (sr != 0) {
-    int sa = sr == 1 && rc == MESH_ESELF && m.sharp && m.plainc && rep->sharp
+    int sa = rc == MESH_ESELF && m.sharp && m.plainc && rep->sharp
                  ? sharp_apart(&m, me, &sck) : 0;
     mesh_free(me);
     if (sa < 0) rc = MESH_ENOMEM;
-    if (sa > 0) rc = MESH_RESHARP;
+    if (sa > 0) {
+      rc = MESH_RESHARP;
+      rep->resharp = 2;
+    }
     goto done;
   }
   rep->flat_regions = mm.regions;
@@ -3679,7 +3689,7 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
                        Mesh **out, MeshReport *rep, int *bad_node, char *err,
                        size_t errlen, int sharp, hmap *force, hmap *plainc) {
   double t = 0;
-  int rc;
+  int rc, resharp = 0;
   Mesh *prev = NULL;
   MeshReport prep;
   MeshCheck pck = {0};
@@ -3688,6 +3698,10 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
     rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, sharp, force,
                   plainc);
     t += rep->seconds;
+    /* a crack or a self-intersection in a later round: that round again
+       with the sharp cells about it meshed by their tetrahedra (the
+       first round's go back to mesh_scene) */
+    if (rc == MESH_RESHARP && prev && ++resharp < RESHARP_TRIES) continue;
     if (prev) {
       /* a round is kept only when it proved more of the surface and left
          the mesh's components and Euler characteristic as they were:
@@ -3746,21 +3760,22 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
   /* sharp cells about a crack or a self-intersection meshed by their
      tetrahedra and the rest kept (sharp_apart), a few times; then every
      sharp cell given up */
-  double t0 = 0;
+  double t0 = 0;   /* the tries that failed */
   int rc, tries = 0;
   for (;;) {
     rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 1, &force,
                      &plainc);
     if (rc != MESH_RESHARP) break;
     t0 += rep->seconds;
-    if (++tries == RESHARP_TRIES) {
-      rc = MESH_EINTERNAL;
+    if (++tries == RESHARP_TRIES) { /* the last failure's kind */
+      rc = rep->resharp == 2 ? MESH_ESELF : MESH_EINTERNAL;
+      rep->seconds = 0;
       break;
     }
     memset(rep, 0, sizeof *rep);
   }
-  if (rc != MESH_EINTERNAL && rc != MESH_ESELF) rep->seconds += t0;
-  if (rc == MESH_EINTERNAL || (rc == MESH_ESELF && rep->sharp)) {
+  rep->seconds += t0;
+  if (rc == MESH_EINTERNAL || (rc == MESH_ESELF && (rep->sharp || tries))) {
     /* a degenerate case decided differently by two sharp cells, or a fan
        of a crease path reaching past its tetrahedron: the marching cells
        alone are closed by construction, each triangle in its own

@@ -159,9 +159,13 @@ typedef struct MeshReport {
   long cover_split;        /* cells split for the proof in the last round
                               meshed (kept or not) */
   int cover_last;          /* this round is the last (mesh.c, mesh_rounds) */
-  int cover_wide;          /* the cells not proven beside cells with two
-                              surfaces were split too (few were left and
-                              no others: mesh.c, cover_check) */
+  int cover_wide;          /* this mesh's round split the cells not
+                              proven beside cells with two surfaces too
+                              (few were left and no others: mesh.c,
+                              cover_check) */
+  int cover_wide_next;     /* the next round will (internal) */
+  int resharp;             /* mesh.c's MESH_RESHARP came from a crack (1)
+                              or a self-intersection (2) (internal) */
   int cover_kept;          /* the last round was not kept (it proved no
                               more, or changed the topology, or failed):
                               the mesh is the round's before */
