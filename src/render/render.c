@@ -1108,7 +1108,6 @@ static long ray_work(const RayCtx *c) {
   return c->stats.lg.segments + c->stats.lg.rf_steps + c->stats.soft.intervals;
 }
 
-/* One camera sample of a tile, between its two passes. */
 /* The lights' part of a camera sample's shading, between its shadow rays
    and its colour (shade_geom, shade_colour). */
 typedef struct Lit {
@@ -1119,6 +1118,7 @@ typedef struct Lit {
   unsigned char lit[RENDER_MAX_LIGHTS]; /* light l reaches the point */
 } Lit;
 
+/* One camera sample of a tile, between its two passes. */
 typedef struct Sample {
   Hit h;
   double d[3];
@@ -1156,7 +1156,6 @@ primary_hit(Worker *W, const double o[3], const double d[3], Hit *h,
   }
   return 1;
 }
-
 
 /* A camera sample's geometry from its primary hit h (found, else the
    background): for the AOVs the hit's distance and normal, and in *lt
