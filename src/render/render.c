@@ -1361,14 +1361,19 @@ tile_culled(Worker *W, int x0, int x1, int y0, int y1, int g) {
           long w0 = ray_work(W->c);
           sp->found = primary_hit(W, T->cam.eye, sp->d, &sp->h, tc);
           sp->work = ray_work(W->c) - w0;
-          if (!sp->found) continue;
-          for (int i = 0; i < 3; i++) {
-            double p = T->cam.eye[i] + sp->h.t * sp->d[i];
-            if (p < H.lo[i]) H.lo[i] = p;
-            if (p > H.hi[i]) H.hi[i] = p;
-            if (fabs(p) > pmax) pmax = fabs(p);
-          }
         }
+  /* the hit points' hull, after the tracing: its loop waits on no hit */
+  size_t nsm = (size_t)(x1 - x0) * (size_t)(y1 - y0) * (size_t)g * (size_t)g;
+  for (size_t k = 0; k < nsm; k++) {
+    const Sample *s = &W->samples[k];
+    if (!s->found) continue;
+    for (int i = 0; i < 3; i++) {
+      double p = T->cam.eye[i] + s->h.t * s->d[i];
+      if (p < H.lo[i]) H.lo[i] = p;
+      if (p > H.hi[i]) H.hi[i] = p;
+      if (fabs(p) > pmax) pmax = fabs(p);
+    }
+  }
   /* a shadow ray runs from its hit point moved by eps along the normal
      (shade_hit) to the light moved alike: within eps of the segment from
      the hit point to the light */
