@@ -1347,6 +1347,78 @@ static void hand_meshes(void) {
 
 /* ---- sharp cells kept: the scenes a longer run gave them up in ---------- */
 
+/* Long-run scenes meshed at 0.03 (the property test's generator), each
+   checked by check and then for what every mesh must be: closed and
+   oriented by this file's edge counting with the Euler characteristic
+   the report gives, free of self-intersections by the exact check, and
+   certified within the tolerance. */
+static void long_run_scenes(const char *what, const char *const *objs,
+                            const int *num, size_t n,
+                            void (*check)(const char *, const MeshReport *)) {
+  for (size_t k = 0; k < n; k++) {
+    char name[120], buf[400];
+    snprintf(name, sizeof name, "long run scene %d (%s)", num[k], what);
+    Mesh *m;
+    MeshReport rep;
+    Scene *s = compile_mesh(name, objs[k], 0.03, &m, &rep);
+    if (!s) continue;
+    check(name, &rep);
+    long eu;
+    MeshSelfCheck sc;
+    snprintf(buf, sizeof buf, "%s: closed and oriented by edge counting, Euler "
+             "characteristic %ld as the report says, no self-intersection, "
+             "certified %.4g <= 0.03", name, rep.euler, rep.certified);
+    CHECK(buf, closed_oriented(m, &eu) && eu == rep.euler &&
+                   mesh_self_check(m, &sc) == 0 && rep.certified <= 0.03);
+    mesh_free(m);
+    scene_free(s);
+  }
+}
+
+static void apart_check(const char *name, const MeshReport *rep) {
+  char buf[400];
+  snprintf(buf, sizeof buf, "%s: %ld sharp cells given up locally, %ld kept "
+           "sharp, none given up whole", name, rep->sharp_apart, rep->sharp);
+  CHECK(buf, !rep->sharp_off && rep->sharp_apart > 0 && rep->sharp_apart <= 16 &&
+                 rep->sharp > 0);
+}
+
+/* Long-run scenes 255 and 875, where two sharp cells placed a crease
+   point each its own way (a crack: 5 and 62 boundary edges) and the
+   whole mesh was made again without sharp cells: now only the sharp
+   cells about the crack are (MeshReport.sharp_apart, a few) and the
+   others stay sharp. */
+static void sharp_apart_kept(void) {
+  static const char *objs[] = {
+    /* 255 */ "Union (Union (Rounded 0.13706648229358767 (Rotate \"y\" 57.708 (Shift (-0.136, -0.328, 0.113) (Scale (0.847, 0.805, 0.620) UnitCube)))) (Rotate \"z\" 27.775 (Shift (0.125, 0.192, 0.026) (Scale (0.475, 0.426, 0.402) UnitCube)))) (SoftObject 0.5 [Key (-0.007, -0.146, -0.121) 0.568 1, Key (0.149, -0.425, -0.287) 0.538 1, Key (-0.143, -0.238, 0.327) 0.656 1, Key (0.368, 0.437, -0.243) 0.713 (-1)])",
+    /* 875 */ "SetDifference (Union (Rounded 0.073151740419062791 (Rotate \"y\" 85.649 (Shift (-0.085, 0.318, 0.139) (Scale (0.392, 0.676, 0.845) UnitCube)))) (Rotate \"x\" 59.252 (Shift (0.263, 0.445, -0.450) (Scale (0.812, 0.680, 0.341) UnitCube)))) (SoftObject 0.5 [Key (0.216, -0.308, 0.487) 0.551 1, Key (0.042, -0.178, -0.163) 0.674 1, Key (0.340, -0.158, 0.485) 0.577 1, Key (0.241, -0.231, 0.161) 0.671 (-1)])"};
+  static const int num[] = {255, 875};
+  long_run_scenes("a crack between sharp cells", objs, num, 2, apart_check);
+}
+
+static void wide_check(const char *name, const MeshReport *rep) {
+  char buf[400];
+  snprintf(buf, sizeof buf, "%s: every part proven within the tolerance of "
+           "the mesh (%ld cells not), the last round splitting the cells "
+           "beside two surfaces too", name, rep->cover_unproven);
+  CHECK(buf, rep->cover_unproven == 0 && rep->cover_wide && !rep->cover_kept &&
+                 rep->cover <= 0.03);
+}
+
+/* Long-run scenes 835 and 851: a box, a rounded box and soft keys, where
+   the proof that the surface is within the tolerance of the mesh failed
+   in 8 and 1 cells beside cells with two surfaces (which the rounds leave
+   alone) and the report said so. When those are all that is left (at
+   most 64), one more round splits them too: every part proven (the round
+   is kept only if its topology is the mesh's before it: mesh_rounds). */
+static void cover_wide(void) {
+  static const char *objs[] = {
+    /* 835 */ "SetDifference (Union (Rounded 0.05944437258005722 (Rotate \"z\" 51.936 (Shift (0.269, 0.396, 0.119) (Scale (0.373, 0.448, 0.501) UnitCube)))) (Rotate \"x\" 24.969 (Shift (-0.396, -0.200, -0.148) (Scale (0.812, 0.783, 0.580) UnitCube)))) (SoftObject 0.5 [Key (0.185, 0.335, 0.423) 0.601 1, Key (0.310, 0.172, 0.359) 0.797 1, Key (-0.146, -0.465, 0.158) 0.872 1, Key (0.463, -0.194, 0.031) 0.764 (-1)])",
+    /* 851 */ "SetDifference (Union (Rounded 0.14095049972681922 (Rotate \"x\" 21.972 (Shift (-0.237, -0.095, -0.172) (Scale (0.751, 0.533, 0.285) UnitCube)))) (Rotate \"y\" 68.918 (Shift (-0.444, 0.007, -0.205) (Scale (0.748, 0.692, 0.498) UnitCube)))) (SoftObject 0.5 [Key (0.036, 0.380, 0.410) 0.815 1, Key (0.118, 0.030, 0.444) 0.828 1])"};
+  static const int num[] = {835, 851};
+  long_run_scenes("cells beside two surfaces", objs, num, 2, wide_check);
+}
+
 /* Random scenes of the property test's generator (a run of 240 drawn in
    one stream, as the default run draws its 24, before scenes were drawn
    by seed; their numbers there) that gave up their sharp cells: a vertex of a sharp
@@ -1358,80 +1430,6 @@ static void hand_meshes(void) {
    sharp cells (each fails so before face_cell in mesh.c). Each now keeps
    them: meshed with sharp cells, closed and oriented by this file's edge
    counting, and free of self-intersections by the exact check. */
-/* Long-run scenes 255 and 875 at 0.03, where two sharp cells placed a
-   crease point each its own way (a crack: 5 and 62 boundary edges) and
-   the whole mesh was made again without sharp cells: now only the sharp
-   cells about the crack are (MeshReport.sharp_apart, a few), the others
-   stay sharp, and the mesh is closed, oriented, without
-   self-intersections, within the tolerance, with the topology the
-   mesh without sharp cells had (2 and 1 component, the same Euler
-   characteristic: counted here by edges). */
-static void sharp_apart_kept(void) {
-  static const char *objs[] = {
-    /* 255 */ "Union (Union (Rounded 0.13706648229358767 (Rotate \"y\" 57.708 (Shift (-0.136, -0.328, 0.113) (Scale (0.847, 0.805, 0.620) UnitCube)))) (Rotate \"z\" 27.775 (Shift (0.125, 0.192, 0.026) (Scale (0.475, 0.426, 0.402) UnitCube)))) (SoftObject 0.5 [Key (-0.007, -0.146, -0.121) 0.568 1, Key (0.149, -0.425, -0.287) 0.538 1, Key (-0.143, -0.238, 0.327) 0.656 1, Key (0.368, 0.437, -0.243) 0.713 (-1)])",
-    /* 875 */ "SetDifference (Union (Rounded 0.073151740419062791 (Rotate \"y\" 85.649 (Shift (-0.085, 0.318, 0.139) (Scale (0.392, 0.676, 0.845) UnitCube)))) (Rotate \"x\" 59.252 (Shift (0.263, 0.445, -0.450) (Scale (0.812, 0.680, 0.341) UnitCube)))) (SoftObject 0.5 [Key (0.216, -0.308, 0.487) 0.551 1, Key (0.042, -0.178, -0.163) 0.674 1, Key (0.340, -0.158, 0.485) 0.577 1, Key (0.241, -0.231, 0.161) 0.671 (-1)])"};
-  static const int num[] = {255, 875};
-  for (size_t k = 0; k < sizeof objs / sizeof objs[0]; k++) {
-    char name[120], buf[400];
-    snprintf(name, sizeof name, "long run scene %d (a crack between sharp cells)", num[k]);
-    Mesh *m;
-    MeshReport rep;
-    Scene *s = compile_mesh(name, objs[k], 0.03, &m, &rep);
-    if (!s) continue;
-    long eu;
-    MeshSelfCheck sc;
-    snprintf(buf, sizeof buf, "%s: %ld sharp cells given up locally, %ld kept "
-             "sharp, none given up whole", name, rep.sharp_apart, rep.sharp);
-    CHECK(buf, !rep.sharp_off && rep.sharp_apart > 0 && rep.sharp_apart <= 16 &&
-                   rep.sharp > 0);
-    snprintf(buf, sizeof buf, "%s: closed and oriented by edge counting, Euler "
-             "characteristic %ld as the report says, no self-intersection",
-             name, rep.euler);
-    CHECK(buf, closed_oriented(m, &eu) && eu == rep.euler &&
-                   mesh_self_check(m, &sc) == 0);
-    snprintf(buf, sizeof buf, "%s: certified %.4g <= 0.03", name, rep.certified);
-    CHECK(buf, rep.certified <= 0.03);
-    mesh_free(m);
-    scene_free(s);
-  }
-}
-
-/* Long-run scenes 835 and 851 at 0.03: a box, a rounded box and soft
-   keys, where the proof that the surface is within the tolerance of the
-   mesh failed in 8 and 1 cells beside cells with two surfaces (which the
-   rounds leave alone) and the report said so. When those are all that is
-   left (at most 64), one more round splits them too: every part proven
-   (the round is kept only if its topology is the mesh's before it:
-   mesh_rounds), the mesh closed and still within the tolerance. */
-static void cover_wide(void) {
-  static const char *objs[] = {
-    /* 835 */ "SetDifference (Union (Rounded 0.05944437258005722 (Rotate \"z\" 51.936 (Shift (0.269, 0.396, 0.119) (Scale (0.373, 0.448, 0.501) UnitCube)))) (Rotate \"x\" 24.969 (Shift (-0.396, -0.200, -0.148) (Scale (0.812, 0.783, 0.580) UnitCube)))) (SoftObject 0.5 [Key (0.185, 0.335, 0.423) 0.601 1, Key (0.310, 0.172, 0.359) 0.797 1, Key (-0.146, -0.465, 0.158) 0.872 1, Key (0.463, -0.194, 0.031) 0.764 (-1)])",
-    /* 851 */ "SetDifference (Union (Rounded 0.14095049972681922 (Rotate \"x\" 21.972 (Shift (-0.237, -0.095, -0.172) (Scale (0.751, 0.533, 0.285) UnitCube)))) (Rotate \"y\" 68.918 (Shift (-0.444, 0.007, -0.205) (Scale (0.748, 0.692, 0.498) UnitCube)))) (SoftObject 0.5 [Key (0.036, 0.380, 0.410) 0.815 1, Key (0.118, 0.030, 0.444) 0.828 1])"};
-  static const int num[] = {835, 851};
-  for (size_t k = 0; k < sizeof objs / sizeof objs[0]; k++) {
-    char name[120], buf[400];
-    snprintf(name, sizeof name, "long run scene %d (cells beside two surfaces)", num[k]);
-    Mesh *m;
-    MeshReport rep;
-    Scene *s = compile_mesh(name, objs[k], 0.03, &m, &rep);
-    if (!s) continue;
-    long eu;
-    MeshSelfCheck sc;
-    snprintf(buf, sizeof buf, "%s: every part proven within the tolerance of "
-             "the mesh (%ld cells not), the last round splitting the cells "
-             "beside two surfaces too", name, rep.cover_unproven);
-    CHECK(buf, rep.cover_unproven == 0 && rep.cover_wide && !rep.cover_kept &&
-                   rep.cover <= 0.03);
-    snprintf(buf, sizeof buf, "%s: closed, oriented, Euler characteristic %ld "
-             "as reported, no self-intersection, certified %.4g <= 0.03",
-             name, rep.euler, rep.certified);
-    CHECK(buf, closed_oriented(m, &eu) && eu == rep.euler &&
-                   mesh_self_check(m, &sc) == 0 && rep.certified <= 0.03);
-    mesh_free(m);
-    scene_free(s);
-  }
-}
-
 static void sharp_kept(void) {
   static const char *objs[] = {
     /* 99 */ "Union (Union (Rounded 0.059116706536565658 (Rotate \"y\" 49.984 (Shift (-0.374, 0.037, 0.134) (Scale (0.516, 0.428, 0.835) UnitCube)))) (Rotate \"y\" 28.123 (Shift (0.118, -0.135, 0.160) (Scale (0.269, 0.411, 0.269) UnitCube)))) (SoftObject 0.5 [Key (0.407, 0.092, -0.474) 0.900 1, Key (-0.316, 0.189, 0.421) 0.776 1, Key (0.091, -0.241, 0.248) 0.861 1, Key (0.259, 0.326, -0.336) 0.867 (-1)])",
