@@ -65,6 +65,14 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           "than about twice the tolerance the mesh can pinch it or leave "
           "islands\n", r->components, r->components == 1 ? "" : "s",
           r->euler, r->components - r->euler / 2);
+  if (r->cover_topo)
+    fprintf(f, "  topology changed by the rounds: the mesh first made had %ld "
+            "component%s, Euler characteristic %ld, and parts of the surface "
+            "not proven within the tolerance of it; this one, made with those "
+            "cells split, has every part proven: a part or gap thinner than "
+            "the first cells was found (an island, a thin sheet) or opened "
+            "in places\n", r->first_components,
+            r->first_components == 1 ? "" : "s", r->first_euler);
   fprintf(f, "  checked: no self-intersections, %ld triangle pairs tested "
           "exactly (%ld signs in exact arithmetic) in %.2f s\n", r->pairs,
           r->pairs_exact, r->check_seconds);

@@ -3703,23 +3703,43 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
        first round's go back to mesh_scene) */
     if (rc == MESH_RESHARP && prev && ++resharp < RESHARP_TRIES) continue;
     if (prev) {
-      /* a round is kept only when it proved more of the surface and left
-         the mesh's components and Euler characteristic as they were:
+      /* a round is kept when it proved more of the surface and left the
+         mesh's components and Euler characteristic as they were:
          splitting some cells of a gap narrowing to nothing (under the
          edge of a box resting flush on another) and not others opens it
          in places and closes it between, a bubble or a tunnel (figure12's
-         obj5 at 0.01 had 2 components that way); then, or if the round
-         failed (a limit), the mesh before it is kept */
+         obj5 at 0.01 had 2 components that way). A round that proves
+         every part of the surface within the tolerance is kept even when
+         it changes them (an island smaller than the cells found, a thin
+         part or gap opened: MeshReport.cover_topo). A round that is
+         neither but has few cells left not proven (WIDE_MAX; seed 799 at
+         0.03: 11 cells, then 16, then none) leads to the next, split
+         again there, with the mesh kept before it as the fallback; many
+         (figure12's obj5 at 0.003: 2248, then 4735) end the rounds, which
+         would cost 1.6 times the time for nothing. Else, or if the round
+         failed (a limit), the mesh kept before it stays */
       MeshCheck ck = {0};
-      int keep = rc == MESH_OK || rc == MESH_RECOVER;
-      if (keep && mesh_check(*out, &ck) == -2) {
+      int ok = rc == MESH_OK || rc == MESH_RECOVER;
+      if (ok && mesh_check(*out, &ck) == -2) {
         mesh_free(*out);
         *out = NULL;
         mesh_free(prev);
         return MESH_ENOMEM;
       }
-      if (!keep || rep->cover_unproven >= prep.cover_unproven ||
-          ck.components != pck.components || ck.euler != pck.euler) {
+      int more = ok && rep->cover_unproven < prep.cover_unproven;
+      int same = ck.components == pck.components && ck.euler == pck.euler;
+      if (more && !same && rep->cover_unproven == 0) {
+        rep->cover_topo = 1;
+        rep->first_components = pck.components;
+        rep->first_euler = pck.euler;
+      } else if ((!more || !same) && rc == MESH_RECOVER &&
+                 rep->cover_unproven <= WIDE_MAX) {
+        /* on to the next round; the kept mesh stays the fallback */
+        mesh_free(*out);
+        *out = NULL;
+        rep->cover_rounds++;
+        continue;
+      } else if (!more || !same) {
         mesh_free(*out);
         *out = prev;
         int rounds = rep->cover_rounds;

@@ -48,8 +48,9 @@
  * construction, and in the smooth cells (by columns along the gradient)
  * and the finest cells (box by box) after the mesh is made
  * (mesh_cover.h); cells where that proof gives up, and the leaves
- * beside them, are split and the object meshed again, a round kept only
- * when it proves more and keeps the mesh's topology.
+ * beside them, are split and the object meshed again, a round kept
+ * when it proves more and keeps the mesh's topology, or proves every part
+ * (MeshReport.cover_topo when that changed the topology).
  * The flat regions of the mesh made (a sharp face, a flat middle) are then
  * triangulated again without their inner vertices (mesh_merge.h; the
  * surface moves by at most flat_moved, added to the certified bound;
@@ -164,6 +165,11 @@ typedef struct MeshReport {
                               (few were left and no others: mesh.c,
                               cover_check) */
   int cover_wide_next;     /* the next round will (internal) */
+  int cover_topo;          /* this mesh's round proved every part of the
+                              surface and changed the components or Euler
+                              characteristic of the mesh before the
+                              rounds, which were: */
+  long first_components, first_euler;
   int resharp;             /* mesh.c's MESH_RESHARP came from a crack (1)
                               or a self-intersection (2) (internal) */
   int cover_kept;          /* the last round was not kept (it proved no
