@@ -103,6 +103,31 @@ if (cd "$tmp" && "$top/$QCS" hair.qcs > out 2> err); then echo "FAIL mesh: a hai
 elif grep -q "hair.qcs:1:54: error: hair.stl: a part of the object is thinner than the finest cell the octree can make" "$tmp/err" &&
      [ ! -e "$tmp/hair.stl" ]; then echo "ok mesh: a hair thinner than the deepest cell is refused, naming it, no file"
 else echo "FAIL mesh: hair: $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
+# max-memory bounds a mesh too. The peak resident memory of the whole
+# process (python's getrusage over the child, independent of qcs's own
+# count): B for a unit cube at 0.1 (the program and a tiny mesh), P for
+# the mesh below, made without a limit; the growth G = P - B. With the
+# limit at P the mesh is made; at G / 2 it is refused naming the limit,
+# with no file; at 40M, where the octree alone takes 5M to 10M, it is
+# refused before the crossings are sought ("would need about")
+peak() { python3 -c 'import resource, subprocess, sys
+r = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss if r.returncode == 0 else -1)' "$@"; }
+memexpr='meshWith [Tolerance 0.0005, Quiet] "mem.stl" (Rounded 0.1 UnitCube)'
+base=$(cd "$tmp" && peak "$top/$QCS" --max-memory 0 -e 'meshWith [Tolerance 0.1, Quiet] "mem.stl" UnitCube')
+pk=$(cd "$tmp" && peak "$top/$QCS" --max-memory 0 -e "$memexpr")
+rm -f "$tmp/mem.stl"
+if [ "${base:--1}" -gt 0 ] && [ "${pk:--1}" -gt "$base" ] &&
+   (cd "$tmp" && "$top/$QCS" --max-memory "$pk"K -e "$memexpr" > out 2> err) && [ -s "$tmp/mem.stl" ] &&
+   rm -f "$tmp/mem.stl" &&
+   ! (cd "$tmp" && "$top/$QCS" --max-memory "$(((pk - base) / 2))"K -e "$memexpr" > out 2> err) &&
+   grep -q "(limit max-memory; raise it with :set max-memory SIZE or --max-memory SIZE)" "$tmp/err" &&
+   [ ! -e "$tmp/mem.stl" ] &&
+   ! (cd "$tmp" && "$top/$QCS" --max-memory 40M -e "$memexpr" > out 2> err) &&
+   grep -q "the mesh would need about [0-9.]*M of memory, over 40M (limit max-memory" "$tmp/err" &&
+   [ ! -e "$tmp/mem.stl" ]; then
+  echo "ok mesh: max-memory bounds a mesh: made under its peak ($pk KB), refused under half its growth ($(((pk - base) / 2)) KB) and, before the work, under 40M, no file either time"
+else echo "FAIL mesh: max-memory (peak $pk KB, base $base KB): $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
 printf 'meshWith [MaxTriangles 1000] "big.stl" (Rounded 0.2 UnitCube)\n' > "$tmp/big.qcs"
 if (cd "$tmp" && "$top/$QCS" big.qcs > out 2> err); then echo "FAIL mesh: MaxTriangles ignored"
 elif grep -q "max-triangles" "$tmp/err" && [ ! -e "$tmp/big.stl" ]; then echo "ok mesh: MaxTriangles refuses, no file"

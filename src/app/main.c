@@ -167,8 +167,9 @@ static void usage(FILE *out) {
           "  --max-steps N       evaluation steps of one top-level expression\n"
           "                      (default 10000000000; 0 for no limit)\n"
           "  --max-list N        elements of one list (default 10000000; 0: none)\n"
-          "  --max-memory SIZE   memory for values (default 8G, or half the RAM if\n"
-          "                      less; a bare number is megabytes; 0: no limit)\n"
+          "  --max-memory SIZE   memory for values, and a mesh's growth (default\n"
+          "                      8G, or half the RAM if less; a bare number is\n"
+          "                      megabytes; 0: no limit)\n"
           "  --max-pixels N|WxH  pixels of one image (default 4096x4096)\n"
           "  --max-spp N         samples per pixel (default 64, at most 256)\n"
           "  -h, --help          this help\n"
@@ -336,6 +337,7 @@ static void *run(void *arg) {
     o->render.capture_ctx = o;
   } else if (o->render.output && mesh_is_mesh_path(o->render.output)) {
     o->render.capture = mesh_lang_capture; /* -o part.stl: mesh, not render */
+    o->render.capture_ctx = I;              /* its max-memory */
   }
   if (o->params) {
     o->status = interp_params(I, o->files[0], stdout) != RUN_OK;

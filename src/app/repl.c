@@ -382,7 +382,7 @@ static void cmd_help(Repl *R, const char *arg, int bang) {
        "  max-stack SIZE   stack for nested calls, i.e. recursion depth (256M)\n"
        "  max-steps N      evaluation steps of one entry (0: no limit)\n"
        "  max-list N       elements of one list (0: no limit)\n"
-       "  max-memory SIZE  memory for values, e.g. 512M or 2G (0: no limit)\n"
+       "  max-memory SIZE  memory for values and a mesh's, e.g. 512M or 2G (0: none)\n"
        "  max-pixels N     pixels of one image, N or WxH (at most 8192x8192)\n"
        "  max-spp N        samples per pixel of a render (at most 256)\n"
        "The same limits are options of the command line: --max-steps N, ...");

@@ -151,6 +151,7 @@ int mesh_lang_capture(void *ctx, const struct Scene *s,
   MeshSettings ms = {0};
   ms.tol = -1;
   ms.max_triangles = MESH_DEFAULT_MAX_TRIANGLES;
+  if (ctx) ms.max_memory = ((Interp *)ctx)->max_memory; /* qcs -o: main.c */
   int bad;
   char e2[400];
   int rc = do_mesh(s, &ms, path, 0, &bad, e2, sizeof e2);
@@ -179,6 +180,7 @@ static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
   MeshSettings ms = {0};
   ms.tol = -1;
   ms.max_triangles = MESH_DEFAULT_MAX_TRIANGLES;
+  ms.max_memory = I->max_memory; /* the values' limit bounds a mesh too */
   int quiet = 0;
   for (Value *l = force(I, args[0]);; l = force(I, l->u.cons.tail)) {
     if (l->kind == V_NIL) break;

@@ -1778,7 +1778,7 @@ static const struct {
    "evaluation steps of one top-level expression"},
   {"max-list", LIM_COUNT, 1, 1, ~0ULL,
    "elements of one list (ranges, length, sum, printing, ...)"},
-  {"max-memory", LIM_SIZE, 1, 1ULL << 20, 1ULL << 50, "memory for values"},
+  {"max-memory", LIM_SIZE, 1, 1ULL << 20, 1ULL << 50, "memory for values, and a mesh's"},
   {"max-pixels", LIM_PIXELS, 0, 1, QCS_MAX_PIXELS_CAP,
    "pixels of one rendered image"},
   {"max-spp", LIM_SPP, 0, 1, 256, "samples per pixel of a render"},

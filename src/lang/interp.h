@@ -180,7 +180,8 @@ void interp_set_max_memory(Interp *I, size_t bytes);
  *                     default 10000000000, 0 for none
  *   max-list    N     elements of one list built by a range or forced by
  *                     length, sum, printing, ...; default 10000000, 0 none
- *   max-memory  SIZE  memory for values; default 8G, 0 for none
+ *   max-memory  SIZE  memory for values (and, read by bind/mesh_lang.c,
+ *                     a mesh's growth); default 8G, 0 for none
  *   max-pixels  N     pixels of one rendered image (N or WxH); default
  *                     4096x4096, at most 8192x8192
  *   max-spp     N     samples per pixel of a render; default 64, at most 256

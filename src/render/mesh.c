@@ -9,7 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 #include <zip.h>
+#include <fcntl.h>
+#include <sys/resource.h>
 
 #include "core/bounds.h"
 #include "core/interval.h"
@@ -38,6 +41,13 @@ static Mesh *mesh_copy(const Mesh *m);
 
 /* mesh_run's answer: mesh again (cover_check split cells) */
 #define MESH_RECOVER 100
+/* A mesh needs about this many bytes per marching triangle at its peak
+   (vertices, triangles, the octree's maps, the checks' tables): 112 to
+   140 measured (peak RSS over the triangles before flat regions are
+   merged: `Rounded 0.1 UnitCube` at 1e-4, figure12's obj2, a soft pair);
+   the estimate before the crossings are sought takes the lower end, the
+   resident memory checked as the work goes on takes the rest */
+#define TRI_BYTES 75
 /* mesh_run's answer: mesh again, the sharp cells at a crack or a
    self-intersection meshed by their tetrahedra (sharp_apart) */
 #define MESH_RESHARP 101
@@ -644,6 +654,10 @@ typedef struct {
   Leaf *leaves;
   size_t nleaves, capleaves;
   size_t max_cells;
+  size_t mem0, peak0;      /* resident bytes when meshing began, and the
+                              process's peak then */
+  size_t max_mem;          /* the growth allowed (MeshSettings.max_memory) */
+  int memout;              /* MESH_ELIMIT came from max_mem */
   hmap split;              /* (level, cell) -> 1 for every split cell */
   hmap *force;             /* (level, cell) -> 1 for cells that must split:
                               the surface in them was not proven within
@@ -713,6 +727,78 @@ static int in_clip(const Mesher *m, const double p[3]) {
   for (int i = 0; i < 3; i++)
     if (!(p[i] > m->clo[i] && p[i] < m->chi[i])) return 0;
   return 1;
+}
+
+/* The process's resident bytes (/proc/self/statm), 0 where unknown. */
+static size_t resident(void) {
+  int fd = open("/proc/self/statm", O_RDONLY);
+  if (fd < 0) return 0;
+  char b[128];
+  ssize_t n = read(fd, b, sizeof b - 1);
+  close(fd);
+  if (n <= 0) return 0;
+  b[n] = 0;
+  unsigned long long size, res;
+  const char *c = b;
+  char *e;
+  size = strtoull(c, &e, 10);
+  if (e == c) return 0;
+  res = strtoull(e, &e, 10);
+  (void)size;
+  long page = sysconf(_SC_PAGESIZE);
+  return page > 0 ? (size_t)res * (size_t)page : 0;
+}
+
+/* The process's peak resident bytes so far (getrusage). */
+static size_t peak_resident(void) {
+  struct rusage u;
+  if (getrusage(RUSAGE_SELF, &u) < 0 || u.ru_maxrss < 0) return 0;
+  return (size_t)u.ru_maxrss * 1024;
+}
+
+/* The resident memory has grown by more than the limit since meshing
+   began, now or at a peak since (a check's tables freed before this
+   looked: a peak above the process's peak before meshing is one of
+   meshing's). MESH_ELIMIT in m->err, m->memout. */
+static int over_memory(Mesher *m) {
+  if (!m->max_mem) return 0;
+  size_t r = resident(), pk = peak_resident();
+  if (pk > m->peak0 && pk > r) r = pk;
+  if (r > m->mem0 && r - m->mem0 > m->max_mem) {
+    m->err = MESH_ELIMIT;
+    m->memout = 1;
+    return 1;
+  }
+  return 0;
+}
+
+/* "512M" for a size in bytes. */
+static void fmt_size(char *buf, size_t n, size_t bytes) {
+  static const char unit[] = "KMGT";
+  double v = (double)bytes;
+  int u = -1;
+  while (v >= 1024 && u < 3) v /= 1024, u++;
+  if (u < 0) snprintf(buf, n, "%zu bytes", bytes);
+  else snprintf(buf, n, "%.4g%c", v, unit[u]);
+}
+
+static int memory_error(const Mesher *m, char *err, size_t errlen,
+                        size_t need) {
+  char lim[32], nd[32];
+  fmt_size(lim, sizeof lim, m->max_mem);
+  if (need) {
+    fmt_size(nd, sizeof nd, need);
+    snprintf(err, errlen, "the mesh would need about %s of memory, over "
+             "%s (limit max-memory; raise it with :set max-memory SIZE or "
+             "--max-memory SIZE), or give a larger tolerance than %g; nothing "
+             "was written", nd, lim, m->tol);
+  } else {
+    snprintf(err, errlen, "meshing took more than %s of memory (limit "
+             "max-memory; raise it with :set max-memory SIZE or --max-memory "
+             "SIZE), or give a larger tolerance than %g; nothing was written",
+             lim, m->tol);
+  }
+  return MESH_ELIMIT;
 }
 
 static int grow(void **p, size_t *cap, size_t need, size_t size) {
@@ -1189,6 +1275,7 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
       m->err = MESH_ELIMIT;
       return -1;
     }
+    if ((m->nleaves & 4095) == 4095 && over_memory(m)) return -1;
     if (grow((void **)&m->leaves, &m->capleaves, m->nleaves + 1,
              sizeof *m->leaves) < 0) {
       m->err = MESH_ENOMEM;
@@ -2776,7 +2863,8 @@ static int closure_failed(int cr, const MeshCheck *ck, char *err, size_t errlen)
 
 static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
                     Mesh **out, MeshReport *rep, int *bad_node, char *err,
-                    size_t errlen, int sharp, hmap *force, hmap *plainc) {
+                    size_t errlen, int sharp, hmap *force, hmap *plainc,
+                    const size_t mem0[2]) {
   struct timespec t0, t1;
   clock_gettime(CLOCK_MONOTONIC, &t0);
   MeshReport keep = *rep;
@@ -2857,6 +2945,9 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.uniform = ms->uniform;
   m.rep = rep;
   m.max_cells = ms->max_cells ? ms->max_cells : (size_t)1 << 24;
+  m.mem0 = mem0[0];
+  m.peak0 = mem0[1];
+  m.max_mem = mem0[0] ? ms->max_memory : 0;
   for (int i = 0; i < 3; i++) {
     double c = 0.5 * (lo[i] + hi[i]);
     /* off centre by a fraction of a cell unlike on each axis, so that a
@@ -2907,7 +2998,9 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   }
   if (walk(&m, 0, 0, 0, 0) < 0 || refine_two(&m) < 0) {
     rc = m.err;
-    if (rc == MESH_ELIMIT)
+    if (rc == MESH_ELIMIT && m.memout)
+      memory_error(&m, err, errlen, 0);
+    else if (rc == MESH_ELIMIT)
       snprintf(err, errlen, "the mesh needs more than %zu surface octree "
                "cells (limit max-cells): give a larger tolerance than %g",
                m.max_cells, e);
@@ -2960,6 +3053,14 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_ELIMIT;
     goto done;
   }
+  if (m.max_mem) { /* before the crossings are sought */
+    size_t r = resident(), grown = r > m.mem0 ? r - m.mem0 : 0;
+    size_t need = grown + (count < SIZE_MAX / TRI_BYTES ? count * TRI_BYTES : SIZE_MAX / 2);
+    if (need > m.max_mem) {
+      rc = memory_error(&m, err, errlen, need);
+      goto done;
+    }
+  }
   /* the sharp cells first: their crease points split the marching
      triangles next to them */
   for (int pass = 0; pass < 2; pass++) {
@@ -2975,6 +3076,10 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   }
   if (m.ray->failed) {
     rc = MESH_ENOMEM;
+    goto done;
+  }
+  if (over_memory(&m)) {
+    rc = memory_error(&m, err, errlen, 0);
     goto done;
   }
   /* the count above is a lower bound: crease paths split a few marching
@@ -3107,6 +3212,11 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     }
     goto done;
   }
+  if (over_memory(&m)) { /* the checks' peak */
+    mesh_free(me);
+    rc = memory_error(&m, err, errlen, 0);
+    goto done;
+  }
   rep->flat_regions = mm.regions;
   rep->flat_before = mm.before;
   if (mm.regions) {
@@ -3118,6 +3228,11 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   if (cover_check(&m, me, rep) < 0) {
     mesh_free(me);
     rc = MESH_ENOMEM;
+    goto done;
+  }
+  if (over_memory(&m)) {
+    mesh_free(me);
+    rc = memory_error(&m, err, errlen, 0);
     goto done;
   }
   rep->vertices = me->nv;
@@ -3687,7 +3802,8 @@ int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
    (cover_check; at most COVER_ROUNDS times). */
 static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
                        Mesh **out, MeshReport *rep, int *bad_node, char *err,
-                       size_t errlen, int sharp, hmap *force, hmap *plainc) {
+                       size_t errlen, int sharp, hmap *force, hmap *plainc,
+                       const size_t mem0[2]) {
   double t = 0;
   int rc, resharp = 0;
   Mesh *prev = NULL;
@@ -3696,7 +3812,7 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
   for (;;) {
     rep->cover_last = rep->cover_rounds >= COVER_ROUNDS;
     rc = mesh_run(s, node, ms, out, rep, bad_node, err, errlen, sharp, force,
-                  plainc);
+                  plainc, mem0);
     t += rep->seconds;
     /* a crack or a self-intersection in a later round: that round again
        with the sharp cells about it meshed by their tetrahedra (the
@@ -3777,6 +3893,9 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
                MeshReport *rep, int *bad_node, char *err, size_t errlen) {
   hmap force = {0}, plainc = {0};
   memset(rep, 0, sizeof *rep);
+  /* the resident memory now: max_memory bounds its growth */
+  size_t mem0[2] = {ms->max_memory ? resident() : 0,
+                    ms->max_memory ? peak_resident() : 0};
   /* sharp cells about a crack or a self-intersection meshed by their
      tetrahedra and the rest kept (sharp_apart), a few times; then every
      sharp cell given up */
@@ -3784,7 +3903,7 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
   int rc, tries = 0;
   for (;;) {
     rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 1, &force,
-                     &plainc);
+                     &plainc, mem0);
     if (rc != MESH_RESHARP) break;
     t0 += rep->seconds;
     if (++tries == RESHARP_TRIES) { /* the last failure's kind */
@@ -3803,7 +3922,7 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
     double t = rep->seconds + t0;
     int why = rc == MESH_ESELF ? 2 : 1;
     rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 0, &force,
-                     &plainc);
+                     &plainc, mem0);
     rep->seconds += t;
     rep->sharp_off = why;
   }

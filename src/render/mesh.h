@@ -80,6 +80,11 @@ typedef struct MeshSettings {
   double lo[3], hi[3];
   size_t max_triangles;    /* refuse a mesh with more (0: no limit) */
   size_t max_cells;        /* refuse an octree with more surface cells */
+  size_t max_memory;       /* refuse when meshing would grow the process's
+                              resident memory by more (an estimate from
+                              the triangles before the crossings are
+                              sought, then measured as the work goes on;
+                              0: no limit; Linux's /proc, else none) */
   int uniform;             /* every surface cell at the finest level, no
                               sharp cells: the uniform grid, to compare */
   int keep_flat;           /* do not triangulate flat regions again
