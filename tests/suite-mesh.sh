@@ -107,27 +107,47 @@ else echo "FAIL mesh: hair: $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
 # process (python's getrusage over the child, independent of qcs's own
 # count): B for a unit cube at 0.1 (the program and a tiny mesh), P for
 # the mesh below, made without a limit; the growth G = P - B. With the
-# limit at P the mesh is made; at G / 2 it is refused naming the limit,
-# with no file; at 40M, where the octree alone takes 5M to 10M, it is
-# refused before the crossings are sought ("would need about")
+# limit at P the mesh is made; at 40M, where the octree alone takes 5M
+# to 10M, it is refused before the crossings are sought, with qcs's
+# estimate E ("would need about E"); at G / 2 it is refused; between E
+# and G the estimate lets it start and the growth measured as the work
+# goes on refuses it ("meshing took more than"); no file any time
 peak() { python3 -c 'import resource, subprocess, sys
 r = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss if r.returncode == 0 else -1)' "$@"; }
+limit_msg="(limit max-memory; raise it with :set max-memory SIZE or --max-memory SIZE)"
+if [ ! -r /proc/self/statm ]; then
+  echo "skip mesh: max-memory: no /proc/self/statm here, so qcs has no measure of its memory"
+else
 memexpr='meshWith [Tolerance 0.0005, Quiet] "mem.stl" (Rounded 0.1 UnitCube)'
 base=$(cd "$tmp" && peak "$top/$QCS" --max-memory 0 -e 'meshWith [Tolerance 0.1, Quiet] "mem.stl" UnitCube')
 pk=$(cd "$tmp" && peak "$top/$QCS" --max-memory 0 -e "$memexpr")
 rm -f "$tmp/mem.stl"
+est=-1 mid=-1
 if [ "${base:--1}" -gt 0 ] && [ "${pk:--1}" -gt "$base" ] &&
    (cd "$tmp" && "$top/$QCS" --max-memory "$pk"K -e "$memexpr" > out 2> err) && [ -s "$tmp/mem.stl" ] &&
    rm -f "$tmp/mem.stl" &&
-   ! (cd "$tmp" && "$top/$QCS" --max-memory "$(((pk - base) / 2))"K -e "$memexpr" > out 2> err) &&
-   grep -q "(limit max-memory; raise it with :set max-memory SIZE or --max-memory SIZE)" "$tmp/err" &&
-   [ ! -e "$tmp/mem.stl" ] &&
    ! (cd "$tmp" && "$top/$QCS" --max-memory 40M -e "$memexpr" > out 2> err) &&
-   grep -q "the mesh would need about [0-9.]*M of memory, over 40M (limit max-memory" "$tmp/err" &&
-   [ ! -e "$tmp/mem.stl" ]; then
-  echo "ok mesh: max-memory bounds a mesh: made under its peak ($pk KB), refused under half its growth ($(((pk - base) / 2)) KB) and, before the work, under 40M, no file either time"
-else echo "FAIL mesh: max-memory (peak $pk KB, base $base KB): $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
+   grep -q "the mesh would need about [0-9.]*M of memory, over 40M $limit_msg" "$tmp/err" &&
+   [ ! -e "$tmp/mem.stl" ] &&
+   est=$(sed -n 's/.*would need about \([0-9.]*\)M of memory.*/\1/p' "$tmp/err" | awk '{printf "%d", $1 * 1024}') &&
+   mid=$(((est + pk - base) / 2)) && [ "$est" -lt "$((pk - base))" ] &&
+   ! (cd "$tmp" && "$top/$QCS" --max-memory "$mid"K -e "$memexpr" > out 2> err) &&
+   grep -q "meshing took more than [0-9.]*M of memory $limit_msg" "$tmp/err" &&
+   [ ! -e "$tmp/mem.stl" ] &&
+   ! (cd "$tmp" && "$top/$QCS" --max-memory "$(((pk - base) / 2))"K -e "$memexpr" > out 2> err) &&
+   grep -q "$limit_msg" "$tmp/err" && [ ! -e "$tmp/mem.stl" ]; then
+  echo "ok mesh: max-memory bounds a mesh: made under its peak ($pk KB), refused before the work under 40M (estimate $est KB), during it under $mid KB (growth $((pk - base)) KB), and under half the growth; no file any time"
+else echo "FAIL mesh: max-memory (peak $pk KB, base $base KB, estimate $est KB, between $mid KB): $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
+# a later round over the limit is refused too (it kept the round before
+# it and wrote the file): the island scene above grows about 5M in its
+# first meshing and 7M with the round that finds the island
+rm -f "$tmp/island.stl"
+if ! (cd "$tmp" && "$top/$QCS" --max-memory 6M island.qcs > out 2> err) &&
+   grep -q "$limit_msg" "$tmp/err" && [ ! -e "$tmp/island.stl" ]; then
+  echo "ok mesh: max-memory refuses a round over it, with no file"
+else echo "FAIL mesh: max-memory, a later round: $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
+fi
 printf 'meshWith [MaxTriangles 1000] "big.stl" (Rounded 0.2 UnitCube)\n' > "$tmp/big.qcs"
 if (cd "$tmp" && "$top/$QCS" big.qcs > out 2> err); then echo "FAIL mesh: MaxTriangles ignored"
 elif grep -q "max-triangles" "$tmp/err" && [ ! -e "$tmp/big.stl" ]; then echo "ok mesh: MaxTriangles refuses, no file"

@@ -784,6 +784,7 @@ static void fmt_size(char *buf, size_t n, size_t bytes) {
 
 static int memory_error(const Mesher *m, char *err, size_t errlen,
                         size_t need) {
+  m->rep->memout = 1;
   char lim[32], nd[32];
   fmt_size(lim, sizeof lim, m->max_mem);
   if (need) {
@@ -3818,6 +3819,13 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
        with the sharp cells about it meshed by their tetrahedra (the
        first round's go back to mesh_scene) */
     if (rc == MESH_RESHARP && prev && ++resharp < RESHARP_TRIES) continue;
+    /* over max-memory in a later round: the limit is passed, so the mesh
+       is refused as in the first (a later round's other limits keep the
+       mesh before it, below) */
+    if (rc == MESH_ELIMIT && rep->memout) {
+      mesh_free(prev);
+      return rc;
+    }
     if (prev) {
       /* a round is kept when it proved more of the surface and left the
          mesh's components and Euler characteristic as they were:

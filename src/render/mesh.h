@@ -175,6 +175,7 @@ typedef struct MeshReport {
                               characteristic of the mesh before the
                               rounds, which were: */
   long first_components, first_euler;
+  int memout;              /* MESH_ELIMIT came from max_memory (internal) */
   int resharp;             /* mesh.c's MESH_RESHARP came from a crack (1)
                               or a self-intersection (2) (internal) */
   int cover_kept;          /* the last round was not kept (it proved no
