@@ -1129,6 +1129,8 @@ typedef struct Sample {
 } Sample;
 
 typedef struct Worker {
+  char pad0[128];             /* no cache line shared with the worker
+                                 before it (its per-ray counters) */
   Tracer *T;
   RayCtx *c;
   long primary, shadow, max_work;
@@ -1138,6 +1140,7 @@ typedef struct Worker {
   TileCull sh[RENDER_MAX_LIGHTS]; /* its shadow rays', per light */
   Sample *samples;            /* CULL_BLOCK^2 x grid^2 */
   Lit *lits;                  /* their shade_geom, as many */
+  char pad1[128];
 } Worker;
 
 /* The primary ray of one camera sample: its hit, if any (counted). */
