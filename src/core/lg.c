@@ -203,9 +203,13 @@ double lg_multiroot_length(double f0, double df0, double f1, double df1,
 #define LG_LEVEL_CODE 4096   /* instructions for the levels' views */
 #define LG_MAX_LEVELS 32
 
+/* depth is 8 bytes wide: a segment is copied off the stack as 16-byte
+   loads and one 8-byte load of its tail, which a 4-byte store of depth
+   alone cannot forward (a stall on every search's first pop and every
+   split's) */
 typedef struct {
   double a, b, fa, dfa, fb, dfb;
-  int depth;
+  long depth;
 } segment;
 
 /* Everything one search needs, so helpers stay short. */
@@ -376,7 +380,7 @@ static void trace(search *s, const segment *sg, const lg_bounds *lb,
   if (!s->hook || !s->hook->fn) return;
   lg_trace_event ev = {sg->a, sg->b, sg->fa, sg->fb, sg->dfa, sg->dfb,
                        lb->L, lb->G, lb->lo, lb->hi, lhs, decision,
-                       sg->depth, ncode, nroots};
+                       (int)sg->depth, ncode, nroots};
   s->hook->fn(s->hook->ctx, &ev);
 }
 
@@ -461,8 +465,9 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     if (s->st) s->st->segments++;
     const dt_tape *vp = t;   /* this segment's view; level 0 is t */
     if (sg.depth > 0) {
-      int from = sg.depth - 1 < s->nlv - 1 ? sg.depth - 1 : s->nlv - 1;
-      int to = sg.depth < s->nlv ? sg.depth : s->nlv;
+      int dep = (int)sg.depth;
+      int from = dep - 1 < s->nlv - 1 ? dep - 1 : s->nlv - 1;
+      int to = dep < s->nlv ? dep : s->nlv;
       view_of(from ? &lv[from] : t, s->rl, sg.a, sg.b,
               s->lvbuf + (size_t)to * (size_t)s->ncode, &lv[to]);
       vp = &lv[to];
