@@ -39,13 +39,16 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "surface in them, or the solid where surfaces meet, not proven "
             "one sheet), down to depth %d (cell "
             "%.4g)\n", r->thin, r->deepest, ldexp(r->h, r->depth - r->deepest));
-  if (r->two)
-    fprintf(f, "  two surfaces: %ld cells (side %.4g, 1/%.0f of the finest) "
-            "hold two surfaces, each one sheet, not proven one sheet "
-            "together: a part or gap between them thinner than the cell may "
-            "be lost or closed there (the first at (%.6g, %.6g, %.6g))\n",
-            r->two, r->two_side, r->h / r->two_side, r->two_at[0],
-            r->two_at[1], r->two_at[2]);
+  if (r->two) {
+    char of[48] = "the finest level's";
+    if (r->two_side < r->h)
+      snprintf(of, sizeof of, "1/%.0f of the finest", r->h / r->two_side);
+    fprintf(f, "  two surfaces: %ld cells (side up to %.4g, %s) hold two "
+            "surfaces, each one sheet, not proven one sheet together: a part "
+            "or gap between them thinner than the cell may be lost or closed "
+            "there (the first at (%.6g, %.6g, %.6g))\n",
+            r->two, r->two_side, of, r->two_at[0], r->two_at[1], r->two_at[2]);
+  }
   if (r->sharp_apart && !r->sharp_off)
     fprintf(f, "  sharp cells given up locally: %ld about a crack or a "
             "self-intersection that two sharp cells left between them were "

@@ -1376,9 +1376,11 @@ static int refine_two(Mesher *m) {
   for (size_t l = 0; l < m->nleaves; l++) {
     Leaf *lf = &m->leaves[l];
     if (lf->level == 0xff) continue;
-    if (lf->two && !m->rep->two++) {
+    if (lf->two) {   /* counted, with the side of the largest */
       double side = ldexp(m->h, m->depth - lf->level);
-      for (int a = 0; a < 3; a++) m->rep->two_at[a] = m->org[a] + side * lf->q[a];
+      if (!m->rep->two++)
+        for (int a = 0; a < 3; a++) m->rep->two_at[a] = m->org[a] + side * lf->q[a];
+      if (side > m->rep->two_side) m->rep->two_side = side;
     }
     m->leaves[w++] = *lf;
   }
@@ -2966,7 +2968,6 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   rep->depth = depth;
   rep->h = L / ldexp(1, depth);
   rep->deepest = depth;
-  rep->two_side = ldexp(rep->h, -TWO_LEVELS);
   rep->vtol = vtol;
   int nsub = node - s->nodes[node].first + 1;
   m.st = malloc((size_t)nsub);

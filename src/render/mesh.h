@@ -126,7 +126,7 @@ typedef struct MeshReport {
   long two;                /* cells meshed with two surfaces in them, each
                               one sheet, not proven one sheet together
                               (mesh.c, TWO_LEVELS below the finest) */
-  double two_side;         /* their side */
+  double two_side;         /* the side of the largest */
   double two_at[3];        /* the lowest corner of the first */
   double vtol;             /* the vertices' distance bound */
   double certified;        /* the proven bound, see above */
