@@ -97,8 +97,10 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
   if (r->cover_rounds && !r->cover_kept)
     fprintf(f, "; meshed %d more time%s, %ld cells split where it was not "
             "proven%s", r->cover_rounds, r->cover_rounds == 1 ? "" : "s",
-            r->cover_split, r->cover_wide ? ", beside cells with two "
-            "surfaces too" : "");
+            r->cover_split, r->cover_wide == 2 ? ", beside cells with "
+            "two surfaces too, a groove (kept: its topology is the first "
+            "mesh's)" : r->cover_wide ? ", beside cells with two surfaces "
+            "too" : "");
   else if (r->cover_rounds)
     fprintf(f, "; meshed %d more time%s with the cells not proven split "
             "(%ld in the last), the last not kept: it proved no more, or "

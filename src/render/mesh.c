@@ -36,6 +36,9 @@
 #define NEAR_TWO 2
 /* ... unless at most this many are left and no others (cover_check) */
 #define WIDE_MAX 64
+/* ... or at most this many, the round kept only with the topology of
+   the mesh before the rounds (a groove: mesh_rounds) */
+#define WIDE_SPLIT_MAX 2048
 
 static Mesh *mesh_copy(const Mesh *m);
 
@@ -2800,7 +2803,10 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
      (WIDE_MAX), they are split too, from then on (MeshReport.cover_wide):
      a round that opens a groove in places and closes it between is not
      kept (mesh_rounds), and few cells cost one round, where figure12's
-     obj5 at 0.0015 (thousands of them) took 3 times the time */
+     obj5 at 0.0015 (thousands of them) took 3 times the time. More, up
+     to WIDE_SPLIT_MAX, are a groove (cover_wide 2): split at once, the
+     round kept only with the first mesh's topology (obj5 at 0.01: 741
+     cells, proven in one round) */
   long skipped = 0;
   for (int pass = 0; pass < 2; pass++) {
     for (size_t i = 0; i < n && !m->uniform; i++) {
@@ -2821,8 +2827,8 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
                 hput(&m->ring, ckey(m->fine, (uint64_t)a, (uint64_t)b, (uint64_t)c), 1) < 0)
               goto done;
     }
-    if (m->ring.n || !skipped || skipped > WIDE_MAX) break;
-    rep->cover_wide_next = 1;
+    if (m->ring.n || !skipped || skipped > WIDE_SPLIT_MAX) break;
+    rep->cover_wide_next = skipped > WIDE_MAX ? 2 : 1;
   }
   for (size_t l = 0; m->ring.n && l < m->nleaves; l++) {
     const Leaf *lf = &m->leaves[l];
@@ -3836,7 +3842,9 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
          obj5 at 0.01 had 2 components that way). A round that proves
          every part of the surface within the tolerance is kept even when
          it changes them (an island smaller than the cells found, a thin
-         part or gap opened: MeshReport.cover_topo). A round that is
+         part or gap opened: MeshReport.cover_topo), unless its cells were
+         split as a groove (cover_wide 2: obj5 at 0.005, split round after
+         round, ended proven with genus 9). A round that is
          neither but has few cells left not proven (WIDE_MAX; seed 799 at
          0.03: 11 cells, then 16, then none) leads to the next, split
          again there, with the mesh kept before it as the fallback; many
@@ -3853,7 +3861,7 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
       }
       int more = ok && rep->cover_unproven < prep.cover_unproven;
       int same = ck.components == pck.components && ck.euler == pck.euler;
-      if (more && !same && rep->cover_unproven == 0) {
+      if (more && !same && rep->cover_unproven == 0 && rep->cover_wide != 2) {
         rep->cover_topo = 1;
         rep->first_components = pck.components;
         rep->first_euler = pck.euler;

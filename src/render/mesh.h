@@ -167,8 +167,9 @@ typedef struct MeshReport {
   int cover_last;          /* this round is the last (mesh.c, mesh_rounds) */
   int cover_wide;          /* this mesh's round split the cells not
                               proven beside cells with two surfaces too
-                              (few were left and no others: mesh.c,
-                              cover_check) */
+                              (no others were left: 1 few, 2 a groove
+                              of more, kept only with the first mesh's
+                              topology: mesh.c, cover_check) */
   int cover_wide_next;     /* the next round will (internal) */
   int cover_topo;          /* this mesh's round proved every part of the
                               surface and changed the components or Euler
