@@ -660,7 +660,6 @@ typedef struct {
   size_t mem0, peak0;      /* resident bytes when meshing began, and the
                               process's peak then */
   size_t max_mem;          /* the growth allowed (MeshSettings.max_memory) */
-  int memout;              /* MESH_ELIMIT came from max_mem */
   hmap split;              /* (level, cell) -> 1 for every split cell */
   hmap *force;             /* (level, cell) -> 1 for cells that must split:
                               the surface in them was not proven within
@@ -762,14 +761,14 @@ static size_t peak_resident(void) {
 /* The resident memory has grown by more than the limit since meshing
    began, now or at a peak since (a check's tables freed before this
    looked: a peak above the process's peak before meshing is one of
-   meshing's). MESH_ELIMIT in m->err, m->memout. */
+   meshing's). MESH_ELIMIT in m->err, m->rep->memout set. */
 static int over_memory(Mesher *m) {
   if (!m->max_mem) return 0;
   size_t r = resident(), pk = peak_resident();
   if (pk > m->peak0 && pk > r) r = pk;
   if (r > m->mem0 && r - m->mem0 > m->max_mem) {
     m->err = MESH_ELIMIT;
-    m->memout = 1;
+    m->rep->memout = 1;
     return 1;
   }
   return 0;
@@ -3006,7 +3005,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   }
   if (walk(&m, 0, 0, 0, 0) < 0 || refine_two(&m) < 0) {
     rc = m.err;
-    if (rc == MESH_ELIMIT && m.memout)
+    if (rc == MESH_ELIMIT && rep->memout)
       memory_error(&m, err, errlen, 0);
     else if (rc == MESH_ELIMIT)
       snprintf(err, errlen, "the mesh needs more than %zu surface octree "
