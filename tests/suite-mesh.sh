@@ -34,6 +34,35 @@ if (cd "$tmp" && "$top/$QCS" -o cli.stl scene.qcs > out 2> err) && [ -s "$tmp/cl
   echo "ok mesh: qcs -o part.stl meshes the scene"
 else echo "FAIL mesh: -o part.stl: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 
+# qcs -o part.stl on a scene with a floor: refused, naming the floor and
+# the command line's way to give a box; --bounds meshes the part inside
+# it (the floor's slab below the raised cube: 2 components), and
+# --mesh-tolerance is the tolerance the report proves
+cat > "$tmp/floored.qcs" <<'Q'
+cube = Shift (0, 0.5, 0) (Rounded 0.07 UnitCube);
+floor = Halfspace ((0, 1, 0), 0);
+scene = Union cube floor;
+Q
+if (cd "$tmp" && "$top/$QCS" -o fl.stl floored.qcs > out 2> err); then echo "FAIL mesh: -o part.stl meshed a floor"
+elif grep -q "unbounded.*give --bounds X0,Y0,Z0,X1,Y1,Z1" "$tmp/err" && grep -q "floored.qcs:2:9" "$tmp/err" && [ ! -e "$tmp/fl.stl" ]; then
+  echo "ok mesh: -o part.stl refuses a floor, naming it and --bounds"
+else echo "FAIL mesh: -o part.stl with a floor: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
+if (cd "$tmp" && "$top/$QCS" -o fl.stl --bounds -1,-0.25,-1,2,2,2 --mesh-tolerance 0.02 floored.qcs > out 2> err) &&
+   [ -s "$tmp/fl.stl" ] && grep -q "topology: 2 components" "$tmp/err" &&
+   grep -q "requested 0.02;" "$tmp/err" && grep -q "surface to mesh: every part proven within 0.02 of the mesh" "$tmp/err"; then
+  echo "ok mesh: -o part.stl --bounds --mesh-tolerance meshes the part inside the box at that tolerance (the floor's slab and the cube, 2 components, proven)"
+else echo "FAIL mesh: --bounds/--mesh-tolerance: $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
+bad=0
+for a in "--mesh-tolerance 0" "--mesh-tolerance nan" "--mesh-tolerance 1e999" "--bounds 1,2,3" "--bounds 0,0,0,1,1,1," \
+         "--bounds 0,0,0,0,1,1" "--bounds 0,0,0,1,inf,1" "--bounds x,0,0,1,1,1"; do
+  # shellcheck disable=SC2086
+  if (cd "$tmp" && "$top/$QCS" -o bad.stl $a floored.qcs > out 2> err) || [ -e "$tmp/bad.stl" ] ||
+     ! grep -q "^qcs: error: --[a-z-]* needs" "$tmp/err"; then bad=1; echo "FAIL mesh: $a: $(head -c 200 "$tmp/err")"; fi
+done
+if (cd "$tmp" && "$top/$QCS" -o bad.png --bounds 0,0,0,1,1,1 floored.qcs > out 2> err) || [ -e "$tmp/bad.png" ] ||
+   ! grep -q "is for a mesh: it needs -o FILE.stl" "$tmp/err"; then bad=1; echo "FAIL mesh: --bounds with a picture: $(head -c 200 "$tmp/err")"; fi
+[ $bad = 0 ] && echo "ok mesh: bad --mesh-tolerance and --bounds values, and either without a mesh -o, are refused before anything runs"
+
 printf 'floor = Halfspace ((0, 1, 0), 0);\nmesh "floor.stl" floor\n' > "$tmp/floor.qcs"
 if (cd "$tmp" && "$top/$QCS" floor.qcs > out 2> err); then echo "FAIL mesh: a floor was meshed"
 elif grep -q "unbounded" "$tmp/err" && grep -q "floor.qcs:1:" "$tmp/err" && [ ! -e "$tmp/floor.stl" ]; then

@@ -12,6 +12,7 @@
  * deep (non-tail) recursion in user programs is limited by a clear
  * "recursion too deep" error rather than by the 8 MB default stack. */
 #include <gc.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -68,6 +69,8 @@ typedef struct Options {
   int a_first, a_last;
   int tiles;               /* --tiles N (with --index-env) */
   int index_env;           /* --index-env */
+  MeshCli mesh;            /* --mesh-tolerance, --bounds (-o part.stl) */
+  const char *mesh_opt;    /* the first of them given, for its error */
 } Options;
 
 static double now(void) {
@@ -133,6 +136,12 @@ static void usage(FILE *out) {
           "  -o FILE             render to FILE (.exr, .png, .ppm), or mesh to it\n"
           "                      (.stl, .obj, .ply, .3mf): what the scripts\n"
           "                      render, or else their `scene`\n"
+          "  --mesh-tolerance E  with -o FILE.stl (.obj, .ply, .3mf): the\n"
+          "                      mesh's tolerance, a distance (default 1/100\n"
+          "                      of the object's largest side)\n"
+          "  --bounds X0,Y0,Z0,X1,Y1,Z1  with a mesh -o: mesh the part inside\n"
+          "                      this box, closed by its faces (a scene\n"
+          "                      with a floor needs one)\n"
           "  --size WxH          image size, overriding the scripts' own\n"
           "  --spp N             samples per pixel (1, 4, 9, ...: n x n strata)\n"
           "  --threads N         render threads (default: all cores)\n"
@@ -337,7 +346,8 @@ static void *run(void *arg) {
     o->render.capture_ctx = o;
   } else if (o->render.output && mesh_is_mesh_path(o->render.output)) {
     o->render.capture = mesh_lang_capture; /* -o part.stl: mesh, not render */
-    o->render.capture_ctx = I;              /* its max-memory */
+    o->mesh.I = I;                          /* its max-memory */
+    o->render.capture_ctx = &o->mesh;
   }
   if (o->params) {
     o->status = interp_params(I, o->files[0], stdout) != RUN_OK;
@@ -833,6 +843,38 @@ int main(int argc, char **argv) {
       }
       o.render.tol = t;
       i++;
+    } else if (!strcmp(a, "--mesh-tolerance")) {
+      char *end;
+      double t = i + 1 < argc ? strtod(argv[i + 1], &end) : 0;
+      if (i + 1 >= argc || *end || !(t > 0) || !isfinite(t)) {
+        fprintf(stderr, "qcs: error: --mesh-tolerance needs a distance > 0, "
+                "like 0.001\n");
+        return 1;
+      }
+      o.mesh.tol = t;
+      if (!o.mesh_opt) o.mesh_opt = a;
+      i++;
+    } else if (!strcmp(a, "--bounds")) {
+      double v[6];
+      int k = 0;
+      const char *p = i + 1 < argc ? argv[i + 1] : "";
+      for (; k < 6; k++) { /* six numbers, a comma between each two */
+        char *end;
+        v[k] = strtod(p, &end);
+        if (end == p || !isfinite(v[k]) || *end != (k < 5 ? ',' : '\0')) break;
+        p = end + 1;
+      }
+      if (k < 6 || !(v[0] < v[3] && v[1] < v[4] && v[2] < v[5])) {
+        fprintf(stderr, "qcs: error: --bounds needs X0,Y0,Z0,X1,Y1,Z1, the "
+                "box's low and high corners, finite, with X0 < X1, Y0 < Y1 "
+                "and Z0 < Z1\n");
+        return 1;
+      }
+      o.mesh.has_bounds = 1;
+      memcpy(o.mesh.lo, v, sizeof o.mesh.lo);
+      memcpy(o.mesh.hi, v + 3, sizeof o.mesh.hi);
+      if (!o.mesh_opt) o.mesh_opt = a;
+      i++;
     } else if (!strcmp(a, "--cost")) {
       o.render.cost = 1;
     } else if (!strcmp(a, "--show")) {
@@ -877,6 +919,12 @@ int main(int argc, char **argv) {
   if (!sub && farm_resolve(&o)) return 1;
   if (o.render.output && o.nfiles == 0 && o.nexprs == 0) {
     fprintf(stderr, "qcs: error: -o needs a scene file to render\n");
+    return 1;
+  }
+  if (o.mesh_opt && !sub &&
+      !(o.render.output && mesh_is_mesh_path(o.render.output))) {
+    fprintf(stderr, "qcs: error: %s is for a mesh: it needs -o FILE.stl "
+            "(.obj, .ply, .3mf)\n", o.mesh_opt);
     return 1;
   }
   if (o.render.output) {

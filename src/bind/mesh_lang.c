@@ -153,14 +153,27 @@ static int do_mesh(const struct Scene *s, const MeshSettings *ms,
 int mesh_lang_capture(void *ctx, const struct Scene *s,
                       const struct RenderSettings *rs, const char *path,
                       char *err, size_t errlen) {
+  const MeshCli *cli = ctx;
   MeshSettings ms = {0};
   ms.tol = -1;
   ms.max_triangles = MESH_DEFAULT_MAX_TRIANGLES;
-  if (ctx) ms.max_memory = ((Interp *)ctx)->max_memory; /* qcs -o: main.c */
+  if (cli) { /* qcs -o: main.c */
+    if (cli->I) ms.max_memory = cli->I->max_memory;
+    if (cli->tol > 0) ms.tol = cli->tol;
+    if (cli->has_bounds) {
+      ms.has_bounds = 1;
+      memcpy(ms.lo, cli->lo, sizeof ms.lo);
+      memcpy(ms.hi, cli->hi, sizeof ms.hi);
+    }
+  }
   int bad;
   char e2[400];
   int rc = do_mesh(s, &ms, path, 0, &bad, e2, sizeof e2);
   if (rc == 0) return 0;
+  if (rc == MESH_EUNBOUNDED) /* the command line's way to give the box */
+    snprintf(e2, sizeof e2, "the object is unbounded (it has no finite "
+             "box): give --bounds X0,Y0,Z0,X1,Y1,Z1 to mesh the part inside "
+             "a box");
   if (bad >= 0) {
     Pos p = compile_node_pos(s, bad);
     if (p.src)

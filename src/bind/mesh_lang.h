@@ -17,9 +17,19 @@ struct RenderSettings;
 
 void mesh_lang_install(Interp *I);
 
+/* qcs -o FILE.stl's settings (main.c): the interpreter, whose max-memory
+   bounds the mesh; the tolerance (--mesh-tolerance; <= 0: the default,
+   1/100 of the object's largest side); the box (--bounds). */
+typedef struct MeshCli {
+  Interp *I;
+  double tol;
+  int has_bounds;
+  double lo[3], hi[3];
+} MeshCli;
+
 /* A RenderCapture (render_lang.h) for qcs -o FILE.stl / FILE.obj: meshes
-   the scene a render would draw, with the default tolerance, and writes
-   it. ctx is unused. */
+   the scene a render would draw and writes it. ctx is a MeshCli, or NULL
+   (the defaults). */
 int mesh_lang_capture(void *ctx, const struct Scene *s,
                       const struct RenderSettings *rs, const char *path,
                       char *err, size_t errlen);
