@@ -52,6 +52,14 @@ if (cd "$tmp" && "$top/$QCS" -o fl.stl --bounds -1,-0.25,-1,2,2,2 --mesh-toleran
    grep -q "requested 0.02;" "$tmp/err" && grep -q "surface to mesh: every part proven within 0.02 of the mesh" "$tmp/err"; then
   echo "ok mesh: -o part.stl --bounds --mesh-tolerance meshes the part inside the box at that tolerance (the floor's slab and the cube, 2 components, proven)"
 else echo "FAIL mesh: --bounds/--mesh-tolerance: $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
+# the box's low face in the floor's plane: the floor is left out, the
+# cube alone is meshed and proven (before, the proof failed along the
+# whole face)
+if (cd "$tmp" && "$top/$QCS" -o fl0.stl --bounds -1,0,-1,2,2,2 --mesh-tolerance 0.02 floored.qcs > out 2> err) &&
+   [ -s "$tmp/fl0.stl" ] && grep -q "topology: 1 component, Euler characteristic 2" "$tmp/err" &&
+   grep -q "surface to mesh: every part proven within 0.02 of the mesh" "$tmp/err"; then
+  echo "ok mesh: --bounds from the floor's plane up meshes the cube alone, proven"
+else echo "FAIL mesh: --bounds on the floor's plane: $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
 bad=0
 for a in "--mesh-tolerance 0" "--mesh-tolerance nan" "--mesh-tolerance 1e999" "--bounds 1,2,3" "--bounds 0,0,0,1,1,1," \
          "--bounds 0,0,0,0,1,1" "--bounds 0,0,0,1,inf,1" "--bounds x,0,0,1,1,1"; do

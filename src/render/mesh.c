@@ -2,6 +2,7 @@
    exact (sharp) tetrahedra, the checks and the writers (see mesh.h). */
 #include "render/mesh.h"
 
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
@@ -349,7 +350,7 @@ static int set_op(const Scene *s, ScKind k, int a, int oa, int b, int ob,
    subtree); *onep is the node deciding a T_ONE result. flush as set_op's. */
 static int scene_box_g(const Scene *s, int node, const double lo[3],
                        const double hi[3], unsigned char *st, int *one,
-                       int *onep, int flush) {
+                       int *onep, int flush, const unsigned char *forced) {
   int f = s->nodes[node].first;
   for (int i = f; i <= node; i++) {
     const ScNode *nd = &s->nodes[i];
@@ -361,7 +362,9 @@ static int scene_box_g(const Scene *s, int node, const double lo[3],
       r = set_op(s, nd->kind, st[nd->a - f], one[nd->a - f], st[nd->b - f],
                  one[nd->b - f], &o, lo, hi, flush);
       break;
-    default: r = leaf_box(nd, lo, hi); break;
+    default:
+      r = forced && forced[i - f] ? forced[i - f] - 1 : leaf_box(nd, lo, hi);
+      break;
     }
     st[i - f] = (unsigned char)r;
     one[i - f] = o;
@@ -370,11 +373,6 @@ static int scene_box_g(const Scene *s, int node, const double lo[3],
   return st[node - f];
 }
 
-static int scene_box(const Scene *s, int node, const double lo[3],
-                     const double hi[3], unsigned char *st, int *one,
-                     int *onep) {
-  return scene_box_g(s, node, lo, hi, st, one, onep, 0);
-}
 
 /* ---- the gradient of a density tape over a box -------------------------- */
 
@@ -649,6 +647,8 @@ typedef struct {
   unsigned char *flip;     /* per node of the subtree: 1 if its solid
                               enters the object complemented (the right
                               side of an odd number of differences) */
+  unsigned char *forced;   /* per node of the subtree, 0 or 1 + its class
+                              over the whole clip box (clip_forced) */
   unsigned char *st;       /* scene_box scratch: classes */
   int *one;                /* scene_box scratch: T_ONE's node */
   unsigned char *st2, *rel;/* solid_along scratch: classes, live nodes */
@@ -710,6 +710,43 @@ typedef struct {
   MeshReport *rep;
   int err;                 /* MESH_E* */
 } Mesher;
+
+/* Halfspaces whose open solid misses the open clip box, as a floor does
+   under a box whose low face lies in its plane: forced[] says so (1 +
+   T_OUT), so that no cell counts them. Else a cell on that face, whose
+   closed box touches the plane, is undecided, and the surface-to-mesh
+   proof fails along the whole face though nothing is there. The least
+   of n . p - d over the closed clip box must be >= 0: exactly for an
+   axis-aligned plane, past a bound on its rounding otherwise; a clip
+   box open on an axis the normal has decides nothing. Only halfspaces
+   that enter the object as they are (not complemented by a difference:
+   m->flip): inside the clip box the class is then each cell's own, and
+   outside it, where the clipped solid is empty, the solid the classes
+   describe only shrinks. */
+static void clip_forced(const Mesher *m, unsigned char *forced) {
+  int f = m->s->nodes[m->node].first;
+  for (int x = f; x <= m->node; x++) {
+    const ScNode *nd = &m->s->nodes[x];
+    forced[x - f] = 0;
+    if (nd->kind != SC_HALFSPACE || m->flip[x - f]) continue;
+    double v = 0, mag = fabs(nd->d);
+    int nz = 0, ok = 1, k1 = 0;
+    for (int k = 0; k < 3 && ok; k++) {
+      if (nd->n[k] == 0) continue;
+      double c = nd->n[k] > 0 ? m->clo[k] : m->chi[k];
+      ok = isfinite(c);
+      v += nd->n[k] * c;
+      mag += fabs(nd->n[k] * c);
+      nz++;
+      k1 = k;
+    }
+    if (!ok || nz == 0) continue;
+    int out = nz == 1 && fabs(nd->n[k1]) == 1
+                  ? v >= nd->d   /* n_k c is exact: an exact comparison */
+                  : v - nd->d - 8 * DBL_EPSILON * mag >= 0;
+    if (out) forced[x - f] = 1 + T_OUT;
+  }
+}
 
 /* A smooth cell's bound (manual, "smooth enough"): a triangle with
    longest side d is within vtol + w (2/3) D'' / gmin of the surface, D''
@@ -1042,7 +1079,8 @@ static int solid_along(Mesher *m, const double lo[3], const double hi[3],
   int ok = 1, one, ys[SH_MAX];
   for (int i = 0; i < n && ok; i++) ok = rising(m, xs[i], lo, hi, u);
   if (ok) return 1;
-  int c = scene_box_g(m->s, m->node, lo, hi, m->st2, m->one2, &one, 0);
+  int c = scene_box_g(m->s, m->node, lo, hi, m->st2, m->one2, &one, 0,
+                      m->forced);
   if (c == T_IN || c == T_OUT) return 1;
   int ny = live_surfaces(m, m->st2, m->one2, ys);
   if (ny < 0) return 0;
@@ -1131,7 +1169,8 @@ static int resolvable(Mesher *m, const double lo[3], const double hi[3],
     double l2[3], h2[3];
     int one;
     eighth(lo, hi, c8, l2, h2);
-    int c = scene_box_g(m->s, m->node, l2, h2, m->st, m->one, &one, 1);
+    int c = scene_box_g(m->s, m->node, l2, h2, m->st, m->one, &one, 1,
+                        m->forced);
     if (c != T_MIX) continue;
     if (settled(m, c, one, l2, h2) == 2 && !resolvable(m, l2, h2, k - 1))
       return 0;
@@ -1171,7 +1210,8 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   }
   int one = -1;
   int c = clip_out ? T_OUT
-                   : scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one, 1);
+                   : scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one, 1,
+                                 m->forced);
   if (c == T_IN && !clip_in) c = T_MIX;
   if (c == T_OUT) {
     m->rep->empty++;
@@ -2244,7 +2284,7 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
       hi[a] = lo[a] + side;
     }
     int one, f = m->s->nodes[m->node].first;
-    scene_box(m->s, m->node, lo, hi, m->st, m->one, &one);
+    scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one, 0, m->forced);
     for (int x = f; x <= m->node; x++) {
       if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
       int y = 0;
@@ -2580,7 +2620,8 @@ static int cover_class(void *ctx, const double lo[3], const double hi[3]) {
     if (hi[a] <= m->clo[a] || lo[a] >= m->chi[a]) return 0;
     if (lo[a] <= m->clo[a] || hi[a] >= m->chi[a]) clip_in = 0;
   }
-  int k = scene_box_g(m->s, m->node, lo, hi, c->st, c->one, &one, 2);
+  int k = scene_box_g(m->s, m->node, lo, hi, c->st, c->one, &one, 2,
+                      m->forced);
   return !(k == T_OUT || (k == T_IN && clip_in));
 }
 
@@ -2765,7 +2806,7 @@ static int cover_check(Mesher *m, const Mesh *me, MeshReport *rep) {
     int one = -1;
     if (lf->kind == LEAF_SMOOTH &&
         scene_box_g(m->s, m->node, bx + 6 * n, bx + 6 * n + 3, cc[0].st,
-                    cc[0].one, &one, 1) == T_ONE)
+                    cc[0].one, &one, 1, m->forced) == T_ONE)
       fnode[n] = one;
     n++;
   }
@@ -2997,9 +3038,11 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   }
   m.ex = malloc(sizeof *m.ex);
   m.ray = ray_ctx_new(s, vtol);
+  if (ms->has_bounds && m.flip && (m.forced = malloc((size_t)nsub)))
+    clip_forced(&m, m.forced);
   int rc = MESH_OK;
   if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.flip || !m.st2 || !m.rel || !m.one2 || !m.ex ||
-      !m.ray) {
+      !m.ray || (ms->has_bounds && !m.forced)) {
     rc = MESH_ENOMEM;
     goto done;
   }
@@ -3252,6 +3295,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   if (rep->cover_more && !rep->cover_last) rc = MESH_RECOVER;
 done:
   if (rc == MESH_ENOMEM) snprintf(err, errlen, "out of memory while meshing");
+  free(m.forced);
   free(m.st);
   free(m.one);
   free(m.gst);

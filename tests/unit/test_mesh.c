@@ -1486,6 +1486,68 @@ static void cover_groove(void) {
   scene_free(s);
 }
 
+/* A floor under a Bounds box whose low face lies in the floor's plane
+   (qcs -o part.stl --bounds X0,0,Z0,... on a scene with a floor): the
+   floor's solid y < 0 has no point in the box, and is taken out of every
+   cell's class (clip_forced). Before, every cell on that face was
+   undecided and the surface-to-mesh proof failed along all of it. The
+   rounded cube standing on the floor is then all there is: its surface,
+   by the exact ray spans of 60 lines across it at heights from 0.001 up
+   (through its rounded side edges), within the tolerance of the mesh by brute
+   force. */
+static void bounds_floor(void) {
+  const char *obj = "Union (Rounded 0.1 UnitCube) (Halfspace ((0, 1, 0), 0))";
+  char buf[600], err[400];
+  Scene *s = compile(obj);
+  CHECK("bounds on a floor: compiled", s != NULL);
+  if (!s) return;
+  MeshSettings ms = {0};
+  ms.tol = 0.02;
+  ms.has_bounds = 1;
+  double lo[3] = {-0.5, 0, -0.5}, hi[3] = {1.5, 1.5, 1.5};
+  memcpy(ms.lo, lo, sizeof lo);
+  memcpy(ms.hi, hi, sizeof hi);
+  Mesh *m;
+  MeshReport rep;
+  int bad, rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  snprintf(buf, sizeof buf, "bounds on a floor: meshed (%s)", rc ? err : "ok");
+  CHECK(buf, rc == 0);
+  if (rc) {
+    scene_free(s);
+    return;
+  }
+  long eu;
+  int ok = closed_oriented(m, &eu);
+  snprintf(buf, sizeof buf, "bounds on a floor: every part proven within the "
+           "tolerance (%ld cells not); closed and oriented, Euler %ld (2), %ld "
+           "components (1)", rep.cover_unproven, eu, rep.components);
+  CHECK(buf, rep.cover_unproven == 0 && ok && eu == 2 && rep.components == 1);
+  RayCtx *c = ray_ctx_new(s, 1e-9);
+  static const double ys[] = {0.001, 0.003, 0.01, 0.03, 0.1, 0.5};
+  double worst = -1;
+  int hit = 0;
+  for (int i = 0; i < 6; i++)
+    for (int k = 0; k < 10; k++) {
+      /* away from the edges' rounding (0.1 wide): every line crosses */
+      double z = 0.15 + 0.07 * k, o[3] = {-0.4, ys[i], z}, d[3] = {1, 0, 0};
+      if (k & 1) { /* along z too */
+        o[0] = z;
+        o[2] = -0.4;
+        d[0] = 0;
+        d[2] = 1;
+      }
+      double f = crossings_far(s, m, c, o, d, 1.8);
+      hit += f >= 0;
+      worst = fmax(worst, f);
+    }
+  ray_ctx_free(c);
+  snprintf(buf, sizeof buf, "bounds on a floor: the cube's surface within 0.02 "
+           "of the mesh (%d of 60 lines cross it; worst %.3g)", hit, worst);
+  CHECK(buf, hit == 60 && worst >= 0 && worst <= 0.02);
+  mesh_free(m);
+  scene_free(s);
+}
+
 static void wide_check(const char *name, const MeshReport *rep) {
   char buf[400];
   snprintf(buf, sizeof buf, "%s: every part proven within the tolerance of "
@@ -1531,6 +1593,7 @@ static void sharp_kept(void) {
   cover_wide();
   cover_groove();
   cover_island();
+  bounds_floor();
   for (size_t k = 0; k < sizeof objs / sizeof objs[0]; k++) {
     char name[120], buf[300];
     snprintf(name, sizeof name, "long run scene %d (mixed)", num[k]);
