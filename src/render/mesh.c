@@ -711,41 +711,165 @@ typedef struct {
   int err;                 /* MESH_E* */
 } Mesher;
 
-/* Halfspaces whose open solid misses the open clip box, as a floor does
-   under a box whose low face lies in its plane: forced[] says so (1 +
-   T_OUT), so that no cell counts them. Else a cell on that face, whose
-   closed box touches the plane, is undecided, and the surface-to-mesh
-   proof fails along the whole face though nothing is there. The least
-   of n . p - d over the closed clip box must be >= 0: exactly for an
-   axis-aligned plane, past a bound on its rounding otherwise; a clip
-   box open on an axis the normal has decides nothing. Only halfspaces
-   that enter the object as they are (not complemented by a difference:
-   m->flip): inside the clip box the class is then each cell's own, and
-   outside it, where the clipped solid is empty, the solid the classes
-   describe only shrinks. */
-static void clip_forced(const Mesher *m, unsigned char *forced) {
+/* Whether halfspace nd's open solid (n . p < d) misses the open box
+   (blo, bhi): the least of n . p - d over the closed box is >= 0,
+   exactly for an axis-aligned plane (n_k c is exact: an exact
+   comparison), past a bound on its rounding otherwise. */
+static int halfspace_misses(const ScNode *nd, const double blo[3],
+                            const double bhi[3]) {
+  double v = 0, mag = fabs(nd->d);
+  int nz = 0, k1 = 0;
+  for (int k = 0; k < 3; k++) {
+    if (nd->n[k] == 0) continue;
+    double c = nd->n[k] > 0 ? blo[k] : bhi[k];
+    if (!isfinite(c)) return 0;
+    v += nd->n[k] * c;
+    mag += fabs(nd->n[k] * c);
+    nz++;
+    k1 = k;
+  }
+  if (nz == 0) return 0;
+  return nz == 1 && fabs(nd->n[k1]) == 1 ? v >= nd->d
+                                         : v - nd->d - 8 * DBL_EPSILON * mag >= 0;
+}
+
+/* Halfspaces whose open solid misses the open Bounds box (blo, bhi), as
+   a floor does under a box whose low face lies in its plane: forced[]
+   says so (1 + T_OUT), so that no cell counts them. Else a cell on that
+   face, whose closed box touches the plane, is undecided, and the
+   surface-to-mesh proof fails along the whole face though nothing is
+   there. Only halfspaces that enter the object as they are (not
+   complemented by a difference: m->flip), so that the object with them
+   taken out is the object in the box; outside the box the clip (or,
+   where there is none, the object's box without them:
+   box_without_missing) excludes them anyway. */
+static void clip_forced(const Mesher *m, const double blo[3],
+                        const double bhi[3], unsigned char *forced) {
   int f = m->s->nodes[m->node].first;
   for (int x = f; x <= m->node; x++) {
     const ScNode *nd = &m->s->nodes[x];
-    forced[x - f] = 0;
-    if (nd->kind != SC_HALFSPACE || m->flip[x - f]) continue;
-    double v = 0, mag = fabs(nd->d);
-    int nz = 0, ok = 1, k1 = 0;
-    for (int k = 0; k < 3 && ok; k++) {
-      if (nd->n[k] == 0) continue;
-      double c = nd->n[k] > 0 ? m->clo[k] : m->chi[k];
-      ok = isfinite(c);
-      v += nd->n[k] * c;
-      mag += fabs(nd->n[k] * c);
-      nz++;
-      k1 = k;
-    }
-    if (!ok || nz == 0) continue;
-    int out = nz == 1 && fabs(nd->n[k1]) == 1
-                  ? v >= nd->d   /* n_k c is exact: an exact comparison */
-                  : v - nd->d - 8 * DBL_EPSILON * mag >= 0;
-    if (out) forced[x - f] = 1 + T_OUT;
+    forced[x - f] = (unsigned char)(nd->kind == SC_HALFSPACE && !m->flip[x - f] &&
+                                            halfspace_misses(nd, blo, bhi)
+                                        ? 1 + T_OUT
+                                        : 0);
   }
+}
+
+/* The box of node with the halfspaces that clip_forced leaves out taken
+   as empty (a floor under the Bounds box): into lo, hi (lo > hi when
+   nothing is left), 1 if it is finite, 0 if not or out of memory. Node
+   by node, children first: a union's box is its operands', an
+   intersection's the bounded operands', a difference's its left
+   operand's (the right one is subtracted: its halfspaces are never left
+   out), any other node's render_node_box, and so is an operation's
+   whose operands are unbounded (planes that only bound together). */
+static int box_without_missing(const Scene *s, int node, const double blo[3],
+                               const double bhi[3], double lo[3],
+                               double hi[3]) {
+  int f = s->nodes[node].first, n = node - f + 1;
+  double (*b)[6] = malloc((size_t)n * sizeof *b);
+  unsigned char *ok = malloc((size_t)n);
+  if (!b || !ok) {
+    free(b);
+    free(ok);
+    return 0;
+  }
+  for (int x = f; x <= node; x++) {
+    const ScNode *nd = &s->nodes[x];
+    double *r = b[x - f];
+    int i = x - f;
+    if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF) {
+      int a = nd->a - f, c = nd->b - f;
+      if (nd->kind == SC_DIFF || (nd->kind == SC_INTER && !ok[c])) {
+        ok[i] = ok[a];
+        memcpy(r, b[a], sizeof b[a]);
+      } else if (nd->kind == SC_INTER && !ok[a]) {
+        ok[i] = 1;
+        memcpy(r, b[c], sizeof b[c]);
+      } else {
+        ok[i] = (unsigned char)(ok[a] && ok[c]);
+        for (int k = 0; k < 3; k++) {
+          r[k] = nd->kind == SC_UNION ? fmin(b[a][k], b[c][k]) : fmax(b[a][k], b[c][k]);
+          r[3 + k] = nd->kind == SC_UNION ? fmax(b[a][3 + k], b[c][3 + k])
+                                          : fmin(b[a][3 + k], b[c][3 + k]);
+        }
+      }
+      /* halfspaces only bound together (a cube is six): the node's own */
+      if (!ok[i]) ok[i] = (unsigned char)render_node_box(s, x, r, r + 3);
+    } else if (nd->kind == SC_HALFSPACE && halfspace_misses(nd, blo, bhi)) {
+      ok[i] = 1;
+      for (int k = 0; k < 3; k++) r[k] = HUGE_VAL, r[3 + k] = -HUGE_VAL;
+    } else {
+      ok[i] = (unsigned char)render_node_box(s, x, r, r + 3);
+    }
+  }
+  int res = ok[n - 1];
+  if (res) {
+    memcpy(lo, b[n - 1], 3 * sizeof *lo);
+    memcpy(hi, b[n - 1] + 3, 3 * sizeof *hi);
+  }
+  free(b);
+  free(ok);
+  return res;
+}
+
+/* 1 if no point of the closed box [lo, hi] is inside node's solid, by
+   three-valued classes node by node (children first): a halfspace is
+   out when the least of n . p - d over the box is >= 0
+   (halfspace_misses, the open box's test: the same), a rounded node
+   when its outer bound or its density's range (at most 0.5) says so, a
+   soft object when its field's range is at most its level; the
+   halfspaces in forced (clip_forced) are out. Unlike walk's classes, a
+   box touching a surface from outside counts as out: it holds none of
+   the open solid. 0 when undecided or out of memory. */
+static int solid_misses(const Scene *s, int node, const double lo[3],
+                        const double hi[3], const unsigned char *forced) {
+  int f = s->nodes[node].first, n = node - f + 1;
+  unsigned char *st = malloc((size_t)n);
+  if (!st) return 0;
+  for (int x = f; x <= node; x++) {
+    const ScNode *nd = &s->nodes[x];
+    int a = nd->a - f, b = nd->b - f, r = T_MIX;
+    double l, h;
+    switch (nd->kind) {
+    case SC_UNION:
+      r = st[a] == T_OUT && st[b] == T_OUT ? T_OUT
+          : st[a] == T_IN || st[b] == T_IN ? T_IN : T_MIX;
+      break;
+    case SC_INTER:
+      r = st[a] == T_OUT || st[b] == T_OUT ? T_OUT
+          : st[a] == T_IN && st[b] == T_IN ? T_IN : T_MIX;
+      break;
+    case SC_DIFF:
+      r = st[a] == T_OUT || st[b] == T_IN ? T_OUT
+          : st[a] == T_IN && st[b] == T_OUT ? T_IN : T_MIX;
+      break;
+    case SC_HALFSPACE:
+      vec3_plane_range(nd->n, nd->d, lo, hi, &l, &h);
+      r = (forced && forced[x - f]) || halfspace_misses(nd, lo, hi) ? T_OUT
+          : h < 0 ? T_IN : T_MIX;
+      break;
+    case SC_ROUNDED:
+      if (nd->outer && csg_box_class(nd->outer, lo, hi) == T_OUT) {
+        r = T_OUT;
+        break;
+      }
+      dt_range_box(nd->tape, lo, hi, &l, &h);
+      r = h <= 0.5 ? T_OUT : l > 0.5 ? T_IN : T_MIX;
+      break;
+    case SC_SOFT:
+      soft_field_box(nd->soft, lo, hi, &l, &h);
+      r = h <= soft_magic(nd->soft) ? T_OUT : T_MIX;
+      break;
+    case SC_EMPTY: r = T_OUT; break;
+    case SC_ALL: r = T_IN; break;
+    default: r = T_MIX; break;
+    }
+    st[x - f] = (unsigned char)r;
+  }
+  int out = st[n - 1] == T_OUT;
+  free(st);
+  return out;
 }
 
 /* A smooth cell's bound (manual, "smooth enough"): a triangle with
@@ -2928,17 +3052,28 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   rep->cover_wide = rep->cover_wide_next = keep.cover_wide_next;
   *out = NULL;
   *bad_node = -1;
-  double lo[3], hi[3];
-  if (!render_node_box(s, node, lo, hi)) {
+  /* lo, hi: the object's box (olo, ohi) within the Bounds box; an
+     unbounded object's with the halfspaces that miss the Bounds box
+     left out (a floor: clip_forced), else the Bounds box */
+  double lo[3], hi[3], olo[3], ohi[3];
+  int bounded = render_node_box(s, node, lo, hi);
+  if (!bounded && ms->has_bounds)
+    bounded = box_without_missing(s, node, ms->lo, ms->hi, lo, hi);
+  if (!bounded) {
     if (!ms->has_bounds) {
       *bad_node = unbounded_leaf(s, node);
       snprintf(err, errlen, "the object is unbounded (it has no finite "
                "box): give Bounds lo hi to mesh the part inside a box");
       return MESH_EUNBOUNDED;
     }
+    for (int i = 0; i < 3; i++) olo[i] = -HUGE_VAL, ohi[i] = HUGE_VAL;
     memcpy(lo, ms->lo, sizeof lo);
     memcpy(hi, ms->hi, sizeof hi);
-  } else if (ms->has_bounds) {
+  } else {
+    memcpy(olo, lo, sizeof olo);
+    memcpy(ohi, hi, sizeof ohi);
+  }
+  if (bounded && ms->has_bounds) {
     for (int i = 0; i < 3; i++) {
       lo[i] = fmax(lo[i], ms->lo[i]);
       hi[i] = fmin(hi[i], ms->hi[i]);
@@ -3005,11 +3140,12 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
        case for the sharp cells) */
     static const double shift[3] = {0.1713, 0.2389, 0.3167};
     m.org[i] = c - 0.5 * L + shift[i] * ht;
-    /* the clip box: the user's box where it cuts the object, else no
-       clip (the object's box is conservative; a clip there would keep
-       the cells at its faces from being proven plane) */
-    m.clo[i] = ms->has_bounds && ms->lo[i] >= lo[i] ? lo[i] : -HUGE_VAL;
-    m.chi[i] = ms->has_bounds && ms->hi[i] <= hi[i] ? hi[i] : HUGE_VAL;
+    /* the clip box: the user's box where it cuts into the object's,
+       else no clip (the object's box is conservative; a clip there, or
+       at a face the two boxes share, would keep the cells at its faces
+       from being proven plane) */
+    m.clo[i] = ms->has_bounds && ms->lo[i] > olo[i] ? lo[i] : -HUGE_VAL;
+    m.chi[i] = ms->has_bounds && ms->hi[i] < ohi[i] ? hi[i] : HUGE_VAL;
   }
   rep->depth = depth;
   rep->h = L / ldexp(1, depth);
@@ -3038,8 +3174,23 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   }
   m.ex = malloc(sizeof *m.ex);
   m.ray = ray_ctx_new(s, vtol);
-  if (ms->has_bounds && m.flip && (m.forced = malloc((size_t)nsub)))
-    clip_forced(&m, m.forced);
+  if (ms->has_bounds && m.flip && (m.forced = malloc((size_t)nsub))) {
+    clip_forced(&m, ms->lo, ms->hi, m.forced);
+    /* a face of the Bounds box that no solid lies beyond (a cube
+       standing on its low face: the object's box, padded for rounding,
+       reaches a little past it) clips nothing: no clip there, so that
+       the cells on it can be proven plane or sharp */
+    for (int i = 0; i < 6 && bounded; i++) {
+      int a = i % 3, up = i >= 3;
+      double *c = up ? &m.chi[a] : &m.clo[a], sl[3], sh[3];
+      if (!isfinite(*c)) continue;
+      memcpy(sl, olo, sizeof sl);
+      memcpy(sh, ohi, sizeof sh);
+      if (up) sl[a] = ms->hi[a];
+      else sh[a] = ms->lo[a];
+      if (solid_misses(s, node, sl, sh, m.forced)) *c = up ? HUGE_VAL : -HUGE_VAL;
+    }
+  }
   int rc = MESH_OK;
   if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.flip || !m.st2 || !m.rel || !m.one2 || !m.ex ||
       !m.ray || (ms->has_bounds && !m.forced)) {

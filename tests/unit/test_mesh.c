@@ -1546,6 +1546,27 @@ static void bounds_floor(void) {
   CHECK(buf, hit == 60 && worst >= 0 && worst <= 0.02);
   mesh_free(m);
   scene_free(s);
+  /* A sharp cube standing on the floor, the box's low face in the
+     floor's plane: no solid lies below that face (solid_misses: the
+     cube's box, padded for rounding, reaches 2e-9 below it), so it
+     clips nothing and the cube is one sharp cell, 12 triangles, as
+     without the floor; before, the clip there kept every cell on the
+     face at the finest level (13794 triangles). */
+  s = compile("Union UnitCube (Halfspace ((0, 1, 0), 0))");
+  CHECK("bounds on a floor, sharp: compiled", s != NULL);
+  if (!s) return;
+  rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+  snprintf(buf, sizeof buf, "bounds on a floor, sharp: meshed (%s)", rc ? err : "ok");
+  CHECK(buf, rc == 0);
+  if (!rc) {
+    ok = closed_oriented(m, &eu);
+    snprintf(buf, sizeof buf, "bounds on a floor, sharp: the cube alone, %zu "
+             "triangles (12), Euler %ld (2), %ld cells not proven",
+             m->nt, eu, rep.cover_unproven);
+    CHECK(buf, m->nt == 12 && ok && eu == 2 && rep.cover_unproven == 0);
+    mesh_free(m);
+  }
+  scene_free(s);
 }
 
 static void wide_check(const char *name, const MeshReport *rep) {
