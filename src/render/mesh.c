@@ -1336,6 +1336,22 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   int c = clip_out ? T_OUT
                    : scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one, 1,
                                  m->forced);
+  /* Full, and cut by one face of the clip box (no other face in or on
+     it): the clipped solid in the cell is that face's halfspace, a plane
+     the marching tetrahedra reproduce, their crossings on it exactly (a
+     slab of the floor cut by the box's sides) */
+  int clip_plane = 0;
+  if (c == T_IN && !clip_in && !m->uniform) {
+    int cut = 0, touch = 0;
+    for (int a = 0; a < 3; a++)
+      for (int e = 0; e < 2; e++) {
+        double f = e ? m->chi[a] : m->clo[a];
+        if (!isfinite(f)) continue;
+        if (lo[a] < f && f < hi[a]) cut++;
+        else if (lo[a] == f || hi[a] == f) touch++;
+      }
+    clip_plane = cut == 1 && !touch;
+  }
   if (c == T_IN && !clip_in) c = T_MIX;
   if (c == T_OUT) {
     m->rep->empty++;
@@ -1347,6 +1363,10 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   }
   Leaf lf = {{i, j, k}, (unsigned char)level, LEAF_FINE, 0, 0, 0, 0, 0, 0, 0};
   int leaf = m->uniform && level == m->fine;
+  if (clip_plane) {
+    lf.kind = LEAF_PLANE;
+    leaf = 1;
+  }
   int sheet = 0;           /* the surface in the cell is proven one sheet */
   if (c == T_ONE && clip_in && !m->uniform) {
     const ScNode *nd = &m->s->nodes[one];
