@@ -204,6 +204,23 @@ static double crossings_far(const Scene *s, const Mesh *m, RayCtx *c,
   return worst;
 }
 
+/* crossings_far over n lines, line i from o[i] along d[i] to tmax: the
+   largest (-1 if no line crosses the surface), and in *hit how many
+   lines cross it. */
+static double lines_far(const Scene *s, const Mesh *m, const double (*o)[3],
+                        const double (*d)[3], int n, double tmax, int *hit) {
+  RayCtx *c = ray_ctx_new(s, 1e-9);
+  double worst = -1;
+  *hit = 0;
+  for (int i = 0; i < n; i++) {
+    double f = crossings_far(s, m, c, o[i], d[i], tmax);
+    *hit += f >= 0;
+    worst = fmax(worst, f);
+  }
+  ray_ctx_free(c);
+  return worst;
+}
+
 /* Surface points (crossings of random rays through the box) against the
    mesh: the largest distance found. */
 static double surface_to_mesh(const Scene *s, const Mesh *m, int nrays) {
@@ -1420,18 +1437,15 @@ static void cover_island(void) {
            rep.first_components, rep.first_euler, rep.components, rep.euler);
   CHECK(buf, rep.cover_unproven == 0 && rep.cover_topo &&
                  rep.components > rep.first_components);
-  RayCtx *c = ray_ctx_new(s, 1e-9);
-  double worst = -1;
-  int hit = 0;
-  for (int i = 0; i <= 10; i++)
-    for (int k = 0; k <= 10; k++) {
-      double o[3] = {0.2005 + 0.0002 * i, 0.38, 0.349 + 0.00035 * k},
-             d[3] = {0, 0.02, 0};
-      double f = crossings_far(s, m, c, o, d, 1);
-      hit += f >= 0;
-      worst = fmax(worst, f);
+  double o[121][3], d[121][3];
+  for (int i = 0, l = 0; i <= 10; i++)
+    for (int k = 0; k <= 10; k++, l++) {
+      o[l][0] = 0.2005 + 0.0002 * i, o[l][1] = 0.38, o[l][2] = 0.349 + 0.00035 * k;
+      d[l][0] = 0, d[l][1] = 0.02, d[l][2] = 0;
     }
-  ray_ctx_free(c);
+  int hit;
+  double worst = lines_far(s, m, (const double (*)[3])o, (const double (*)[3])d,
+                           121, 1, &hit);
   snprintf(buf, sizeof buf, "scene 575: the island's surface within 0.03 of the "
            "mesh (%d of 121 lines cross it; worst %.3g)", hit, worst);
   CHECK(buf, hit >= 10 && worst >= 0 && worst <= 0.03);
@@ -1465,20 +1479,18 @@ static void cover_groove(void) {
            rep.cover_unproven, rep.cover_wide, eu);
   CHECK(buf, rep.cover_unproven == 0 && rep.cover_wide == 2 && !rep.cover_topo &&
                  !rep.cover_kept && ok && eu == 2 && rep.components == 1);
-  RayCtx *c = ray_ctx_new(s, 1e-9);
-  double worst = -1;
-  int hit = 0;
-  for (int i = 0; i < 11; i++)
-    for (int k = 0; k < 4; k++) {
+  double o[44][3], d[44][3];
+  for (int i = 0, l = 0; i < 11; i++)
+    for (int k = 0; k < 4; k++, l++) {
       /* down through the groove along the box's edge x = 0.25 .. 0.32
          (z = 0.4 .. 0.6) and, turned, along z = 0.25 .. 0.32 */
       double u = 0.29 + 0.0029 * i, w = k & 1 ? 0.6 : 0.4;
-      double o[3] = {k < 2 ? u : w, 1.05, k < 2 ? w : u}, d[3] = {0, -0.1, 0};
-      double f = crossings_far(s, m, c, o, d, 1);
-      hit += f >= 0;
-      worst = fmax(worst, f);
+      o[l][0] = k < 2 ? u : w, o[l][1] = 1.05, o[l][2] = k < 2 ? w : u;
+      d[l][0] = 0, d[l][1] = -0.1, d[l][2] = 0;
     }
-  ray_ctx_free(c);
+  int hit;
+  double worst = lines_far(s, m, (const double (*)[3])o, (const double (*)[3])d,
+                           44, 1, &hit);
   snprintf(buf, sizeof buf, "obj5 at 0.01: the groove's surface within 0.01 of "
            "the mesh (%d of 44 lines cross it; worst %.3g)", hit, worst);
   CHECK(buf, hit == 44 && worst >= 0 && worst <= 0.01);
@@ -1522,25 +1534,19 @@ static void bounds_floor(void) {
            "tolerance (%ld cells not); closed and oriented, Euler %ld (2), %ld "
            "components (1)", rep.cover_unproven, eu, rep.components);
   CHECK(buf, rep.cover_unproven == 0 && ok && eu == 2 && rep.components == 1);
-  RayCtx *c = ray_ctx_new(s, 1e-9);
   static const double ys[] = {0.001, 0.003, 0.01, 0.03, 0.1, 0.5};
-  double worst = -1;
-  int hit = 0;
-  for (int i = 0; i < 6; i++)
-    for (int k = 0; k < 10; k++) {
-      /* away from the edges' rounding (0.1 wide): every line crosses */
-      double z = 0.15 + 0.07 * k, o[3] = {-0.4, ys[i], z}, d[3] = {1, 0, 0};
-      if (k & 1) { /* along z too */
-        o[0] = z;
-        o[2] = -0.4;
-        d[0] = 0;
-        d[2] = 1;
-      }
-      double f = crossings_far(s, m, c, o, d, 1.8);
-      hit += f >= 0;
-      worst = fmax(worst, f);
+  double o[60][3], d[60][3];
+  for (int i = 0, l = 0; i < 6; i++)
+    for (int k = 0; k < 10; k++, l++) {
+      /* away from the edges' rounding (0.1 wide): every line crosses;
+         along x, and along z every other one */
+      double z = 0.15 + 0.07 * k;
+      o[l][0] = k & 1 ? z : -0.4, o[l][1] = ys[i], o[l][2] = k & 1 ? -0.4 : z;
+      d[l][0] = k & 1 ? 0 : 1, d[l][1] = 0, d[l][2] = k & 1 ? 1 : 0;
     }
-  ray_ctx_free(c);
+  int hit;
+  double worst = lines_far(s, m, (const double (*)[3])o, (const double (*)[3])d,
+                           60, 1.8, &hit);
   snprintf(buf, sizeof buf, "bounds on a floor: the cube's surface within 0.02 "
            "of the mesh (%d of 60 lines cross it; worst %.3g)", hit, worst);
   CHECK(buf, hit == 60 && worst >= 0 && worst <= 0.02);
