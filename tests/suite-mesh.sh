@@ -52,6 +52,14 @@ if (cd "$tmp" && "$top/$QCS" -o fl.stl --bounds -1,-0.25,-1,2,2,2 --mesh-toleran
    grep -q "requested 0.02;" "$tmp/err" && grep -q "surface to mesh: every part proven within 0.02 of the mesh" "$tmp/err"; then
   echo "ok mesh: -o part.stl --bounds --mesh-tolerance meshes the part inside the box at that tolerance (the floor's slab and the cube, 2 components, proven)"
 else echo "FAIL mesh: --bounds/--mesh-tolerance: $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
+# a sharp cube on a slab of the floor: the box's faces are sharp planes,
+# so the cut is exact: 28 triangles, volume 2.8 (1 + 3 x 0.2 x 3)
+printf 'scene = Union UnitCube (Halfspace ((0, 1, 0), 0));\n' > "$tmp/slab2.qcs"
+if (cd "$tmp" && "$top/$QCS" -o slab2.stl --bounds -1,-0.2,-1,2,2,2 slab2.qcs > out 2> err) &&
+   grep -q "^qcs: mesh slab2.stl: 28 triangles" "$tmp/err" &&
+   grep -q "surface to mesh: every part proven" "$tmp/err"; then
+  echo "ok mesh: --bounds cutting a floor under a cube: the cut exact, 28 triangles"
+else echo "FAIL mesh: the cut slab: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 # the box's low face in the floor's plane: the floor is left out, the
 # cube alone is meshed and proven (before, the proof failed along the
 # whole face)

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "bind/compile.h"
@@ -113,15 +114,55 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           r->crossings - r->bisected, r->bisected);
 }
 
-static int do_mesh(const struct Scene *s, const MeshSettings *ms,
+/* The scene with its root intersected with the box [lo, hi] as six
+   sharp halfspaces, appended to a copy of the node array (the nodes'
+   tapes and soft objects stay the scene's: free only out->nodes). The
+   box's faces are then planes of the mesher's sharp and plane cells, so
+   a cut through the object has its edges and corners exact, where a
+   clip box splits the cells along them to the finest level. 0, or -1
+   out of memory or when the root is not the last node (its subtree
+   and the box's would not be contiguous). */
+static int box_scene(const Scene *s, const double lo[3], const double hi[3],
+                     Scene *out) {
+  *out = *s;
+  out->nodes = NULL;
+  if (s->root != s->n - 1) return -1;
+  out->cap = s->n + 12;   /* 6 halfspaces, 6 intersections: no realloc */
+  out->nodes = malloc((size_t)out->cap * sizeof *out->nodes);
+  if (!out->nodes) return -1;
+  memcpy(out->nodes, s->nodes, (size_t)s->n * sizeof *s->nodes);
+  int root = s->root, tag = s->nodes[root].tag, box = -1;
+  for (int k = 0; k < 6; k++) {
+    ScNode h;
+    memset(&h, 0, sizeof h);
+    h.kind = SC_HALFSPACE;
+    h.a = h.b = -1;
+    h.tag = tag;
+    int a = k % 3;
+    h.n[a] = k < 3 ? -1 : 1;   /* -x < -lo, that is x > lo; x < hi */
+    h.d = k < 3 ? -lo[a] : hi[a];
+    int i = scene_add(out, &h);
+    box = box < 0 ? i : scene_add_op(out, SC_INTER, box, i, tag);
+  }
+  scene_add_op(out, SC_INTER, root, box, tag);
+  return 0;
+}
+
+static int do_mesh(const struct Scene *s0, const MeshSettings *ms,
                    const char *path, int quiet, int *bad, char *err,
                    size_t errlen) {
   Mesh *m;
   MeshReport rep;
   MeshSettings m2 = *ms;
+  /* with Bounds, the box's faces as sharp planes (box_scene); the
+     colours are still the object's parts' */
+  Scene boxed;
+  const Scene *s = s0;
+  if (ms->has_bounds && box_scene(s0, ms->lo, ms->hi, &boxed) == 0) s = &boxed;
+  int rc = 0;
   if (m2.tol < 0) { /* the default: relative to the object's box */
     double lo[3], hi[3], size = 0;
-    int bounded = render_node_box(s, s->root, lo, hi);
+    int bounded = render_node_box(s0, s0->root, lo, hi);
     if (!bounded && m2.has_bounds) {
       memcpy(lo, m2.lo, sizeof lo);
       memcpy(hi, m2.hi, sizeof hi);
@@ -131,23 +172,25 @@ static int do_mesh(const struct Scene *s, const MeshSettings *ms,
       if (isfinite(hi[i] - lo[i])) size = fmax(size, hi[i] - lo[i]);
     m2.tol = size > 0 ? MESH_DEFAULT_REL * size : 1;
   }
-  int rc = mesh_scene(s, s->root, &m2, &m, &rep, bad, err, errlen);
-  if (rc) return rc;
+  rc = mesh_scene(s, s->root, &m2, &m, &rep, bad, err, errlen);
+  if (rc) goto out;
   size_t pl = strlen(path);
   if (pl > 4 && (!strcmp(path + pl - 4, ".ply") || !strcmp(path + pl - 4, ".3mf"))) {
     /* the renderer's default object colour where no Colour is given */
     static const double grey[3] = {0.80, 0.78, 0.72};
-    if (mesh_colour(s, s->root, m, grey, 4 * rep.vtol) < 0) {
+    if (mesh_colour(s, s0->root, m, grey, 4 * rep.vtol) < 0) {
       mesh_free(m);
       snprintf(err, errlen, "out of memory while colouring the mesh");
-      return -1;
+      rc = -1;
+      goto out;
     }
   }
-  rc = mesh_write(m, path, err, errlen);
+  rc = mesh_write(m, path, err, errlen) ? -1 : 0;
   mesh_free(m);
-  if (rc) return -1;
-  if (!quiet) report(stderr, &rep, path, m2.tol);
-  return 0;
+  if (!rc && !quiet) report(stderr, &rep, path, m2.tol);
+out:
+  if (s == &boxed) free(boxed.nodes);
+  return rc;
 }
 
 int mesh_lang_capture(void *ctx, const struct Scene *s,
