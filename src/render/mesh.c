@@ -382,7 +382,12 @@ static int scene_box_g(const Scene *s, int node, const double lo[3],
    own derivative 3/4 (alpha^2 - 1) / r over its alpha range, the product
    and union rules with the operands' value ranges. Keeping one interval
    per leaf, not per axis, keeps a lone leaf's gradient exactly along its
-   normal, so a flat face of a rounded solid is seen to be flat. */
+   normal, so a flat face of a rounded solid is seen to be flat. At most
+   GR_MAX leaves are kept; past that the least (by the largest |c_k|) go
+   into a remainder vector of length at most rho, whatever its direction
+   (a rounded hole of 50 faces has some 36 of them live at its rim, most
+   with c_k near 0: without the remainder no bound at all was found
+   there, and the rim split to the octree's limit). */
 #define GR_MAX 16
 
 typedef struct {
@@ -391,34 +396,70 @@ typedef struct {
   int leaf[GR_MAX];
   unsigned char step[GR_MAX]; /* a sharp leaf: no derivative, a jump */
   double cl[GR_MAX], ch[GR_MAX];
+  double rho;              /* |the leaves' part not kept| <= rho */
 } GrIv;
 
+/* rho's sums and products rounded up (with room) */
+#define GR_UP (1 + 4 * DBL_EPSILON)
+
+/* Adds leaf's coefficient [l, h] to o as a new entry; when o is full,
+   the entry of least magnitude (this one or a kept one, not a step) goes
+   into o->rho. 0, or -1 when every entry is a step. */
+static int gr_push(GrIv *o, int leaf, unsigned char step, double l, double h) {
+  if (o->n < GR_MAX) {
+    o->leaf[o->n] = leaf;
+    o->step[o->n] = step;
+    o->cl[o->n] = l;
+    o->ch[o->n] = h;
+    o->n++;
+    return 0;
+  }
+  int j = -1;
+  double mj = HUGE_VAL, m = fmax(fabs(l), fabs(h));
+  for (int i = 0; i < o->n; i++) {
+    double mi = fmax(fabs(o->cl[i]), fabs(o->ch[i]));
+    if (!o->step[i] && !(mi >= mj)) j = i, mj = mi;
+  }
+  if (!step && !(m > mj)) { /* also when no kept entry may go */
+    o->rho = (o->rho + m) * GR_UP;
+    return 0;
+  }
+  if (j < 0) return -1;
+  o->rho = (o->rho + mj) * GR_UP;
+  o->leaf[j] = leaf;
+  o->step[j] = step;
+  o->cl[j] = l;
+  o->ch[j] = h;
+  return 0;
+}
+
 /* r = sx x + sy y on the coefficients (sx, sy intervals); -1 when more
-   than GR_MAX leaves are live. An operand multiplied by exactly 0 (a
+   than GR_MAX steps are live. An operand multiplied by exactly 0 (a
    product with a factor that is 0 over the whole box) drops out: the
    result does not depend on its leaves there. */
 static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
                   const GrIv *y, double syl, double syh) {
   GrIv o;
   o.n = 0;
-  for (int i = 0; i < x->n && !(sxl == 0 && sxh == 0); i++) {
+  o.rho = 0;
+  int zx = sxl == 0 && sxh == 0, zy = syl == 0 && syh == 0;
+  if (!zx && x->rho > 0)
+    o.rho = fmax(fabs(sxl), fabs(sxh)) * x->rho * GR_UP;
+  if (!zy && y->rho > 0)
+    o.rho = (o.rho + fmax(fabs(syl), fabs(syh)) * y->rho * GR_UP) * GR_UP;
+  for (int i = 0; i < x->n && !zx; i++) {
     o.leaf[o.n] = x->leaf[i];
     o.step[o.n] = x->step[i];
     iv_mul(sxl, sxh, x->cl[i], x->ch[i], &o.cl[o.n], &o.ch[o.n]);
     o.n++;
   }
-  for (int i = 0; i < y->n && !(syl == 0 && syh == 0); i++) {
+  for (int i = 0; i < y->n && !zy; i++) {
     double l, h;
     iv_mul(syl, syh, y->cl[i], y->ch[i], &l, &h);
     int j = 0;
     while (j < o.n && o.leaf[j] != y->leaf[i]) j++;
     if (j == o.n) {
-      if (o.n == GR_MAX) return -1;
-      o.leaf[o.n] = y->leaf[i];
-      o.step[o.n] = y->step[i];
-      o.cl[o.n] = l;
-      o.ch[o.n] = h;
-      o.n++;
+      if (gr_push(&o, y->leaf[i], y->step[i], l, h) < 0) return -1;
     } else {
       iv_add(o.cl[j], o.ch[j], l, h, &o.cl[j], &o.ch[j]);
       o.step[j] |= y->step[i];
@@ -479,6 +520,7 @@ static const GrIv *gr_tape(const dt_tape *t, const double lo[3],
       double rl, rh;
       vec3_plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
       x->n = 0;
+      x->rho = 0;
       if (lf->r <= 0) {
         x->l = rh < 0 ? 1 : 0;
         x->h = rl > 0 ? 0 : 1;
@@ -507,6 +549,7 @@ static const GrIv *gr_tape(const dt_tape *t, const double lo[3],
     } else if (in->op == DT_CONST) {
       x->l = x->h = in->c;
       x->n = 0;
+      x->rho = 0;
       sp++;
     } else {
       sp--;
@@ -540,12 +583,12 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   if (!r) return -1;
   memset(b, 0, sizeof *b);
   for (int i = 0; i < r->n; i++) step |= r->step[i];
-  if (r->n == 1) {
+  if (r->n == 1 && r->rho == 0) {
     b->planar = 1;
     return 0;
   }
-  if (step || r->n == 0) return -1;
-  double g0[3] = {0, 0, 0}, w = 0;
+  if (step || r->n == 0 || !isfinite(r->rho)) return -1;
+  double g0[3] = {0, 0, 0}, w = r->rho;
   for (int i = 0; i < r->n; i++) {
     const double *n = t->leaves[r->leaf[i]].n;
     double c = 0.5 * (r->cl[i] + r->ch[i]);
@@ -554,7 +597,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   }
   double len = sqrt(vec3_dot(g0, g0));
   if (!(len > 0) || !isfinite(len)) return -1;
-  double al = 0, ah = 0;
+  double al = -r->rho, ah = r->rho;
   for (int i = 0; i < r->n; i++) {
     double k = vec3_dot(t->leaves[r->leaf[i]].n, g0) / len, l, h;
     iv_mul(k, k, r->cl[i], r->ch[i], &l, &h);
@@ -564,7 +607,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   double gmin = al > 0 ? al : (ah < 0 ? -ah : 0);
   if (!(gmin > 0) || !isfinite(w)) return -1;
   /* the deviation from g0 along u = g0 / |g0| and across it */
-  double wu = 0, wp = 0;
+  double wu = r->rho, wp = r->rho;
   for (int i = 0; i < r->n; i++) {
     const double *n = t->leaves[r->leaf[i]].n;
     double k = vec3_dot(n, g0) / len, p[3];
@@ -1022,8 +1065,8 @@ static int grad_dir(Mesher *m, int x, const double lo[3], const double hi[3],
   const ScNode *nd = &m->s->nodes[x];
   if (nd->kind == SC_ROUNDED) {
     const GrIv *r = gr_tape(nd->tape, lo, hi, m->gst);
-    if (!r) return -1;
-    double low = 0;
+    if (!r || !isfinite(r->rho)) return -1;
+    double low = -r->rho;
     if (g0) g0[0] = g0[1] = g0[2] = 0;
     for (int i = 0; i < r->n; i++) {
       if (r->step[i]) return -1;
@@ -2802,7 +2845,12 @@ static int field_grad(void *ctx, int x, const double lo[3], const double hi[3],
   double mid[3] = {0, 0, 0}, rad = 0, al = 0, ah = 0, mag = 0;
   if (nd->kind == SC_ROUNDED) {
     const GrIv *r = gr_tape(nd->tape, lo, hi, c->gst);
-    if (!r || r->n == 0) return -1;
+    if (!r || r->n == 0 || !isfinite(r->rho)) return -1;
+    /* the remainder: any direction, within rho */
+    al = -r->rho;
+    ah = r->rho;
+    rad = r->rho;
+    mag = r->rho;
     for (int i = 0; i < r->n; i++) {
       if (r->step[i]) return -1;
       const double *n = nd->tape->leaves[r->leaf[i]].n;

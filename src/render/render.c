@@ -58,11 +58,14 @@ static Box box_inter(Box a, Box b) {
   return a;
 }
 
-/* A convex set n.x <= d over a list of planes, or a box. An intersection
-   that would hold more than CONVEX_MAX_PLANES planes becomes the
-   intersection of the two boxes instead (still conservative): convex_box
-   costs the fourth power of the plane count, and a scene can intersect a
-   million halfspaces. */
+/* A convex set n.x <= d over a list of planes, or a box: a set holding
+   the node's (only its box is asked for). An intersection that would
+   hold more than CONVEX_MAX_PLANES planes keeps that many of them
+   (shape_thin): convex_box costs the fourth power of the plane count,
+   and a scene can intersect a million halfspaces. Fewer planes hold
+   more, so the box stays conservative; they are chosen so that the set
+   stays bounded (a prism of 72 sides and its two caps, 74 planes, had no
+   box when the two halves' boxes, each unbounded, were intersected). */
 #define CONVEX_MAX_PLANES 64
 typedef struct Shape {
   int convex;
@@ -151,12 +154,51 @@ static Box convex_box(const Shape *s) {
 
 static Box shape_box(Shape *s) { return s->convex ? convex_box(s) : s->box; }
 
+/* Keeps CONVEX_MAX_PLANES of s's planes (s->n larger): first, for each
+   of the 26 directions to a cube's faces, edges and corners from its
+   centre, the plane whose normal is nearest it (so that a bounded set
+   stays bounded: every direction is then cut off by some plane, unless
+   the set is unbounded, or nearly, along it), then the others evenly
+   spread over the list. */
+static void shape_thin(Shape *s) {
+  int n = s->n, k = 0;
+  unsigned char *keep = calloc((size_t)n, 1);
+  if (!keep) { /* the first planes alone: still a superset */
+    s->n = CONVEX_MAX_PLANES;
+    return;
+  }
+  for (int dx = -1; dx <= 1; dx++)
+    for (int dy = -1; dy <= 1; dy++)
+      for (int dz = -1; dz <= 1; dz++) {
+        if (!dx && !dy && !dz) continue;
+        double u[3] = {dx, dy, dz}, best = -HUGE_VAL;
+        int bi = -1;
+        for (int i = 0; i < n; i++) {
+          double c = vec3_dot(s->pl[i], u);
+          if (c > best) best = c, bi = i;
+        }
+        if (bi >= 0 && !keep[bi]) keep[bi] = 1, k++;
+      }
+  /* then every (n / room)th of the rest */
+  int room = CONVEX_MAX_PLANES - k, rest = n - k, seen = 0;
+  for (int i = 0; i < n && room > 0; i++) {
+    if (keep[i]) continue;
+    if ((long)seen++ * room % rest < room) keep[i] = 1, k++;
+  }
+  int m = 0;
+  for (int i = 0; i < n && m < CONVEX_MAX_PLANES; i++)
+    if (keep[i]) memmove(s->pl[m++], s->pl[i], sizeof s->pl[i]);
+  s->n = m;
+  free(keep);
+}
+
 /* Combine two shapes by a set operation ('u', 'i', 'd' for a - b). */
 static void shape_combine(Shape *a, Shape *b, int op) {
-  if (op == 'i' && a->convex && b->convex &&
-      a->n + b->n <= CONVEX_MAX_PLANES) {
-    for (int i = 0; i < b->n; i++) shape_add(a, b->pl[i], b->pl[i][3]);
+  if (op == 'i' && a->convex && b->convex) {
+    for (int i = 0; i < b->n; i++)
+      if (shape_add(a, b->pl[i], b->pl[i][3]) < 0) break; /* a superset */
     shape_free(b);
+    if (a->n > CONVEX_MAX_PLANES) shape_thin(a);
     return;
   }
   Box ba = shape_box(a), bb = shape_box(b);
