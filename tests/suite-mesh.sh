@@ -47,6 +47,37 @@ if (cd "$tmp" && "$top/$QCS" -o fl.stl floored.qcs > out 2> err); then echo "FAI
 elif grep -q "unbounded.*give --bounds X0,Y0,Z0,X1,Y1,Z1" "$tmp/err" && grep -q "floored.qcs:2:9" "$tmp/err" && [ ! -e "$tmp/fl.stl" ]; then
   echo "ok mesh: -o part.stl refuses a floor, naming it and --bounds"
 else echo "FAIL mesh: -o part.stl with a floor: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
+# the refusal suggests a box (the cube's, padded: the cube stands 0.5
+# above the floor, so the box misses it), and that box meshes the cube
+# alone, proven
+sug=$(grep -o 'e\.g\. --bounds [-0-9.e,]*' "$tmp/err" | sed 's/^e\.g\. //')
+if [ -n "$sug" ] && (cd "$tmp" && "$top/$QCS" -o sug.stl $sug floored.qcs > out 2> err) &&
+   grep -q "topology: 1 component, Euler characteristic 2" "$tmp/err" &&
+   grep -q "surface to mesh: every part proven" "$tmp/err"; then
+  echo "ok mesh: the refusal suggests a box ($sug) that meshes the cube alone, proven"
+else echo "FAIL mesh: the suggested box '$sug': $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
+# a rounded plate with the kit's holes standing on the floor (bracket.qcs's
+# base): the suggested box's low face on the floor's plane, and through it
+# the plate alone, genus 2; a script's meshWith gets the same box as Bounds
+cat > "$tmp/plate.qcs" <<'Q'
+plate = Rounded 0.04 (Difference (Box (0, 0, 0) (1.6, 0.18, 0.8))
+          (DensityUnion (Shift (0.4, -0.5, 0.4) (Cylinder 0.1 1)) (Shift (1.2, -0.5, 0.4) (Cylinder 0.1 1))));
+scene = Union plate (Halfspace ((0, 1, 0), 0));
+Q
+"$top/$QCS" -o "$tmp/plate.stl" "$tmp/plate.qcs" > "$tmp/out" 2> "$tmp/err"
+sug=$(grep -o 'e\.g\. --bounds [-0-9.e,]*' "$tmp/err" | sed 's/^e\.g\. //')
+if [ -n "$sug" ] && grep -q "its low y face on the unbounded part's plane" "$tmp/err" &&
+   [ "$(echo "$sug" | cut -d, -f2)" = 0 ] &&
+   (cd "$tmp" && "$top/$QCS" -o plate.stl $sug plate.qcs > out 2> err) &&
+   grep -q "topology: 1 component, Euler characteristic -2 (genus 2" "$tmp/err" &&
+   grep -q "surface to mesh: every part proven" "$tmp/err"; then
+  echo "ok mesh: a rounded plate with two holes on the floor: the suggested box ($sug) from the floor's plane meshes the plate alone, genus 2, proven"
+else echo "FAIL mesh: the plate on the floor '$sug': $(head -c 400 "$tmp/err" | tr '\n' ' ')"; fi
+printf 'mesh "%s/plw.stl" scene\n' "$tmp" | cat "$tmp/plate.qcs" - > "$tmp/plw.qcs"
+if ! "$top/$QCS" "$tmp/plw.qcs" > "$tmp/out" 2> "$tmp/err" && [ ! -e "$tmp/plw.stl" ] &&
+   grep -q "give Bounds lo hi to mesh the part inside a box, e.g. Bounds (-0.[0-9]*, 0, -0.[0-9]*) (1.[0-9]*, 0.[0-9]*, 0.[0-9]*)" "$tmp/err"; then
+  echo "ok mesh: meshWith's refusal suggests the box as Bounds lo hi"
+else echo "FAIL mesh: meshWith's suggestion: $(head -c 300 "$tmp/err" | tr '\n' ' ')"; fi
 if (cd "$tmp" && "$top/$QCS" -o fl.stl --bounds -1,-0.25,-1,2,2,2 --mesh-tolerance 0.02 floored.qcs > out 2> err) &&
    [ -s "$tmp/fl.stl" ] && grep -q "topology: 2 components" "$tmp/err" &&
    grep -q "requested 0.02;" "$tmp/err" && grep -q "surface to mesh: every part proven within 0.02 of the mesh" "$tmp/err"; then

@@ -10,6 +10,7 @@
 #include "bind/render_lang.h"
 #include "lang/builtins.h"
 #include "lang/eval.h"
+#include "lang/print.h"
 #include "render/mesh.h"
 #include "render/render.h"
 
@@ -193,6 +194,39 @@ out:
   return rc;
 }
 
+/* Appends to err (of errlen bytes) a box to give an unbounded object,
+   in the command line's form (cli) or as Bounds, when one is found. */
+static void suggest_bounds(const Scene *s, int cli, char *err, size_t errlen) {
+  double lo[3], hi[3];
+  int r = mesh_suggest_bounds(s, s->root, lo, hi);
+  if (!r) return;
+  char v[6][32];
+  for (int k = 0; k < 3; k++) {
+    format_real(v[k], lo[k]);
+    format_real(v[3 + k], hi[k]);
+  }
+  size_t len = strlen(err);
+  if (cli)
+    snprintf(err + len, errlen - len, ", e.g. --bounds %s,%s,%s,%s,%s,%s",
+             v[0], v[1], v[2], v[3], v[4], v[5]);
+  else
+    snprintf(err + len, errlen - len, ", e.g. Bounds (%s, %s, %s) "
+             "(%s, %s, %s)", v[0], v[1], v[2], v[3], v[4], v[5]);
+  static const char *face[6] = {"low x", "low y", "low z",
+                                "high x", "high y", "high z"};
+  len = strlen(err);
+  snprintf(err + len, errlen - len, " (the box of the bounded parts, padded");
+  for (int k = 0, first = 1; k < 6; k++)
+    if (r >> 1 >> k & 1) {
+      len = strlen(err);
+      snprintf(err + len, errlen - len, "%s %s", first ? "; its" : ",", face[k]);
+      first = 0;
+    }
+  len = strlen(err);
+  snprintf(err + len, errlen - len, "%s)",
+           r >> 1 ? " face on the unbounded part's plane" : "");
+}
+
 int mesh_lang_capture(void *ctx, const struct Scene *s,
                       const struct RenderSettings *rs, const char *path,
                       char *err, size_t errlen) {
@@ -213,10 +247,12 @@ int mesh_lang_capture(void *ctx, const struct Scene *s,
   char e2[400];
   int rc = do_mesh(s, &ms, path, 0, &bad, e2, sizeof e2);
   if (rc == 0) return 0;
-  if (rc == MESH_EUNBOUNDED) /* the command line's way to give the box */
+  if (rc == MESH_EUNBOUNDED) { /* the command line's way to give the box */
     snprintf(e2, sizeof e2, "the object is unbounded (it has no finite "
              "box): give --bounds X0,Y0,Z0,X1,Y1,Z1 to mesh the part inside "
              "a box");
+    suggest_bounds(s, 1, e2, sizeof e2);
+  }
   if (bad >= 0) {
     Pos p = compile_node_pos(s, bad);
     if (p.src)
@@ -288,6 +324,7 @@ static Value *bi_mesh_with(Interp *I, Value **args, Pos pos) {
   int bad = -1;
   int rc = do_mesh(s, &ms, path, quiet, &bad, err, sizeof err);
   Pos bp = bad >= 0 ? compile_node_pos(s, bad) : pos;
+  if (rc == MESH_EUNBOUNDED) suggest_bounds(s, 0, err, sizeof err);
   scene_free(s);
   if (rc) {
     if (bad >= 0 && bp.src)

@@ -856,6 +856,89 @@ static int box_without_missing(const Scene *s, int node, const double blo[3],
   return res;
 }
 
+/* A number of the form k 10^e, as a double: k / 10^-e when e < 0, so
+   that it is the double nearest the decimal (it prints back short). */
+static double decimal(double k, int e) {
+  return e < 0 ? k / pow(10, -e) : k * pow(10, e);
+}
+
+int mesh_suggest_bounds(const Scene *s, int node, double lo[3], double hi[3]) {
+  int f = s->nodes[node].first, n = node - f + 1;
+  double (*b)[6] = malloc((size_t)n * sizeof *b);
+  unsigned char *st = malloc((size_t)n); /* 0 unbounded, 1 box, 2 a
+                                            halfspace, 3 one a union drops */
+  if (!b || !st) {
+    free(b);
+    free(st);
+    return 0;
+  }
+  for (int x = f; x <= node; x++) {
+    const ScNode *nd = &s->nodes[x];
+    double *r = b[x - f];
+    int i = x - f;
+    st[i] = (unsigned char)render_node_box(s, x, r, r + 3);
+    if (st[i]) continue;
+    if (nd->kind == SC_HALFSPACE) {
+      st[i] = 2;
+    } else if (nd->kind == SC_UNION) {
+      int a = nd->a - f, c = nd->b - f;
+      if (!st[a] || !st[c]) continue;
+      if (st[a] >= 2 && st[c] >= 2) continue; /* nothing bounded left */
+      const double *p = st[a] == 1 ? b[a] : b[c], *q = st[c] == 1 ? b[c] : b[a];
+      if (st[a] == 2) st[a] = 3; /* a union leaves it out */
+      if (st[c] == 2) st[c] = 3;
+      for (int k = 0; k < 3; k++) {
+        r[k] = fmin(p[k], q[k]);
+        r[3 + k] = fmax(p[3 + k], q[3 + k]);
+      }
+      st[i] = 1;
+    }
+  }
+  int ok = st[n - 1] == 1, faces = 0;
+  double blo[3], bhi[3], size = 0;
+  if (ok) {
+    memcpy(blo, b[n - 1], sizeof blo);
+    memcpy(bhi, b[n - 1] + 3, sizeof bhi);
+    for (int k = 0; k < 3; k++) {
+      if (!isfinite(blo[k]) || !isfinite(bhi[k]) || !(bhi[k] >= blo[k])) ok = 0;
+      else size = fmax(size, bhi[k] - blo[k]);
+    }
+    if (!(size > 0)) ok = 0;
+  }
+  if (ok) {
+    /* pad by 2% of the largest side, out to a grid of a power of ten no
+       wider than the pad, so that the numbers are short to type */
+    double pad = 0.02 * size;
+    int e = (int)floor(log10(pad));
+    double g = pow(10, e);
+    for (int k = 0; k < 3; k++) {
+      lo[k] = decimal(floor((blo[k] - pad) / g), e);
+      hi[k] = decimal(ceil((bhi[k] + pad) / g), e);
+    }
+    /* an axis-aligned dropped halfspace: the face on its plane, which
+       then leaves it out (clip_forced) when the bounded parts stand on
+       it; a plane beyond the bounded parts is already outside */
+    for (int x = f; x <= node; x++) {
+      const ScNode *nd = &s->nodes[x];
+      if (st[x - f] != 3) continue;
+      for (int k = 0; k < 3; k++) {
+        if (nd->n[k] == 1 && nd->d > lo[k] && nd->d < bhi[k])
+          lo[k] = nd->d, faces |= 1 << k;
+        if (nd->n[k] == -1 && -nd->d < hi[k] && -nd->d > blo[k])
+          hi[k] = -nd->d, faces |= 8 << k;
+      }
+    }
+    double l2[3], h2[3];
+    ok = 1;
+    for (int k = 0; k < 3; k++) ok &= lo[k] < hi[k];
+    /* the box must make the object bounded as the mesher takes it */
+    ok = ok && box_without_missing(s, node, lo, hi, l2, h2);
+  }
+  free(b);
+  free(st);
+  return ok ? 1 | faces << 1 : 0;
+}
+
 /* 1 if no point of the closed box [lo, hi] is inside node's solid, by
    three-valued classes node by node (children first): a halfspace is
    out when the least of n . p - d over the box is >= 0

@@ -203,6 +203,15 @@ enum {
 int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
                MeshReport *rep, int *bad_node, char *err, size_t errlen);
 void mesh_free(Mesh *m);
+/* For the error of an unbounded object: a box that makes it bounded, into
+   lo, hi, and 1; 0 if none is found. The box of the parts a union holds
+   beside its unbounded halfspaces, padded by 2% of its largest side out
+   to round decimals, with a face on each axis-aligned halfspace's plane
+   that cuts that padding (a floor under objects standing on it: the
+   floor is then left out, as Bounds does). Returns 0, or 1 plus twice a
+   mask of the faces put on a plane (bit k: low face of axis k, bit 3 + k:
+   high face). */
+int mesh_suggest_bounds(const Scene *s, int node, double lo[3], double hi[3]);
 
 /* Edge counting on the mesh alone. */
 typedef struct MeshCheck {

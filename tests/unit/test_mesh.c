@@ -1642,6 +1642,53 @@ static void kit_round_parts(void) {
   scene_free(s);
 }
 
+/* A box for an unbounded object's error (mesh_suggest_bounds): a sharp
+   cube on the floor gets a box from the floor's plane up, and meshed in
+   it is the cube alone, 12 triangles of volume 1 (exact); a cube raised
+   above the floor, a box that misses the floor; a tilted floor, none. */
+static void suggest_bounds(void) {
+  static const char *src[2] = {
+      "Union UnitCube (Halfspace ((0, 1, 0), 0))",
+      "Union (Shift (0, 2, 0) UnitCube) (Halfspace ((0, 1, 0), 0))"};
+  for (int c = 0; c < 2; c++) {
+    char buf[600], err[400];
+    Scene *s = compile(src[c]);
+    if (!s) {
+      CHECK(src[c], 0);
+      continue;
+    }
+    MeshSettings ms = {0};
+    ms.tol = 0.02;
+    double y0 = c ? 2 : 0;
+    int r = mesh_suggest_bounds(s, s->root, ms.lo, ms.hi);
+    snprintf(buf, sizeof buf, "%s: a box [%g %g %g] - [%g %g %g] holding the cube%s",
+             src[c], ms.lo[0], ms.lo[1], ms.lo[2], ms.hi[0], ms.hi[1], ms.hi[2],
+             c ? " and not the floor" : ", its low y face on the floor's plane");
+    CHECK(buf, r && ms.lo[0] < 0 && ms.lo[2] < 0 && ms.hi[0] > 1 && ms.hi[2] > 1 &&
+                   ms.hi[1] > y0 + 1 && (c ? ms.lo[1] > 0 && ms.lo[1] < y0
+                                           : ms.lo[1] == 0 && r == (1 | 2 << 1)));
+    ms.has_bounds = 1;
+    Mesh *m;
+    MeshReport rep;
+    int bad;
+    int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+    snprintf(buf, sizeof buf, "%s: meshed in that box (%s)", src[c], rc ? err : "ok");
+    CHECK(buf, rc == 0);
+    if (!rc) {
+      long eu;
+      snprintf(buf, sizeof buf, "%s: the cube alone, closed, volume %.17g", src[c],
+               volume(m));
+      CHECK(buf, closed_oriented(m, &eu) && eu == 2 && fabs(volume(m) - 1) < 1e-12);
+      mesh_free(m);
+    }
+    scene_free(s);
+  }
+  Scene *s = compile("Union UnitCube (Halfspace ((0, 1, 1), 0))");
+  double lo[3], hi[3];
+  CHECK("a tilted floor: no box suggested", s && !mesh_suggest_bounds(s, s->root, lo, hi));
+  if (s) scene_free(s);
+}
+
 static void wide_check(const char *name, const MeshReport *rep) {
   char buf[400];
   snprintf(buf, sizeof buf, "%s: every part proven within the tolerance of "
@@ -2586,6 +2633,7 @@ int main(void) {
            "(SoftObject 0.5 [Key (1, 1, 1) 0.8 1])");
   one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
   kit_round_parts();
+  suggest_bounds();
   predicates();
   cover_sphere();
   cover_columns_sphere();
