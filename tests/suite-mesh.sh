@@ -283,7 +283,7 @@ else
 fi
 
 if command -v admesh > /dev/null 2>&1; then
-  for f in cli.stl soft.stl slab.stl; do
+  for f in cli.stl soft.stl slab.stl plate.stl; do
     admesh "$tmp/$f" > "$tmp/adm" 2>&1
     if grep -q "No holes need to be filled" "$tmp/adm" &&
        grep -q "Total disconnected facets *: *0 " "$tmp/adm"; then

@@ -384,10 +384,11 @@ static int scene_box_g(const Scene *s, int node, const double lo[3],
    per leaf, not per axis, keeps a lone leaf's gradient exactly along its
    normal, so a flat face of a rounded solid is seen to be flat. At most
    GR_MAX leaves are kept; past that the least (by the largest |c_k|) go
-   into a remainder vector of length at most rho, whatever its direction
-   (a rounded hole of 50 faces has some 36 of them live at its rim, most
-   with c_k near 0: without the remainder no bound at all was found
-   there, and the rim split to the octree's limit). */
+   into a remainder, the sum of their c_k n_k bounded per axis (a
+   rounded hole of 50 faces has some 36 of them live at its rim, most
+   with c_k near 0; a rounded cone's apex, all 50: without the remainder
+   no bound at all was found there, and the rim or the apex split to the
+   octree's limit). */
 #define GR_MAX 16
 
 typedef struct {
@@ -396,16 +397,58 @@ typedef struct {
   int leaf[GR_MAX];
   unsigned char step[GR_MAX]; /* a sharp leaf: no derivative, a jump */
   double cl[GR_MAX], ch[GR_MAX];
-  double rho;              /* |the leaves' part not kept| <= rho */
+  double rl[3], rh[3];     /* the leaves' part not kept, per axis */
 } GrIv;
 
-/* rho's sums and products rounded up (with room) */
-#define GR_UP (1 + 4 * DBL_EPSILON)
+/* [*l, *h] += [a, b], rounded outwards (with room) */
+static void gr_acc(double *l, double *h, double a, double b) {
+  *l += a;
+  *h += b;
+  *l -= 4 * DBL_EPSILON * fabs(*l);
+  *h += 4 * DBL_EPSILON * fabs(*h);
+}
+
+/* The remainder of o += c n, c in [l, h]. */
+static void gr_rest_add(GrIv *o, const double n[3], double l, double h) {
+  for (int q = 0; q < 3; q++) {
+    double a, b;
+    iv_mul(n[q], n[q], l, h, &a, &b);
+    gr_acc(&o->rl[q], &o->rh[q], a, b);
+  }
+}
+
+static int gr_rest_none(const GrIv *r) {
+  for (int q = 0; q < 3; q++)
+    if (r->rl[q] != 0 || r->rh[q] != 0) return 0;
+  return 1;
+}
+
+/* The remainder R of r: its middle into mid (added), the bounds of
+   u . R into *al, *ah (added; u may be NULL), and the length of its
+   half-widths (a bound of |R - mid|), returned; HUGE_VAL if not finite. */
+static double gr_rest(const GrIv *r, const double *u, double mid[3], double *al,
+                      double *ah) {
+  double w2 = 0;
+  for (int q = 0; q < 3; q++) {
+    if (!isfinite(r->rl[q]) || !isfinite(r->rh[q])) return HUGE_VAL;
+    mid[q] += 0.5 * (r->rl[q] + r->rh[q]);
+    double hw = 0.5 * (r->rh[q] - r->rl[q]);
+    w2 += hw * hw;
+    if (u) {
+      double a, b;
+      iv_mul(u[q], u[q], r->rl[q], r->rh[q], &a, &b);
+      *al += a;
+      *ah += b;
+    }
+  }
+  return sqrt(w2) * (1 + 1e-12) + 1e-300;
+}
 
 /* Adds leaf's coefficient [l, h] to o as a new entry; when o is full,
    the entry of least magnitude (this one or a kept one, not a step) goes
-   into o->rho. 0, or -1 when every entry is a step. */
-static int gr_push(GrIv *o, int leaf, unsigned char step, double l, double h) {
+   into the remainder. 0, or -1 when every entry is a step. */
+static int gr_push(GrIv *o, const dt_leaf *lv, int leaf, unsigned char step,
+                   double l, double h) {
   if (o->n < GR_MAX) {
     o->leaf[o->n] = leaf;
     o->step[o->n] = step;
@@ -421,11 +464,11 @@ static int gr_push(GrIv *o, int leaf, unsigned char step, double l, double h) {
     if (!o->step[i] && !(mi >= mj)) j = i, mj = mi;
   }
   if (!step && !(m > mj)) { /* also when no kept entry may go */
-    o->rho = (o->rho + m) * GR_UP;
+    gr_rest_add(o, lv[leaf].n, l, h);
     return 0;
   }
   if (j < 0) return -1;
-  o->rho = (o->rho + mj) * GR_UP;
+  gr_rest_add(o, lv[o->leaf[j]].n, o->cl[j], o->ch[j]);
   o->leaf[j] = leaf;
   o->step[j] = step;
   o->cl[j] = l;
@@ -438,15 +481,18 @@ static int gr_push(GrIv *o, int leaf, unsigned char step, double l, double h) {
    product with a factor that is 0 over the whole box) drops out: the
    result does not depend on its leaves there. */
 static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
-                  const GrIv *y, double syl, double syh) {
+                  const GrIv *y, double syl, double syh, const dt_leaf *lv) {
   GrIv o;
   o.n = 0;
-  o.rho = 0;
   int zx = sxl == 0 && sxh == 0, zy = syl == 0 && syh == 0;
-  if (!zx && x->rho > 0)
-    o.rho = fmax(fabs(sxl), fabs(sxh)) * x->rho * GR_UP;
-  if (!zy && y->rho > 0)
-    o.rho = (o.rho + fmax(fabs(syl), fabs(syh)) * y->rho * GR_UP) * GR_UP;
+  for (int q = 0; q < 3; q++) {
+    double a = 0, b = 0, c = 0, d = 0;
+    o.rl[q] = o.rh[q] = 0;
+    if (!zx) iv_mul(sxl, sxh, x->rl[q], x->rh[q], &a, &b);
+    if (!zy) iv_mul(syl, syh, y->rl[q], y->rh[q], &c, &d);
+    gr_acc(&o.rl[q], &o.rh[q], a, b);
+    gr_acc(&o.rl[q], &o.rh[q], c, d);
+  }
   for (int i = 0; i < x->n && !zx; i++) {
     o.leaf[o.n] = x->leaf[i];
     o.step[o.n] = x->step[i];
@@ -459,7 +505,7 @@ static int gr_lin(GrIv *r, const GrIv *x, double sxl, double sxh,
     int j = 0;
     while (j < o.n && o.leaf[j] != y->leaf[i]) j++;
     if (j == o.n) {
-      if (gr_push(&o, y->leaf[i], y->step[i], l, h) < 0) return -1;
+      if (gr_push(&o, lv, y->leaf[i], y->step[i], l, h) < 0) return -1;
     } else {
       iv_add(o.cl[j], o.ch[j], l, h, &o.cl[j], &o.ch[j]);
       o.step[j] |= y->step[i];
@@ -520,7 +566,8 @@ static const GrIv *gr_tape(const dt_tape *t, const double lo[3],
       double rl, rh;
       vec3_plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
       x->n = 0;
-      x->rho = 0;
+      memset(x->rl, 0, sizeof x->rl);
+      memset(x->rh, 0, sizeof x->rh);
       if (lf->r <= 0) {
         x->l = rh < 0 ? 1 : 0;
         x->h = rl > 0 ? 0 : 1;
@@ -549,7 +596,8 @@ static const GrIv *gr_tape(const dt_tape *t, const double lo[3],
     } else if (in->op == DT_CONST) {
       x->l = x->h = in->c;
       x->n = 0;
-      x->rho = 0;
+      memset(x->rl, 0, sizeof x->rl);
+      memset(x->rh, 0, sizeof x->rh);
       sp++;
     } else {
       sp--;
@@ -558,12 +606,12 @@ static const GrIv *gr_tape(const dt_tape *t, const double lo[3],
       dt_range_op(in->op, a->l, a->h, y->l, y->h, &l, &h);
       int rc;
       switch (in->op) {
-      case DT_SUM: rc = gr_lin(a, a, 1, 1, y, 1, 1); break;
-      case DT_DIFF: rc = gr_lin(a, a, 1, 1, y, -1, -1); break;
-      case DT_RDIFF: rc = gr_lin(a, a, -1, -1, y, 1, 1); break;
-      case DT_PRODUCT: rc = gr_lin(a, a, y->l, y->h, y, a->l, a->h); break;
+      case DT_SUM: rc = gr_lin(a, a, 1, 1, y, 1, 1, t->leaves); break;
+      case DT_DIFF: rc = gr_lin(a, a, 1, 1, y, -1, -1, t->leaves); break;
+      case DT_RDIFF: rc = gr_lin(a, a, -1, -1, y, 1, 1, t->leaves); break;
+      case DT_PRODUCT: rc = gr_lin(a, a, y->l, y->h, y, a->l, a->h, t->leaves); break;
       default: /* x + y - x y */
-        rc = gr_lin(a, a, 1 - y->h, 1 - y->l, y, 1 - a->h, 1 - a->l);
+        rc = gr_lin(a, a, 1 - y->h, 1 - y->l, y, 1 - a->h, 1 - a->l, t->leaves);
         break;
       }
       if (rc < 0) return NULL;
@@ -583,12 +631,14 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   if (!r) return -1;
   memset(b, 0, sizeof *b);
   for (int i = 0; i < r->n; i++) step |= r->step[i];
-  if (r->n == 1 && r->rho == 0) {
+  if (r->n == 1 && gr_rest_none(r)) {
     b->planar = 1;
     return 0;
   }
-  if (step || r->n == 0 || !isfinite(r->rho)) return -1;
-  double g0[3] = {0, 0, 0}, w = r->rho;
+  if (step || r->n == 0) return -1;
+  /* the remainder: its middle in g0, its half-widths' length in w */
+  double g0[3] = {0, 0, 0}, dummy = 0, w = gr_rest(r, NULL, g0, &dummy, &dummy);
+  double rw = w;
   for (int i = 0; i < r->n; i++) {
     const double *n = t->leaves[r->leaf[i]].n;
     double c = 0.5 * (r->cl[i] + r->ch[i]);
@@ -597,7 +647,8 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   }
   double len = sqrt(vec3_dot(g0, g0));
   if (!(len > 0) || !isfinite(len)) return -1;
-  double al = -r->rho, ah = r->rho;
+  double al = 0, ah = 0, u0[3] = {g0[0] / len, g0[1] / len, g0[2] / len}, m0[3];
+  if (gr_rest(r, u0, m0, &al, &ah) == HUGE_VAL) return -1;
   for (int i = 0; i < r->n; i++) {
     double k = vec3_dot(t->leaves[r->leaf[i]].n, g0) / len, l, h;
     iv_mul(k, k, r->cl[i], r->ch[i], &l, &h);
@@ -607,7 +658,7 @@ static int grad_box(const dt_tape *t, const double lo[3], const double hi[3],
   double gmin = al > 0 ? al : (ah < 0 ? -ah : 0);
   if (!(gmin > 0) || !isfinite(w)) return -1;
   /* the deviation from g0 along u = g0 / |g0| and across it */
-  double wu = r->rho, wp = r->rho;
+  double wu = rw, wp = rw;
   for (int i = 0; i < r->n; i++) {
     const double *n = t->leaves[r->leaf[i]].n;
     double k = vec3_dot(n, g0) / len, p[3];
@@ -1148,9 +1199,10 @@ static int grad_dir(Mesher *m, int x, const double lo[3], const double hi[3],
   const ScNode *nd = &m->s->nodes[x];
   if (nd->kind == SC_ROUNDED) {
     const GrIv *r = gr_tape(nd->tape, lo, hi, m->gst);
-    if (!r || !isfinite(r->rho)) return -1;
-    double low = -r->rho;
-    if (g0) g0[0] = g0[1] = g0[2] = 0;
+    if (!r) return -1;
+    double low = 0, high = 0, mid[3] = {0, 0, 0};
+    if (gr_rest(r, u, mid, &low, &high) == HUGE_VAL) return -1;
+    if (g0) memcpy(g0, mid, sizeof mid);
     for (int i = 0; i < r->n; i++) {
       if (r->step[i]) return -1;
       const double *n = nd->tape->leaves[r->leaf[i]].n;
@@ -2928,12 +2980,17 @@ static int field_grad(void *ctx, int x, const double lo[3], const double hi[3],
   double mid[3] = {0, 0, 0}, rad = 0, al = 0, ah = 0, mag = 0;
   if (nd->kind == SC_ROUNDED) {
     const GrIv *r = gr_tape(nd->tape, lo, hi, c->gst);
-    if (!r || r->n == 0 || !isfinite(r->rho)) return -1;
-    /* the remainder: any direction, within rho */
-    al = -r->rho;
-    ah = r->rho;
-    rad = r->rho;
-    mag = r->rho;
+    if (!r || r->n == 0) return -1;
+    /* the remainder: its middle (across u with u) and half-widths */
+    double rm[3] = {0, 0, 0};
+    rad = gr_rest(r, u, rm, &al, &ah);
+    if (rad == HUGE_VAL) return -1;
+    double ru = u ? vec3_dot(rm, u) : 0;
+    for (int q = 0; q < 3; q++) {
+      mid[q] = rm[q] - ru * (u ? u[q] : 0);
+      mag += fabs(r->rl[q]) + fabs(r->rh[q]);
+    }
+    if (!u) rad = 0;
     for (int i = 0; i < r->n; i++) {
       if (r->step[i]) return -1;
       const double *n = nd->tape->leaves[r->leaf[i]].n;

@@ -1600,7 +1600,7 @@ static void bounds_floor(void) {
    hole (at its rim some 36 of the hole's faces are live in a cell, more
    than the gradient bound keeps: the rest as a remainder, where before
    no bound was found and the rim split to the octree's limit, "thinner
-   than the finest cell"), and prisms of more than 64 planes, whose box
+   than the finest cell"; a rounded cone's apex, all 50), and prisms of more than 64 planes, whose box
    the renderer found by intersecting two unbounded halves (no box: the
    mesher refused them as unbounded). The prism's box against its
    vertices, its volume against the n-gon's area, n/2 sin(2 pi/n) r^2 h,
@@ -1612,6 +1612,8 @@ static void kit_round_parts(void) {
       "(Shift (0.5, -0.5, 0.5) (Cylinder 0.1 1)))", 0.02, 0, 1, 0, 1);
   one("a rounded 72-sided disc", "Rounded 0.025 (CylinderWith [Sides 72] 1.18 0.3)",
       0.03, 2, 1, 0, 1);
+  one("a rounded 50-sided cone (all its faces live at the apex)",
+      "Rounded 0.04 (Cone 0.5 1)", 0.02, 2, 1, 0, 1);
   const long double pi = 3.141592653589793238462643383279503L;
   int n = 100;
   long double area = 0.5L * n * sinl(2 * pi / n);
