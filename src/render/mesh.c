@@ -787,6 +787,9 @@ typedef struct {
   size_t npls, cappls;
   int *plmap;              /* per node of the subtree: 2 (plane) + flip */
   unsigned char *pv;       /* pl_eval scratch */
+  int *prog, nprog;        /* pl_eval's nodes in the cell (pl_prog) */
+  int *alias;              /* per node: the node whose value it takes in
+                              the cell, or -1 when its class decides it */
   struct ExTet *ex;        /* exact_tet scratch */
   kmap vert2;              /* named corners of sharp cells -> mesh vertex */
   hmap crease;             /* (u, v) -> the surface's path between the
@@ -2293,25 +2296,65 @@ static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
   return lv_add(e, k, x, 1, -1, -1, -1);
 }
 
+/* pl_eval's program for the cell whose classes are in m->st: the nodes
+   its value depends on, children first. A node decided by its class
+   takes no part; an operation one of whose operands leaves the other
+   unchanged (an intersection with a part the cell is inside, a union
+   with one it is outside, a difference with one it is outside) takes
+   that operand's value: an intersection of n halfspaces of which two
+   cross the cell is two nodes and one operation, not 2n nodes. */
+static void pl_prog(Mesher *m) {
+  const Scene *s = m->s;
+  int f = s->nodes[m->node].first;
+  m->nprog = 0;
+  for (int i = f; i <= m->node; i++) {
+    const ScNode *nd = &s->nodes[i];
+    int c = m->st[i - f];
+    if (c == T_IN || c == T_OUT) {
+      m->alias[i - f] = -1;
+      continue;
+    }
+    if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF) {
+      int ca = m->st[nd->a - f], cb = m->st[nd->b - f], id = nd->kind == SC_INTER ? T_IN : T_OUT;
+      if (nd->kind != SC_DIFF && ca == id) {
+        m->alias[i - f] = m->alias[nd->b - f];
+        continue;
+      }
+      if (cb == id) {
+        m->alias[i - f] = m->alias[nd->a - f];
+        continue;
+      }
+    }
+    m->alias[i - f] = i;
+    m->prog[m->nprog++] = i;
+  }
+}
+
+/* A node's value in pl_eval: its class's, or its alias's. */
+static int pl_val(const Mesher *m, int f, int x) {
+  int c = m->st[x - f];
+  if (c == T_IN || c == T_OUT) return c == T_IN;
+  return m->pv[m->alias[x - f] - f];
+}
+
 /* The solid's value with each plane on the side its bit says (scene_box's
-   classes in m->st decide every other node). */
+   classes in m->st decide every other node; pl_prog made the program). */
 static int pl_eval(const Mesher *m, unsigned bits) {
   const Scene *s = m->s;
   int f = s->nodes[m->node].first;
-  for (int i = f; i <= m->node; i++) {
+  for (int k = 0; k < m->nprog; k++) {
+    int i = m->prog[k], v;
     const ScNode *nd = &s->nodes[i];
-    int c = m->st[i - f], v;
-    if (c == T_IN || c == T_OUT) v = c == T_IN;
-    else if (nd->kind == SC_HALFSPACE) {
+    if (nd->kind == SC_HALFSPACE) {
       int q = m->plmap[i - f];
       v = (int)(bits >> (q >> 1) & 1) ^ (q & 1);
     } else {
-      int a = m->pv[nd->a - f], b = m->pv[nd->b - f];
+      int a = pl_val(m, f, nd->a), b = pl_val(m, f, nd->b);
       v = nd->kind == SC_UNION ? a | b : nd->kind == SC_INTER ? a & b : a & !b;
     }
     m->pv[i - f] = (unsigned char)v;
   }
-  return m->pv[m->node - f];
+  return pl_val(m, f, m->node);
 }
 
 static int lv_global(ExTet *e, int i) {
@@ -2615,6 +2658,7 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
       const ScNode *a = &m->s->nodes[x], *b = &m->s->nodes[m->pls[lf->pl0 + y]];
       m->plmap[x - f] = 2 * y + (vec3_dot(a->n, b->n) < 0);
     }
+    pl_prog(m);
     mk = exact_tet;
   }
   m->nft = 0;
@@ -3365,6 +3409,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.gst = malloc(DT_STACK_MAX * sizeof *m.gst);
   m.plmap = malloc((size_t)nsub * sizeof *m.plmap);
   m.pv = malloc((size_t)nsub);
+  m.prog = malloc((size_t)nsub * sizeof *m.prog);
+  m.alias = malloc((size_t)nsub * sizeof *m.alias);
   m.flip = malloc((size_t)nsub);
   m.st2 = malloc((size_t)nsub);
   m.rel = malloc((size_t)nsub);
@@ -3400,7 +3446,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     }
   }
   int rc = MESH_OK;
-  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.flip || !m.st2 || !m.rel || !m.one2 || !m.ex ||
+  if (!m.st || !m.one || !m.gst || !m.plmap || !m.pv || !m.prog || !m.alias || !m.flip || !m.st2 || !m.rel || !m.one2 || !m.ex ||
       !m.ray || (ms->has_bounds && !m.forced)) {
     rc = MESH_ENOMEM;
     goto done;
@@ -3660,6 +3706,8 @@ done:
   free(m.gst);
   free(m.plmap);
   free(m.pv);
+  free(m.prog);
+  free(m.alias);
   free(m.flip);
   free(m.st2);
   free(m.rel);
