@@ -920,21 +920,29 @@ int mesh_suggest_bounds(const Scene *s, int node, double lo[3], double hi[3]) {
   int f = s->nodes[node].first, n = node - f + 1;
   double (*b)[6] = malloc((size_t)n * sizeof *b);
   unsigned char *st = malloc((size_t)n); /* 0 unbounded, 1 box, 2 a
-                                            halfspace, 3 one a union drops */
+                                            halfspace, 3 one a union drops,
+                                            4 to do */
   if (!b || !st) {
     free(b);
     free(st);
     return 0;
   }
+  /* the nodes reached from the root through unions (st 4), then their
+     boxes children first; a union's from its operands' (as
+     render_node_box makes it), not again from its subtree, so that the
+     work is linear in a long union */
+  memset(st, 0, (size_t)n);
+  st[n - 1] = 4;
+  for (int x = node; x >= f; x--)
+    if (st[x - f] == 4 && s->nodes[x].kind == SC_UNION)
+      st[s->nodes[x].a - f] = st[s->nodes[x].b - f] = 4;
   for (int x = f; x <= node; x++) {
     const ScNode *nd = &s->nodes[x];
     double *r = b[x - f];
     int i = x - f;
-    st[i] = (unsigned char)render_node_box(s, x, r, r + 3);
-    if (st[i]) continue;
-    if (nd->kind == SC_HALFSPACE) {
-      st[i] = 2;
-    } else if (nd->kind == SC_UNION) {
+    if (st[i] != 4) continue;
+    st[i] = 0;
+    if (nd->kind == SC_UNION) {
       int a = nd->a - f, c = nd->b - f;
       if (!st[a] || !st[c]) continue;
       if (st[a] >= 2 && st[c] >= 2) continue; /* nothing bounded left */
@@ -946,6 +954,9 @@ int mesh_suggest_bounds(const Scene *s, int node, double lo[3], double hi[3]) {
         r[3 + k] = fmax(p[3 + k], q[3 + k]);
       }
       st[i] = 1;
+    } else {
+      st[i] = (unsigned char)render_node_box(s, x, r, r + 3);
+      if (!st[i] && nd->kind == SC_HALFSPACE) st[i] = 2;
     }
   }
   int ok = st[n - 1] == 1, faces = 0;
@@ -960,12 +971,13 @@ int mesh_suggest_bounds(const Scene *s, int node, double lo[3], double hi[3]) {
     if (!(size > 0)) ok = 0;
   }
   if (ok) {
-    /* pad by 2% of the largest side, out to a grid of a power of ten no
-       wider than the pad, so that the numbers are short to type */
-    double pad = 0.02 * size;
-    int e = (int)floor(log10(pad));
-    double g = pow(10, e);
+    /* pad each side by 2% of it (of a millionth of the largest at
+       least), out to a grid of a power of ten no wider than the pad, so
+       that the numbers are short to type */
     for (int k = 0; k < 3; k++) {
+      double pad = 0.02 * fmax(bhi[k] - blo[k], 1e-6 * size);
+      int e = (int)floor(log10(pad));
+      double g = pow(10, e);
       lo[k] = decimal(floor((blo[k] - pad) / g), e);
       hi[k] = decimal(ceil((bhi[k] + pad) / g), e);
     }

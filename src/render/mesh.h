@@ -205,8 +205,8 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
 void mesh_free(Mesh *m);
 /* For the error of an unbounded object: a box that makes it bounded, into
    lo, hi, and 1; 0 if none is found. The box of the parts a union holds
-   beside its unbounded halfspaces, padded by 2% of its largest side out
-   to round decimals, with a face on each axis-aligned halfspace's plane
+   beside its unbounded halfspaces, each side padded by 2% of it out to
+   round decimals, with a face on each axis-aligned halfspace's plane
    that cuts that padding (a floor under objects standing on it: the
    floor is then left out, as Bounds does). Returns 0, or 1 plus twice a
    mask of the faces put on a plane (bit k: low face of axis k, bit 3 + k:
