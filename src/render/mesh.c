@@ -1326,6 +1326,52 @@ static int planes_face(const Mesher *m, int x, int y, const double lo[3],
   return t0 > t1;
 }
 
+/* The sign of plane x's n . p - d at a point of plane y's part in the box
+   [lo, hi] (found on a box edge that plane y crosses): -1 inside x's
+   solid, 1 outside, 0 when none is found or it is too near x's plane to
+   tell. */
+static int side_on(const Mesher *m, int x, int y, const double lo[3],
+                   const double hi[3]) {
+  const ScNode *a = &m->s->nodes[x], *b = &m->s->nodes[y];
+  for (int e = 0; e < 12; e++) {
+    int ax = e / 4, u = (ax + 1) % 3, v = (ax + 2) % 3;
+    double p0[3], p1[3];
+    p0[ax] = lo[ax];
+    p1[ax] = hi[ax];
+    p0[u] = p1[u] = e & 1 ? hi[u] : lo[u];
+    p0[v] = p1[v] = e & 2 ? hi[v] : lo[v];
+    double s0 = vec3_dot(b->n, p0) - b->d, s1 = vec3_dot(b->n, p1) - b->d;
+    if ((s0 < 0) == (s1 < 0) || !(s0 != s1)) continue;
+    double t = s0 / (s0 - s1), p[3], mag = fabs(a->d);
+    for (int q = 0; q < 3; q++) {
+      p[q] = p0[q] + t * (p1[q] - p0[q]);
+      mag += fabs(a->n[q] * p[q]);
+    }
+    double w = vec3_dot(a->n, p) - a->d;
+    /* the crossing's rounding moves p by a few ulps of the box */
+    if (fabs(w) <= 1e-9 * (mag + fabs(hi[ax] - lo[ax]))) return 0;
+    return w < 0 ? -1 : 1;
+  }
+  return 0;
+}
+
+/* Two undecided halfspaces x and y whose planes do not meet in the box
+   (planes_face) cut it into three parts, the middle one touching both
+   planes; the solid has a part (or a gap) there thinner than the cell
+   only if its value in the middle differs from both sides'. Not so when
+   the middle lies inside exactly one of the two solids (they are
+   nested there: the sides of a many-sided prism, or of its hole) and
+   both enter the object alike (neither or both complemented, m->flip):
+   the object is then monotone in both, so the middle's value is between
+   the sides', equal to one of them. 1 when that is proven. */
+static int planes_nested(const Mesher *m, int x, int y, const double lo[3],
+                         const double hi[3]) {
+  int f = m->s->nodes[m->node].first;
+  if (m->flip[x - f] != m->flip[y - f]) return 0;
+  int sx = side_on(m, x, y, lo, hi), sy = side_on(m, y, x, lo, hi);
+  return sx && sy && (sx < 0) != (sy < 0);
+}
+
 /* ---- the solid as one sheet where several surfaces cross a cell ------- */
 
 /* The most surfaces solid_along follows in a box. */
@@ -1460,7 +1506,8 @@ static int settled(Mesher *m, int c, int one, const double lo[3],
     if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
     for (int y = f; y < x; y++)
       if (m->s->nodes[y].kind == SC_HALFSPACE && m->st[y - f] == T_ONE &&
-          !same_surface(m->s, x, y) && planes_face(m, x, y, lo, hi))
+          !same_surface(m->s, x, y) && planes_face(m, x, y, lo, hi) &&
+          !planes_nested(m, x, y, lo, hi))
         return (void)(m->badnode = x), 0;
   }
   int whole = solid_sheet(m, lo, hi);

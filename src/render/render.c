@@ -179,9 +179,9 @@ static void shape_thin(Shape *s) {
         }
         if (bi >= 0 && !keep[bi]) keep[bi] = 1, k++;
       }
-  /* then every (n / room)th of the rest */
+  /* then every (rest / room)th of the rest: room of them exactly */
   int room = CONVEX_MAX_PLANES - k, rest = n - k, seen = 0;
-  for (int i = 0; i < n && room > 0; i++) {
+  for (int i = 0; i < n && k < CONVEX_MAX_PLANES; i++) {
     if (keep[i]) continue;
     if ((long)seen++ * room % rest < room) keep[i] = 1, k++;
   }
