@@ -574,6 +574,52 @@ static void grow_regions(Ctx *C, const Adj *A, int *stack, const int *within,
   }
 }
 
+/* The boundary edges of every region of two or more triangles, sorted
+   (C->edges, C->B), and C->rbad for a region with a vertex twice on its
+   boundary. 0, or -1 out of memory. */
+static int bound_build(Ctx *C, const Adj *A) {
+  const Mesh *m = C->m;
+  size_t nt = m->nt, ne = 0;
+  free(C->edges);
+  free(C->B.rs);
+  C->edges = NULL;
+  C->B.rs = NULL;
+  C->nedges = 0;
+  memset(C->rbad, 0, nt);
+  for (size_t i = 0; i < nt; i++) {
+    int r = C->reg[i];
+    if (C->rcount[r] < 2) continue;
+    for (int e = 0; e < 3; e++) {
+      int j = across(A, (int)i, e);
+      ne += j < 0 || C->reg[j] != r;
+    }
+  }
+  C->edges = malloc((ne ? ne : 1) * sizeof *C->edges);
+  C->B.rs = calloc((size_t)C->nreg + 1, sizeof *C->B.rs);
+  if (!C->edges || !C->B.rs) return -1;
+  ne = 0;
+  for (size_t i = 0; i < nt; i++) {
+    int r = C->reg[i];
+    if (C->rcount[r] < 2) continue;
+    for (int e = 0; e < 3; e++) {
+      int j = across(A, (int)i, e);
+      if (j < 0 || C->reg[j] != r) {
+        BEdge b = {r, m->t[3 * i + (size_t)e], m->t[3 * i + (size_t)(e + 1) % 3]};
+        C->edges[ne++] = b;
+      }
+    }
+  }
+  qsort(C->edges, ne, sizeof *C->edges, bedge_cmp);
+  C->nedges = ne;
+  C->B.e = C->edges;
+  for (size_t k = 0; k < ne; k++) C->B.rs[C->edges[k].r + 1]++;
+  for (int r = 0; r < C->nreg; r++) C->B.rs[r + 1] += C->B.rs[r];
+  for (size_t k = 1; k < ne; k++)
+    if (C->edges[k].r == C->edges[k - 1].r && C->edges[k].a == C->edges[k - 1].a)
+      C->rbad[C->edges[k].r] = 1; /* a vertex twice on its boundary */
+  return 0;
+}
+
 static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
   size_t nv = m->nv, nt = m->nt;
   int rc = -2;
@@ -612,23 +658,28 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
     A.nb = nb;
   }
   /* flat regions, grown across edges from a seed's plane; then a region
-     whose boundary is long is grown again in patches of at most
-     MERGE_PATCH triangles (a polygon of many boundary vertices and none
-     inside triangulates into triangles across it, long and thin, whose
-     boxes meet many others: the self-intersection check's cost) */
+     whose boundary is long once its straight runs are dropped is grown
+     again in patches of at most MERGE_PATCH triangles (a polygon of many
+     boundary vertices and none inside triangulates into triangles across
+     it, long and thin, whose boxes meet many others: the
+     self-intersection check's cost). A flat face cut by the octree has
+     hundreds of boundary edges, most of them on straight runs between
+     two faces: counted before the runs were dropped, the top of a plate
+     with a 50-sided hole went in some 125 patches. */
   for (size_t i = 0; i < nt; i++) C.reg[i] = -1;
   grow_regions(&C, &A, stack, NULL, 1 << 30);
+  if (bound_build(&C, &A) < 0) goto out;
+  straight(&C, &A, gone);
   int *old = malloc(nt * sizeof *old), *blen = calloc((size_t)C.nreg, sizeof *blen);
   if (!old || !blen) {
     free(old);
     free(blen);
     goto out;
   }
-  for (size_t i = 0; i < nt; i++)
-    for (int e = 0; e < 3; e++) {
-      int j = across(&A, (int)i, e);
-      blen[C.reg[i]] += j < 0 || C.reg[j] != C.reg[i];
-    }
+  /* per region, its boundary's vertices not gone (a region with a vertex
+     twice on its boundary counted by its edges: it is not clipped) */
+  for (size_t k = 0; k < C.nedges; k++)
+    blen[C.edges[k].r] += !gone[C.edges[k].a] || C.rbad[C.edges[k].r];
   int longb = 0;
   for (size_t i = 0; i < nt; i++) {
     old[i] = C.reg[i];
@@ -660,39 +711,12 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
   }
   free(old);
   free(blen);
-  /* the boundaries of regions of two or more */
-  size_t ne = 0;
-  for (size_t i = 0; i < nt; i++) {
-    int r = C.reg[i];
-    if (C.rcount[r] < 2) continue;
-    for (int e = 0; e < 3; e++) {
-      int j = across(&A, (int)i, e);
-      ne += j < 0 || C.reg[j] != r;
-    }
+  if (longb) { /* the boundaries and the straight runs again */
+    memset(gone, 0, nv);
+    if (bound_build(&C, &A) < 0) goto out;
+    straight(&C, &A, gone);
   }
-  C.edges = malloc((ne ? ne : 1) * sizeof *C.edges);
-  C.B.rs = calloc((size_t)C.nreg + 1, sizeof *C.B.rs);
-  if (!C.edges || !C.B.rs) goto out;
-  ne = 0;
-  for (size_t i = 0; i < nt; i++) {
-    int r = C.reg[i];
-    if (C.rcount[r] < 2) continue;
-    for (int e = 0; e < 3; e++) {
-      int j = across(&A, (int)i, e);
-      if (j < 0 || C.reg[j] != r) {
-        BEdge b = {r, m->t[3 * i + (size_t)e], m->t[3 * i + (size_t)(e + 1) % 3]};
-        C.edges[ne++] = b;
-      }
-    }
-  }
-  qsort(C.edges, ne, sizeof *C.edges, bedge_cmp);
-  C.B.e = C.edges;
-  for (size_t k = 0; k < ne; k++) C.B.rs[C.edges[k].r + 1]++;
-  for (int r = 0; r < C.nreg; r++) C.B.rs[r + 1] += C.B.rs[r];
-  for (size_t k = 1; k < ne; k++)
-    if (C.edges[k].r == C.edges[k - 1].r && C.edges[k].a == C.edges[k - 1].a)
-      C.rbad[C.edges[k].r] = 1; /* a vertex twice on its boundary */
-  straight(&C, &A, gone);
+  size_t ne = C.nedges;
   /* each region again, by ear clipping */
   merged = calloc((size_t)C.nreg, 1);
   used = malloc(ne ? ne : 1);

@@ -2395,7 +2395,8 @@ static double mesh_gap(const Mesh *a, const Mesh *b, int n) {
    own triangles (MeshSettings.keep_flat) of the same object: fewer
    triangles (a unit cube 12, figure12's sharp obj1 28, OpenSCAD's count
    for it; a rotated plate with a sunk square, the case a review found
-   the clipping giving up on, 1746 -> 72); the same components and Euler characteristic; every vertex
+   the clipping giving up on, 1746 -> 72; a plate with a 50-sided hole,
+   216); the same components and Euler characteristic; every vertex
    one of the octree's, to the bit; and the same surface: 1500 points of
    either mesh within the stated bound (MeshReport.flat_moved) of the
    other, by brute force over its triangles. */
@@ -2418,6 +2419,15 @@ static void flat_merge(void) {
      "-0.200, -0.148) (Scale (0.812, 0.783, 0.580) UnitCube)))) (SoftObject 0.5 "
      "[Key (0.185, 0.335, 0.423) 0.601 1, Key (0.310, 0.172, 0.359) 0.797 1, Key "
      "(-0.146, -0.465, 0.158) 0.872 1, Key (0.463, -0.194, 0.031) 0.764 (-1)])", 0.03, -1},
+    /* 54 corners on each of its two faces, Euler characteristic 0: at
+       least 2 * 108 triangles, and no more when no vertex but a corner is
+       left (its top was 125 patches, 5722 triangles, while the boundary's
+       straight runs counted towards a region's length) */
+    {"a plate with a 50-sided hole", "Difference (Scale (2, 0.2, 2) UnitCube) (Shift "
+     "(1, -0.5, 1) (CylinderWith [Sides 50] 0.5 2))", 0.02, 216},
+    {"a rotated plate with a 50-sided hole", "Rotate \"z\" 30 (Rotate \"x\" 20 "
+     "(Difference (Scale (2, 0.2, 2) UnitCube) (Shift (1, -0.5, 1) (CylinderWith "
+     "[Sides 50] 0.5 2))))", 0.001, -1},
   };
   unsigned long long keep = rng;
   for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
