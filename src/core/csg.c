@@ -673,6 +673,96 @@ static int box_op(csg_op op, int a, int b) {
   }
 }
 
+int csg_prune_box(const csg_tape *t, const double lo[3], const double hi[3],
+                  csg_instr *buf, csg_tape *view) {
+  /* per stack entry: a constant (CSG_BOX_IN or CSG_BOX_OUT), or -1 for
+     code, buf[start ..) */
+  int kind[CSG_STACK_MAX + 1], start[CSG_STACK_MAX + 1], sp = 0, n = 0;
+  for (int i = 0; i < t->ncode; i++) {
+    const csg_instr *in = &t->code[i];
+    if (in->op == CSG_PLANE || in->op == CSG_EMPTY || in->op == CSG_ALL) {
+      int c = in->op == CSG_EMPTY ? CSG_BOX_OUT : CSG_BOX_IN;
+      if (in->op == CSG_PLANE) {
+        const csg_plane *p = &t->planes[in->arg];
+        double rl, rh;
+        vec3_plane_range(p->n, p->d, lo, hi, &rl, &rh);
+        c = rh < 0 ? CSG_BOX_IN : (rl > 0 ? CSG_BOX_OUT : CSG_BOX_MIX);
+      }
+      kind[sp] = c == CSG_BOX_MIX ? -1 : c;
+      start[sp++] = n;
+      if (c == CSG_BOX_MIX) buf[n++] = *in;
+      continue;
+    }
+    sp--;
+    int op = in->op, x = kind[sp - 1], y = kind[sp];
+    if (op == CSG_RDIFF) { /* y - x: as a difference of the two swapped */
+      int r;
+      if (x >= 0 && y >= 0) r = box_op(CSG_DIFF, y, x);
+      else if (x >= 0) r = x == CSG_BOX_IN ? CSG_BOX_OUT : -2; /* y, or y */
+      else if (y >= 0) r = y == CSG_BOX_OUT ? CSG_BOX_OUT : -3; /* all - x */
+      else r = -4;
+      if (r >= 0) {
+        n = start[sp - 1];
+        kind[sp - 1] = r;
+      } else if (r == -2) { /* y - Empty: y's code in x's place */
+        kind[sp - 1] = -1;
+        start[sp - 1] = start[sp];
+      } else if (r == -3) { /* Everything - x */
+        buf[n++] = (csg_instr){CSG_ALL, 0};
+        buf[n++] = (csg_instr){CSG_RDIFF, 0};
+      } else {
+        buf[n++] = *in;
+      }
+      continue;
+    }
+    if (x >= 0 && y >= 0) {
+      kind[sp - 1] = box_op((csg_op)op, x, y);
+      continue;
+    }
+    if (x < 0 && y < 0) {
+      buf[n++] = *in;
+      continue;
+    }
+    /* one operand constant: the result is a constant, the other operand,
+       or (Everything - the other) */
+    int cst = x >= 0 ? x : y, other_first = x >= 0; /* the code is y's */
+    int res; /* CSG_BOX_IN / OUT, or -1: the other, -2: its complement */
+    switch (op) {
+    case CSG_UNION: res = cst == CSG_BOX_IN ? CSG_BOX_IN : -1; break;
+    case CSG_INTER: res = cst == CSG_BOX_OUT ? CSG_BOX_OUT : -1; break;
+    default: /* x - y */
+      if (x >= 0) res = x == CSG_BOX_OUT ? CSG_BOX_OUT : -2;
+      else res = y == CSG_BOX_IN ? CSG_BOX_OUT : -1;
+      break;
+    }
+    if (res >= 0) {
+      n = start[sp - 1];
+      kind[sp - 1] = res;
+      continue;
+    }
+    kind[sp - 1] = -1;
+    if (other_first) start[sp - 1] = start[sp];
+    if (res == -2) { /* Everything - y, y's code on the stack */
+      buf[n++] = (csg_instr){CSG_ALL, 0};
+      buf[n++] = (csg_instr){CSG_RDIFF, 0};
+    }
+  }
+  if (sp == 1 && kind[0] >= 0) {
+    n = 0;
+    buf[n++] = (csg_instr){kind[0] == CSG_BOX_IN ? CSG_ALL : CSG_EMPTY, 0};
+  }
+  *view = *t;
+  view->code = buf;
+  view->ncode = n;
+  view->nrcode = 0;
+  view->rcode = NULL;
+  view->ngroups = 0;
+  view->ndirs = 0;
+  view->dir = NULL;
+  view->dirs_of = NULL;
+  return n;
+}
+
 int csg_box_class(const csg_tape *t, const double lo[3], const double hi[3]) {
   unsigned char st[CSG_STACK_MAX];
   int sp = 0;

@@ -106,6 +106,19 @@ int csg_inside(const csg_tape *t, const double p[3]);
 enum { CSG_BOX_OUT = 0, CSG_BOX_IN = 1, CSG_BOX_MIX = 2 };
 int csg_box_class(const csg_tape *t, const double lo[3], const double hi[3]);
 
+/* The specialisation of t to the box [lo, hi], for csg_box_class on boxes
+ * inside it: each plane whose range over the box is wholly on one side
+ * becomes Everything or Empty, and the constants are folded (a union
+ * with Everything is Everything, with Empty its other operand, ...), in
+ * the three-valued logic csg_box_class uses, so the view classifies
+ * every box inside [lo, hi] as t does (where a plane's range over the
+ * inner box is computed within [lo, hi]'s). Writes at most t->ncode + 1
+ * instructions to buf (the view's code); *view borrows buf and t's
+ * planes, and has no ray program: only csg_box_class, csg_inside and
+ * csg_is_empty / csg_is_all may be asked of it. Returns the code length. */
+int csg_prune_box(const csg_tape *t, const double lo[3], const double hi[3],
+                  csg_instr *buf, csg_tape *view);
+
 /* Scratch spans a ray query on t needs. */
 static inline int csg_scratch_spans(const csg_tape *t) {
   return 2 * t->nleaves + 2;

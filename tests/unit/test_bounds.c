@@ -447,9 +447,59 @@ static void test_box_proofs(void) {
         bad_range == 0);
 }
 
+/* csg_prune_box (the mesher's views of a cell's bound solids): over
+ * boxes inside the box it was pruned for, the view classifies as the
+ * tape does, and points inside the box are inside the view exactly when
+ * the reference says so; it is never longer than the tape, and shorter
+ * for many boxes. */
+static void test_box_prune(void) {
+  rng_t g = {777};
+  int differ = 0, wrong = 0, longer = 0, shorter = 0, boxes = 0, sub = 0;
+  for (int sc = 0; sc < 60; sc++) {
+    rtree t;
+    int root = rt_random_scene(&t, &g);
+    csg_tape *ct = csg_of(&t, root);
+    csg_instr *buf = malloc(((size_t)ct->ncode + 1) * sizeof *buf);
+    for (int k = 0; k < 40; k++, boxes++) {
+      double lo[3], hi[3], w = rng_range(&g, 1e-3, 1.5);
+      for (int i = 0; i < 3; i++) {
+        lo[i] = rng_range(&g, -1.4, 2.4);
+        hi[i] = lo[i] + w * rng_range(&g, 0.2, 1);
+      }
+      csg_tape v;
+      int n = csg_prune_box(ct, lo, hi, buf, &v);
+      longer += n > ct->ncode;
+      shorter += n < ct->ncode;
+      for (int j = 0; j < 10; j++, sub++) {
+        double sl[3], sh[3];
+        for (int i = 0; i < 3; i++) {
+          double a = rng_range(&g, lo[i], hi[i]), b = rng_range(&g, lo[i], hi[i]);
+          sl[i] = fmin(a, b);
+          sh[i] = fmax(a, b);
+        }
+        if (j == 0) memcpy(sl, lo, sizeof sl), memcpy(sh, hi, sizeof sh);
+        differ += csg_box_class(&v, sl, sh) != csg_box_class(ct, sl, sh);
+        double p[3];
+        for (int i = 0; i < 3; i++) p[i] = rng_range(&g, sl[i], sh[i]);
+        wrong += csg_inside(&v, p) != ref_in(&t, root, p);
+      }
+    }
+    free(buf);
+    csg_tape_free(ct);
+  }
+  printf("# box prune: %d of %d views shorter than their tape\n", shorter, boxes);
+  CHECK("csg_prune_box: the view classifies every box inside as the tape "
+        "(24000 boxes)", differ == 0);
+  CHECK("csg_prune_box: points inside the box in the view as in the "
+        "reference (24000 points)", wrong == 0);
+  CHECK("csg_prune_box: never longer, shorter for a tenth of the boxes",
+        longer == 0 && shorter > boxes / 10);
+}
+
 int main(void) {
   check_prefix = "bounds";
   test_box_proofs();
+  test_box_prune();
   test_csg_basics();
   test_csg_spans();
   test_bounds_cube();

@@ -1616,6 +1616,49 @@ static void bounds_floor(void) {
    mesher refused them as unbounded). The prism's box against its
    vertices, its volume against the n-gon's area, n/2 sin(2 pi/n) r^2 h,
    in long double. */
+/* Each split cell's rounded tapes and bound solids pruned for its
+   children (prune_cell, csg_prune_box) leave every proof as it was: the
+   same cells, the same triangles, the same vertices to the bit, as with
+   the pruning off (QCS_MESH_NOPRUNE). */
+static void pruned_same(void) {
+  static const struct { const char *name, *src; double tol; } objs[] = {
+    {"a rounded plate with a 50-sided hole", "Rounded 0.04 (Difference (Box (0, 0, 0) "
+     "(1, 0.18, 1)) (Shift (0.5, -0.5, 0.5) (Cylinder 0.1 1)))", 0.02},
+    {"a rounded gear-like disc", "Rounded 0.025 (Difference (CylinderWith [Sides 72] "
+     "1.18 0.3) (foldTree DensityUnion (Ring 12 0.7 (Shift (0, -0.5, 0) "
+     "(Cylinder 0.12 1.5)))))", 0.06},
+    {"a rounded box flush on a rounded cube (figure12 obj5)", "Union (Rounded 0.1 "
+     "UnitCube) (Rounded 0.1 (Shift (0.25, 1, 0.25) (Scale (0.5, 0.5, 0.5) UnitCube)))",
+     0.01},
+    {"a rounded cube minus a sharp one, and soft keys", "Union (SetDifference (Rounded "
+     "0.15 UnitCube) (Shift (0.5, 0.5, 0.5) UnitCube)) (SoftObject 0.5 [Key (1.2, 0.5, "
+     "0.5) 0.5 1])", 0.02},
+  };
+  for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
+    Mesh *a = NULL, *b = NULL;
+    MeshReport ra, rb;
+    char buf[400];
+    Scene *s = compile_mesh(objs[k].name, objs[k].src, objs[k].tol, &a, &ra);
+    if (!s) continue;
+    scene_free(s);
+    setenv("QCS_MESH_NOPRUNE", "1", 1);
+    snprintf(buf, sizeof buf, "%s, not pruned", objs[k].name);
+    s = compile_mesh(buf, objs[k].src, objs[k].tol, &b, &rb);
+    unsetenv("QCS_MESH_NOPRUNE");
+    if (s) {
+      snprintf(buf, sizeof buf, "pruned tapes: %s: the same %ld cells, %zu triangles "
+               "and vertices to the bit as unpruned", objs[k].name, ra.cells, a->nt);
+      CHECK(buf, ra.cells == rb.cells && a->nt == b->nt && a->nv == b->nv &&
+                     !memcmp(a->v, b->v, 3 * a->nv * sizeof *a->v) &&
+                     !memcmp(a->t, b->t, 3 * a->nt * sizeof *a->t));
+      printf("# %s: %.2f s pruned, %.2f s not\n", objs[k].name, ra.seconds, rb.seconds);
+      scene_free(s);
+      mesh_free(b);
+    }
+    mesh_free(a);
+  }
+}
+
 static void kit_round_parts(void) {
   char buf[300];
   one("a rounded plate with a 50-sided hole (genus 1)",
@@ -2677,6 +2720,7 @@ int main(void) {
            "(SoftObject 0.5 [Key (1, 1, 1) 0.8 1])");
   one("rounded minus soft", src, 0.04, 2, 1, 0, 1);
   kit_round_parts();
+  pruned_same();
   suggest_bounds();
   predicates();
   cover_sphere();
