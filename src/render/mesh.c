@@ -1568,7 +1568,8 @@ static int plain_cell_set(const Mesher *m, int level, const uint32_t q[3]) {
    tolerance for grad_box) lies within the box the leaves were classified
    over, where a view's density is its tape's (the same folds as a ray's
    pruning), so every proof is as before, on a tape of the live leaves
-   alone (a gear's rim: some 20 of its 150 leaves). */
+   alone (examples/gear.qcs's part: 588 leaves, 36 on average in the
+   cells split at the level above the finest). */
 typedef struct PruneLevel {
   ScNode *nodes;           /* indices as the scene's; only the subtree set */
   Scene sc;
