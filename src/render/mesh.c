@@ -222,7 +222,8 @@ static int same_surface(const Scene *s, int a, int b) {
 
 /* Node x's surface over [lo, hi] is one plane, (*n, *d) with the solid on
    one side (n . p < d, or > d): a halfspace's, or a rounded node's whose
-   tape has one live leaf over the box (r > 0), met once in the tape, and
+   tape folded over the box (each leaf whose filter misses it a constant)
+   has one leaf left (r > 0), met once in the tape, and
    whose density with that leaf at 0.5 (the others are 0 or 1 over the
    box) is exactly 0.5. The density is then affine in that leaf's value
    (every operation has a constant operand), not constant (the node is
@@ -238,29 +239,65 @@ static int node_plane(const Scene *s, int x, const double lo[3],
     return 1;
   }
   if (nd->kind != SC_ROUNDED) return 0;
-  const dt_tape *t = nd->tape;
-  int live = -1, seen = 0;
-  for (int i = 0; i < t->nleaves; i++) { /* leaves whose filter meets the box */
-    const dt_leaf *lf = &t->leaves[i];
+  /* the tape folded over the box (dt_prune_class: a leaf whose filter
+     misses it is a constant there), so that a leaf multiplied by one at
+     0 there (the infinite plane of a far cylinder's facet passing
+     through the box) is not counted live */
+  const dt_tape *t0 = nd->tape;
+  size_t nl = (size_t)t0->nleaves, nc = (size_t)t0->ncode,
+         np = t0->prog ? (size_t)t0->prog->npcode : 0;
+  void *mem = malloc(nl + nc * sizeof(dt_instr) + np * sizeof(dt_instr) +
+                     nl * sizeof(dt_leaf) + nl * sizeof(int) + 64);
+  if (!mem) return 0;
+  dt_instr *code = mem, *pcode = code + nc;
+  dt_leaf *lv = (dt_leaf *)(pcode + np);
+  int *livei = (int *)(lv + nl);
+  signed char *cls = (signed char *)(livei + nl);
+  int reach = t0->live ? t0->nlive : t0->nleaves;
+  for (int q = 0; q < reach; q++) {
+    int i = t0->live ? t0->live[q] : q;
+    const dt_leaf *lf = &t0->leaves[i];
     double rl, rh;
     vec3_plane_range(lf->n, lf->d, lo, hi, &rl, &rh);
-    if (lf->r <= 0 ? rl <= 0 && rh >= 0 : rl < lf->r && rh > -lf->r) {
-      if (live >= 0 || lf->r <= 0) return 0;
-      live = i;
+    if (lf->r <= 0) cls[i] = rl > 0 ? 0 : rh < 0 ? 1 : -1;
+    else cls[i] = rl >= lf->r ? 0 : rh <= -lf->r ? 1 : -1;
+  }
+  dt_prune_prog pg;
+  dt_tape tv;
+  dt_prune_class(t0, cls, code, lv, pcode, &pg, livei, &tv);
+  const dt_tape *t = &tv;
+  int live = -1, seen = 0;
+  for (int i = 0; i < t->ncode; i++)
+    if (t->code[i].op == DT_LEAF) {
+      if (live >= 0 && t->code[i].arg != live) break;
+      live = t->code[i].arg;
+      seen++;
+    }
+  double vl = 0, vh = 0;
+  if (live >= 0) dt_range_box_fix(t, lo, hi, live, 0.5, &vl, &vh);
+  if (live < 0 || seen != 1 || t->leaves[live].r <= 0 || vl != 0.5 || vh != 0.5) {
+    free(mem);
+    return 0;
+  }
+  /* the plane as t0 holds it (the view's leaves may be copies) */
+  const dt_leaf *lp = &t->leaves[live];
+  *n = NULL;
+  for (int q = 0; q < reach && !*n; q++) {
+    int i = t0->live ? t0->live[q] : q;
+    if (!memcmp(&t0->leaves[i], lp, sizeof *lp)) {
+      *n = t0->leaves[i].n;
+      *d = t0->leaves[i].d;
     }
   }
-  if (live < 0) return 0;
-  for (int i = 0; i < t->ncode; i++)
-    seen += t->code[i].op == DT_LEAF && t->code[i].arg == live;
-  double vl, vh;
-  dt_range_box_fix(t, lo, hi, live, 0.5, &vl, &vh);
-  if (seen != 1 || vl != 0.5 || vh != 0.5) return 0;
-  *n = t->leaves[live].n;
-  *d = t->leaves[live].d;
+  if (!*n) {
+    free(mem);
+    return 0;
+  }
   /* the density is affine in the leaf, 0.5 where it is 0.5: inside is
      where the leaf is above 0.5 (n . x < d) if it rises with the leaf */
   dt_range_box_fix(t, lo, hi, live, 0.75, &vl, &vh);
   *side = vl > 0.5 ? 1 : vh < 0.5 ? -1 : 0;
+  free(mem);
   return 1;
 }
 
@@ -1420,14 +1457,97 @@ static int live_surfaces(const Mesher *m, const unsigned char *st,
    undecided: a halfspace whose normal n has n . u <= 0 (n . u = 0: the
    lines along u do not cross it), a rounded or soft field whose
    gradient's bound has grad . u > 0. */
-static int rising(Mesher *m, int x, const double lo[3], const double hi[3],
-                  const double u[3]) {
+static int rising(Mesher *m, int x, int flip, const double lo[3],
+                  const double hi[3], const double u[3]) {
   const ScNode *nd = &m->s->nodes[x];
   double v[3], g;
-  int f = m->s->nodes[m->node].first;
-  for (int q = 0; q < 3; q++) v[q] = m->flip[x - f] ? -u[q] : u[q];
+  for (int q = 0; q < 3; q++) v[q] = flip ? -u[q] : u[q];
   if (nd->kind == SC_HALFSPACE) return vec3_dot(nd->n, v) <= 0;
   return grad_dir(m, x, lo, hi, NULL, v, &g) == 0 && g > 0;
+}
+
+/* Nodes a and b, both live over [lo, hi], are complements there: their
+   surfaces are one plane with their insides on opposite sides of it
+   (same_plane_box 2, or two halfspaces on one plane facing apart). */
+static int complements(const Scene *s, int a, int b, const double lo[3],
+                       const double hi[3]) {
+  const ScNode *x = &s->nodes[a], *y = &s->nodes[b];
+  if (x->kind == SC_HALFSPACE && y->kind == SC_HALFSPACE) {
+    int opp = 1;
+    for (int i = 0; i < 3; i++) opp &= x->n[i] == -y->n[i];
+    return opp && x->d == -y->d;
+  }
+  return same_plane_box(s, a, b, lo, hi) == 2;
+}
+
+/* The object's value (1 inside, 0 outside, 2 unknown) over a box whose
+   classes are st, with the live surfaces xs[i] taken inside where bit i
+   of bits is set (an undecided node not among them is unknown). */
+static int value_at(const Mesher *m, const unsigned char *st, const int *xs,
+                    int n, unsigned bits, unsigned char *val) {
+  const Scene *s = m->s;
+  int f = s->nodes[m->node].first;
+  for (int x = f; x <= m->node; x++) {
+    const ScNode *nd = &s->nodes[x];
+    int v;
+    if (st[x - f] == T_IN || st[x - f] == T_OUT) {
+      v = st[x - f] == T_IN;
+    } else if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF) {
+      int a = val[nd->a - f], b = val[nd->b - f];
+      if (nd->kind == SC_DIFF) b = b == 2 ? 2 : !b;
+      if (nd->kind == SC_UNION)
+        v = a == 1 || b == 1 ? 1 : a == 0 && b == 0 ? 0 : 2;
+      else
+        v = a == 0 || b == 0 ? 0 : a == 1 && b == 1 ? 1 : 2;
+    } else {
+      v = 2;
+      for (int i = 0; i < n; i++)
+        if (xs[i] == x) v = (int)(bits >> i & 1);
+    }
+    val[x - f] = (unsigned char)v;
+  }
+  return val[m->node - f];
+}
+
+/* The live surfaces xs (n of them, classes st over [lo, hi]) with their
+   flips into fl; where two of them, a and b, are complements over the
+   box (a table's flat top and the halfspace cutting a dome flat where
+   it rests on it: T + (S . H) with H = not T), b is dropped and a kept
+   with the flip the object then has in it, when it has one: the object
+   is a function of a and the rest alone, and if it only grows (or only
+   shrinks) with a whatever the rest are (every assignment tried), it is
+   monotone in every surface left, as the one-sheet argument needs (one
+   pair a box, of at most 8 surfaces: 2^8 assignments). The new count; n
+   when nothing was dropped. */
+static int complement_pairs(Mesher *m, const unsigned char *st,
+                            const double lo[3], const double hi[3], int *xs,
+                            int n, unsigned char *fl) {
+  const Scene *s = m->s;
+  int f = s->nodes[m->node].first;
+  for (int i = 0; i < n; i++) fl[i] = m->flip[xs[i] - f];
+  if (n < 3 || n > 8) return n;
+  for (int i = 0; i < n; i++)
+    for (int j = i + 1; j < n; j++) {
+      if (!complements(s, xs[i], xs[j], lo, hi)) continue;
+      int up = 1, down = 1;
+      for (unsigned r = 0; r < 1u << n && (up || down); r++) {
+        /* i in, j out against i out, j in; every other assignment */
+        if (r >> i & 1 || r >> j & 1) continue;
+        int v1 = value_at(m, st, xs, n, r | 1u << i, m->rel);
+        int v0 = value_at(m, st, xs, n, r | 1u << j, m->rel);
+        if (v1 == 2 || v0 == 2) up = down = 0;
+        up &= v1 >= v0;
+        down &= v1 <= v0;
+      }
+      if (!up && !down) continue;
+      fl[i] = (unsigned char)!up; /* grows with i's inside, or with its complement */
+      for (int k = j; k + 1 < n; k++) {
+        xs[k] = xs[k + 1];
+        fl[k] = fl[k + 1];
+      }
+      return n - 1; /* one pair a box */
+    }
+  return n;
 }
 
 /* Every line along u meets the boundary of the solid in [lo, hi] at most
@@ -1444,23 +1564,26 @@ static int rising(Mesher *m, int x, const double lo[3], const double hi[3],
    are the surfaces live in the box holding this one: when they all rise
    the box is not classified again. */
 static int solid_along(Mesher *m, const double lo[3], const double hi[3],
-                       const double u[3], int k, const int *xs, int n) {
+                       const double u[3], int k, const int *xs,
+                       const unsigned char *fx, int n) {
   int ok = 1, one, ys[SH_MAX];
-  for (int i = 0; i < n && ok; i++) ok = rising(m, xs[i], lo, hi, u);
+  unsigned char fy[SH_MAX];
+  for (int i = 0; i < n && ok; i++) ok = rising(m, xs[i], fx[i], lo, hi, u);
   if (ok) return 1;
   int c = scene_box_g(m->s, m->node, lo, hi, m->st2, m->one2, &one, 0,
                       m->forced);
   if (c == T_IN || c == T_OUT) return 1;
   int ny = live_surfaces(m, m->st2, m->one2, ys);
   if (ny < 0) return 0;
+  ny = complement_pairs(m, m->st2, lo, hi, ys, ny, fy);
   ok = 1;
-  for (int i = 0; i < ny && ok; i++) ok = rising(m, ys[i], lo, hi, u);
+  for (int i = 0; i < ny && ok; i++) ok = rising(m, ys[i], fy[i], lo, hi, u);
   if (ok) return 1;
   if (k == 0) return 0;
   for (int c8 = 0; c8 < 8; c8++) {
     double l2[3], h2[3];
     eighth(lo, hi, c8, l2, h2);
-    if (!solid_along(m, l2, h2, u, k - 1, ys, ny)) return 0;
+    if (!solid_along(m, l2, h2, u, k - 1, ys, fy, ny)) return 0;
   }
   return 1;
 }
@@ -1472,9 +1595,10 @@ static int solid_along(Mesher *m, const double lo[3], const double hi[3],
    cross the box, or only planes (the sharp rules have them). */
 static int solid_sheet(Mesher *m, const double lo[3], const double hi[3]) {
   int xs[SH_MAX], n = live_surfaces(m, m->st, m->one, xs), curved = 0;
+  unsigned char fx[SH_MAX];
   if (n < 0) return 0;
+  n = complement_pairs(m, m->st, lo, hi, xs, n, fx);
   double u[3] = {0, 0, 0};
-  int f = m->s->nodes[m->node].first;
   for (int i = 0; i < n; i++) {
     const ScNode *nd = &m->s->nodes[xs[i]];
     double g[3], len;
@@ -1482,7 +1606,7 @@ static int solid_sheet(Mesher *m, const double lo[3], const double hi[3]) {
       for (int q = 0; q < 3; q++) g[q] = -nd->n[q];
     else if (grad_dir(m, xs[i], lo, hi, g, NULL, NULL) < 0) return 0;
     else curved = 1;
-    len = sqrt(vec3_dot(g, g)) * (m->flip[xs[i] - f] ? -1 : 1);
+    len = sqrt(vec3_dot(g, g)) * (fx[i] ? -1 : 1);
     if (!(fabs(len) > 0) || !isfinite(len)) return 0;
     for (int q = 0; q < 3; q++) u[q] += g[q] / len;
   }
@@ -1490,7 +1614,7 @@ static int solid_sheet(Mesher *m, const double lo[3], const double hi[3]) {
   double len = sqrt(vec3_dot(u, u));
   if (!(len > 1e-9 * n) || !isfinite(len)) return 0;
   for (int q = 0; q < 3; q++) u[q] /= len;
-  return solid_along(m, lo, hi, u, 2, xs, n);
+  return solid_along(m, lo, hi, u, 2, xs, fx, n);
 }
 
 /* An undecided cell at or below the finest level is settled (meshed by
