@@ -28,6 +28,10 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
           r->cells, r->empty, r->full, r->leaves, r->planar, r->smooth,
           r->sharp, r->leaves - r->planar - r->smooth - r->sharp, r->depth,
           r->h);
+  if (r->sharp_pruned)
+    fprintf(f, "  sharp cells: %ld of them without the planes crossing them "
+            "whose faces do not reach them (a many-sided prism's sides near "
+            "its rim)\n", r->sharp_pruned);
   if (r->flat_regions)
     fprintf(f, "  flat parts: %ld regions in one plane triangulated again "
             "without their inner vertices, %zu -> %zu triangles\n",

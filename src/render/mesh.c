@@ -849,6 +849,9 @@ typedef struct {
   struct PruneLevel *plev; /* per level: its split cell's pruned tapes */
   signed char *cls;        /* prune_cell scratch: leaf classes */
   size_t capcls;
+  int *par;                /* per node of the subtree: its parent, or -1 */
+  int *grp;                /* cell_redundant scratch: a halfspace's group */
+  unsigned char *frc;      /* cell_redundant's forced classes */
 } Mesher;
 
 /* Whether halfspace nd's open solid (n . p < d) misses the open box
@@ -1837,6 +1840,118 @@ static const Scene *prune_cell(Mesher *m, int level, const double lo[3],
   return any ? &P->sc : s;
 }
 
+/* ---- planes that do not reach the solid in a sharp cell --------------- */
+
+/* The most planes of one intersection cell_redundant takes (the triples
+   of its planes and the box's are tried: C(30, 3) = 4060). */
+#define RED_MAX 24
+
+/* Where more than PL_MAX distinct undecided halfspaces cross the box
+   [lo, hi] (classes in m->st), all of them reaching the object through
+   one intersection (a group: a prism's sides and caps, or the hole cut
+   by one, away from the plate's faces), those that take no part in the
+   solid there: a halfspace x whose group's
+   undecided members cut the box to a polytope P lying strictly inside x.
+   The group is then the intersection of the others over the box (where
+   x is 0, so is another member), and x's value does not matter: it is
+   forced inside (frc, from m->forced). A member is taken so when no
+   vertex of P lies within eps of its plane: had it a facet of P, the
+   facet's corners would be vertices of P on it. The vertices are found
+   from every triple of the box's planes and the members' (solved, then
+   kept when within eps of every halfspace), and a group with no vertex
+   found is left alone. The infinite planes of a many-sided prism's
+   sides near a rim cross many cells their faces never reach (some 17 of
+   a 300-sided one's cross each finest cell at the rim): without them a
+   cell there holds two or three and is meshed exactly, its edges on the
+   prism's. The number of halfspaces forced; frc is set when it is > 0. */
+static int cell_redundant(Mesher *m, const double lo[3], const double hi[3]) {
+  const Scene *s = m->s;
+  int f = s->nodes[m->node].first, nd = 0, nforced = 0;
+  int pl[PL_MAX + 1];
+  for (int x = f; x <= m->node && nd <= PL_MAX; x++) {
+    if (s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+    int dup = 0;
+    for (int y = 0; y < nd && !dup; y++) dup = same_surface(s, pl[y], x);
+    if (!dup) pl[nd++] = x;
+  }
+  if (nd <= PL_MAX || !m->par || !m->grp || !m->frc) return 0;
+  for (int x = f; x <= m->node; x++) {
+    m->grp[x - f] = -1;
+    if (s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+    int r = x;
+    while (m->par[r - f] >= 0 && s->nodes[m->par[r - f]].kind == SC_INTER) r = m->par[r - f];
+    if (r != x && m->st[r - f] != T_IN && m->st[r - f] != T_OUT) m->grp[x - f] = r;
+    /* one group holds every undecided plane, or nothing is forced: a
+       plane of another part (a plate's face at a hole's rim) has its
+       polygon split by every plane crossing the cell, so a neighbour
+       that keeps x would cut it where this cell does not (a crack) */
+    if (m->grp[x - f] < 0 || m->grp[x - f] != m->grp[pl[0] - f]) return 0;
+  }
+  double w = 0, sc = 0;
+  for (int a = 0; a < 3; a++) {
+    w = fmax(w, hi[a] - lo[a]);
+    sc = fmax(sc, fmax(fabs(lo[a]), fabs(hi[a])));
+  }
+  double eps = 1e-9 * w + 1e-13 * sc;
+  int mem[RED_MAX];
+  for (int x = f; x <= m->node; x++) {
+    int g = m->grp[x - f];
+    if (g < 0) continue;
+    /* the group's members, once: from its first */
+    int k = 0, first = 1;
+    for (int y = f; y < x && first; y++) first = m->grp[y - f] != g;
+    if (!first) continue;
+    for (int y = x; y <= m->node && k <= RED_MAX; y++)
+      if (m->grp[y - f] == g) {
+        if (k < RED_MAX) mem[k] = y;
+        k++;
+      }
+    if (k < 2 || k > RED_MAX) continue;
+    double n[RED_MAX + 6][3], d[RED_MAX + 6];
+    int np = 0, tight[RED_MAX + 6] = {0}, any = 0;
+    for (int a = 0; a < 3; a++)
+      for (int e = 0; e < 2; e++) {
+        n[np][0] = n[np][1] = n[np][2] = 0;
+        n[np][a] = e ? 1 : -1;
+        d[np++] = e ? hi[a] : -lo[a];
+      }
+    for (int i = 0; i < k; i++) {
+      memcpy(n[np], s->nodes[mem[i]].n, sizeof n[np]);
+      d[np++] = s->nodes[mem[i]].d;
+    }
+    for (int a = 0; a < np; a++)
+      for (int b = a + 1; b < np; b++)
+        for (int c = b + 1; c < np; c++) {
+          double bc[3], ca[3], ab[3];
+          vec3_cross(n[b], n[c], bc);
+          vec3_cross(n[c], n[a], ca);
+          vec3_cross(n[a], n[b], ab);
+          double det = vec3_dot(n[a], bc);
+          if (!(fabs(det) > 1e-9)) continue;
+          double v[3];
+          for (int q = 0; q < 3; q++) v[q] = (d[a] * bc[q] + d[b] * ca[q] + d[c] * ab[q]) / det;
+          int ok = 1;
+          for (int q = 0; q < np && ok; q++) ok = vec3_dot(n[q], v) - d[q] <= eps;
+          if (!ok) continue;
+          any = 1;
+          for (int q = 6; q < np; q++)
+            if (fabs(vec3_dot(n[q], v) - d[q]) <= eps) tight[q] = 1;
+        }
+    if (!any) continue;
+    for (int i = 0; i < k; i++)
+      if (!tight[6 + i]) {
+        if (!nforced) {
+          int nsub = m->node - f + 1;
+          if (m->forced) memcpy(m->frc, m->forced, (size_t)nsub);
+          else memset(m->frc, 0, (size_t)nsub);
+        }
+        m->frc[mem[i] - f] = 1 + T_IN;
+        nforced++;
+      }
+  }
+  return nforced;
+}
+
 /* Classify the cell (i, j, k) of the level (in units of its side) and
    either drop it (proven empty or full), keep it as a surface leaf, or
    split it. A leaf is kept above the finest level when its error is
@@ -1948,6 +2063,31 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
       }
       m->pls[m->npls++] = x;
       n++;
+    }
+    if (n > PL_MAX && cell_redundant(m, lo, hi) > 0) {
+      /* again without the planes that do not reach the solid */
+      int one2, c2 = scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one2, 1,
+                                 m->frc);
+      m->npls = (size_t)n0;
+      n = 0;
+      for (int x = f; x <= m->node && n <= PL_MAX && c2 == T_PL; x++) {
+        if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+        int dup = 0;
+        for (int y = 0; y < n && !dup; y++) dup = same_surface(m->s, m->pls[n0 + y], x);
+        if (dup) continue;
+        if (grow((void **)&m->pls, &m->cappls, m->npls + 1, sizeof *m->pls) < 0) {
+          m->err = MESH_ENOMEM;
+          return -1;
+        }
+        m->pls[m->npls++] = x;
+        n++;
+      }
+      if (c2 != T_PL || n > PL_MAX) { /* as it was */
+        n = PL_MAX + 1;
+        scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one2, 1, m->forced);
+      } else {
+        m->rep->sharp_pruned++;
+      }
     }
     if (n <= PL_MAX) {
       lf.kind = LEAF_EXACT;
@@ -3009,6 +3149,8 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
     }
     int one, f = m->s->nodes[m->node].first;
     scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one, 0, m->forced);
+    if (cell_redundant(m, lo, hi) > 0) /* as the walk found them */
+      scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one, 0, m->frc);
     for (int x = f; x <= m->node; x++) {
       if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
       int y = 0;
@@ -3788,6 +3930,21 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.ex = malloc(sizeof *m.ex);
   m.ray = ray_ctx_new(s, vtol);
   m.s0 = s;
+  /* parents, for cell_redundant (no memory: it is left out) */
+  if ((m.par = malloc((size_t)nsub * sizeof *m.par)) &&
+      (m.grp = malloc((size_t)nsub * sizeof *m.grp)) && (m.frc = malloc((size_t)nsub))) {
+    int f = s->nodes[node].first;
+    for (int x = 0; x < nsub; x++) m.par[x] = -1;
+    for (int x = f; x <= node; x++) {
+      const ScNode *nd = &s->nodes[x];
+      if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF)
+        m.par[nd->a - f] = m.par[nd->b - f] = x;
+    }
+  } else {
+    free(m.par);
+    free(m.grp);
+    m.par = m.grp = NULL;
+  }
   if (!getenv("QCS_MESH_NOPRUNE")) {
     int f = s->nodes[node].first;
     for (int x = f; x <= node; x++) m.nrnd += s->nodes[x].kind == SC_ROUNDED;
@@ -4086,6 +4243,9 @@ done:
   free(m.one2);
   free(m.ex);
   prune_levels_free(&m);
+  free(m.par);
+  free(m.grp);
+  free(m.frc);
   free(m.rnd);
   free(m.cls);
   free(m.pls);

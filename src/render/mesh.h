@@ -110,6 +110,9 @@ typedef struct MeshReport {
   long sharp;              /* of them meshed exactly: the solid there is a
                               CSG of at most 8 planes (edges and corners
                               kept) */
+  long sharp_pruned;       /* of them, cells whose other planes do not
+                              reach the solid there (mesh.c,
+                              cell_redundant) */
   long sharp_apart;        /* sharp cells meshed by their tetrahedra's
                               crossings instead, where two sharp cells
                               left a crack or a self-intersection between
