@@ -850,7 +850,8 @@ typedef struct {
   signed char *cls;        /* prune_cell scratch: leaf classes */
   size_t capcls;
   int *par;                /* per node of the subtree: its parent, or -1 */
-  int *grp;                /* cell_redundant scratch: a halfspace's group */
+  int *grp;                /* per node: the top of the intersections above
+                              it (its group, cell_redundant), or -1 */
   unsigned char *frc;      /* cell_redundant's forced classes */
 } Mesher;
 
@@ -1856,10 +1857,10 @@ static const Scene *prune_cell(Mesher *m, int level, const double lo[3],
    x is 0, so is another member), and x's value does not matter: it is
    forced inside (frc, from m->forced). A member is taken so when no
    vertex of P lies within eps of its plane: had it a facet of P, the
-   facet's corners would be vertices of P on it. The vertices are found
-   from every triple of the box's planes and the members' (solved, then
-   kept when within eps of every halfspace), and a group with no vertex
-   found is left alone. The infinite planes of a many-sided prism's
+   facet's edges would be edges of P on it. The edges are found from
+   every pair of a member's plane and another's or the box's: their line
+   clipped by every halfspace (each within eps), a segment not empty
+   marking both; a group with none is left alone. The infinite planes of a many-sided prism's
    sides near a rim cross many cells their faces never reach (some 17 of
    a 300-sided one's cross each finest cell at the rim): without them a
    cell there holds two or three and is meshed exactly, its edges on the
@@ -1875,38 +1876,31 @@ static int cell_redundant(Mesher *m, const double lo[3], const double hi[3]) {
     if (!dup) pl[nd++] = x;
   }
   if (nd <= PL_MAX || !m->par || !m->grp || !m->frc) return 0;
-  for (int x = f; x <= m->node; x++) {
-    m->grp[x - f] = -1;
-    if (s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
-    int r = x;
-    while (m->par[r - f] >= 0 && s->nodes[m->par[r - f]].kind == SC_INTER) r = m->par[r - f];
-    if (r != x && m->st[r - f] != T_IN && m->st[r - f] != T_OUT) m->grp[x - f] = r;
-    /* one group holds every undecided plane, or nothing is forced: a
-       plane of another part (a plate's face at a hole's rim) has its
-       polygon split by every plane crossing the cell, so a neighbour
-       that keeps x would cut it where this cell does not (a crack) */
-    if (m->grp[x - f] < 0 || m->grp[x - f] != m->grp[pl[0] - f]) return 0;
-  }
+  /* one group holds every undecided plane, or nothing is forced: a
+     plane of another part (a plate's face at a hole's rim) has its
+     polygon split by every plane crossing the cell, so a neighbour that
+     keeps x would cut it where this cell does not (a crack) */
+  int g = m->grp[pl[0] - f];
+  if (g < 0 || m->st[g - f] == T_IN || m->st[g - f] == T_OUT) return 0;
+  for (int x = pl[0]; x <= m->node; x++)
+    if (s->nodes[x].kind == SC_HALFSPACE && m->st[x - f] == T_ONE &&
+        m->grp[x - f] != g)
+      return 0;
   double w = 0, sc = 0;
   for (int a = 0; a < 3; a++) {
     w = fmax(w, hi[a] - lo[a]);
     sc = fmax(sc, fmax(fabs(lo[a]), fabs(hi[a])));
   }
   double eps = 1e-9 * w + 1e-13 * sc;
-  int mem[RED_MAX];
-  for (int x = f; x <= m->node; x++) {
-    int g = m->grp[x - f];
-    if (g < 0) continue;
-    /* the group's members, once: from its first */
-    int k = 0, first = 1;
-    for (int y = f; y < x && first; y++) first = m->grp[y - f] != g;
-    if (!first) continue;
-    for (int y = x; y <= m->node && k <= RED_MAX; y++)
-      if (m->grp[y - f] == g) {
-        if (k < RED_MAX) mem[k] = y;
-        k++;
-      }
-    if (k < 2 || k > RED_MAX) continue;
+  /* the one group's members */
+  int mem[RED_MAX], k = 0;
+  for (int y = pl[0]; y <= m->node && k <= RED_MAX; y++)
+    if (s->nodes[y].kind == SC_HALFSPACE && m->st[y - f] == T_ONE) {
+      if (k < RED_MAX) mem[k] = y;
+      k++;
+    }
+  if (k < 2 || k > RED_MAX) return 0;
+  {
     double n[RED_MAX + 6][3], d[RED_MAX + 6];
     int np = 0, tight[RED_MAX + 6] = {0}, any = 0;
     for (int a = 0; a < 3; a++)
@@ -1919,25 +1913,35 @@ static int cell_redundant(Mesher *m, const double lo[3], const double hi[3]) {
       memcpy(n[np], s->nodes[mem[i]].n, sizeof n[np]);
       d[np++] = s->nodes[mem[i]].d;
     }
+    /* each pair's line clipped by every halfspace: a member on no pair
+       whose segment is not empty has no edge of P (its facet's edges
+       would be such segments), and no vertex */
     for (int a = 0; a < np; a++)
-      for (int b = a + 1; b < np; b++)
-        for (int c = b + 1; c < np; c++) {
-          double bc[3], ca[3], ab[3];
-          vec3_cross(n[b], n[c], bc);
-          vec3_cross(n[c], n[a], ca);
-          vec3_cross(n[a], n[b], ab);
-          double det = vec3_dot(n[a], bc);
-          if (!(fabs(det) > 1e-9)) continue;
-          double v[3];
-          for (int q = 0; q < 3; q++) v[q] = (d[a] * bc[q] + d[b] * ca[q] + d[c] * ab[q]) / det;
-          int ok = 1;
-          for (int q = 0; q < np && ok; q++) ok = vec3_dot(n[q], v) - d[q] <= eps;
-          if (!ok) continue;
-          any = 1;
-          for (int q = 6; q < np; q++)
-            if (fabs(vec3_dot(n[q], v) - d[q]) <= eps) tight[q] = 1;
+      for (int b = (a < 6 ? 6 : a + 1); b < np; b++) {
+        double u[3], ul;
+        vec3_cross(n[a], n[b], u);
+        ul = sqrt(vec3_dot(u, u));
+        if (!(ul > 1e-9)) continue;
+        for (int q = 0; q < 3; q++) u[q] /= ul;
+        /* the point of the line nearest the origin */
+        double bu[3], ua[3], p0[3];
+        vec3_cross(n[b], u, bu);
+        vec3_cross(u, n[a], ua);
+        for (int q = 0; q < 3; q++) p0[q] = (d[a] * bu[q] + d[b] * ua[q]) / ul;
+        double t0 = -HUGE_VAL, t1 = HUGE_VAL;
+        int ok = 1;
+        for (int q = 0; q < np && ok; q++) {
+          if (q == a || q == b) continue;
+          double nu = vec3_dot(n[q], u), r = d[q] + eps - vec3_dot(n[q], p0);
+          if (fabs(nu) < 1e-12) ok = r >= 0;
+          else if (nu > 0) t1 = fmin(t1, r / nu);
+          else t0 = fmax(t0, r / nu);
         }
-    if (!any) continue;
+        if (!ok || !(t0 <= t1)) continue;
+        any = 1;
+        tight[a] = tight[b] = 1;
+      }
+    if (!any) return 0;
     for (int i = 0; i < k; i++)
       if (!tight[6 + i]) {
         if (!nforced) {
@@ -3939,6 +3943,13 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
       const ScNode *nd = &s->nodes[x];
       if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF)
         m.par[nd->a - f] = m.par[nd->b - f] = x;
+    }
+    /* each halfspace's group: the top of the intersections above it
+       (parents before children, from the root down), or -1 */
+    for (int x = node; x >= f; x--) {
+      int p = m.par[x - f];
+      int top = p >= 0 && s->nodes[p].kind == SC_INTER;
+      m.grp[x - f] = !top ? -1 : m.grp[p - f] >= 0 ? m.grp[p - f] : p;
     }
   } else {
     free(m.par);
