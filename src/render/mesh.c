@@ -267,9 +267,14 @@ static int node_plane(const Scene *s, int x, const double lo[3],
   dt_prune_class(t0, cls, code, lv, pcode, &pg, livei, &tv);
   const dt_tape *t = &tv;
   int live = -1, seen = 0;
+  /* the whole code: a leaf met again after another (a, b, ..., a) is
+     not one leaf met once */
   for (int i = 0; i < t->ncode; i++)
     if (t->code[i].op == DT_LEAF) {
-      if (live >= 0 && t->code[i].arg != live) break;
+      if (live >= 0 && t->code[i].arg != live) {
+        seen = 2;
+        break;
+      }
       live = t->code[i].arg;
       seen++;
     }
@@ -1847,6 +1852,51 @@ static const Scene *prune_cell(Mesher *m, int level, const double lo[3],
    of its planes and the box's are tried: C(30, 3) = 4060). */
 #define RED_MAX 24
 
+/* Whether some pair of the np planes n . p = d + off (the first six the
+   box's faces, no pair of two of them) meets on a segment inside every
+   other halfspace grown by slack: the edges of the polytope of the
+   halfspaces n . p <= d + slack, as far as they lie on the planes moved
+   by off. Each plane with such a segment is marked in tight (if given). */
+static int pair_segments(const double (*n)[3], const double *d, int np,
+                         double off, double slack, const double lo[3],
+                         const double hi[3], int *tight) {
+  double c[3];
+  for (int q = 0; q < 3; q++) c[q] = 0.5 * (lo[q] + hi[q]);
+  int any = 0;
+  for (int a = 0; a < np; a++)
+    for (int b = (a < 6 ? 6 : a + 1); b < np; b++) {
+      double u[3], ul;
+      vec3_cross(n[a], n[b], u);
+      ul = sqrt(vec3_dot(u, u));
+      if (!(ul > 1e-9)) continue;
+      for (int q = 0; q < 3; q++) u[q] /= ul;
+      /* the point of the line nearest the origin, then the one nearest
+         the box's centre (where a plane nearly parallel to the line is
+         judged, and the clipped parameters are small) */
+      double bu[3], ua[3], p0[3], da = d[a] + off, db = d[b] + off;
+      vec3_cross(n[b], u, bu);
+      vec3_cross(u, n[a], ua);
+      for (int q = 0; q < 3; q++) p0[q] = (da * bu[q] + db * ua[q]) / ul;
+      double cu = (c[0] - p0[0]) * u[0] + (c[1] - p0[1]) * u[1] +
+                  (c[2] - p0[2]) * u[2];
+      for (int q = 0; q < 3; q++) p0[q] += cu * u[q];
+      double t0 = -HUGE_VAL, t1 = HUGE_VAL;
+      int ok = 1;
+      for (int q = 0; q < np && ok; q++) {
+        if (q == a || q == b) continue;
+        double nu = vec3_dot(n[q], u), r = d[q] + slack - vec3_dot(n[q], p0);
+        if (fabs(nu) < 1e-12) ok = r >= 0;
+        else if (nu > 0) t1 = fmin(t1, r / nu);
+        else t0 = fmax(t0, r / nu);
+      }
+      if (!ok || !(t0 <= t1)) continue;
+      any = 1;
+      if (!tight) return 1;
+      tight[a] = tight[b] = 1;
+    }
+  return any;
+}
+
 /* Where more than PL_MAX distinct undecided halfspaces cross the box
    [lo, hi] (classes in m->st), all of them reaching the object through
    one intersection (a group: a prism's sides and caps, or the hole cut
@@ -1913,34 +1963,17 @@ static int cell_redundant(Mesher *m, const double lo[3], const double hi[3]) {
       memcpy(n[np], s->nodes[mem[i]].n, sizeof n[np]);
       d[np++] = s->nodes[mem[i]].d;
     }
+    /* P must hold a point eps inside every halfspace. An empty P (two
+       members facing apart, or three around nothing, nearer than eps)
+       can have a grown P that is not empty, and a member whose plane
+       misses the grown P may be the one that empties P. When P is not
+       empty each facet of P has edges on the grown P's planes' pairs
+       (below), and a member with none is redundant. */
+    if (!pair_segments(n, d, np, -eps, -eps, lo, hi, NULL)) return 0;
     /* each pair's line clipped by every halfspace: a member on no pair
        whose segment is not empty has no edge of P (its facet's edges
        would be such segments), and no vertex */
-    for (int a = 0; a < np; a++)
-      for (int b = (a < 6 ? 6 : a + 1); b < np; b++) {
-        double u[3], ul;
-        vec3_cross(n[a], n[b], u);
-        ul = sqrt(vec3_dot(u, u));
-        if (!(ul > 1e-9)) continue;
-        for (int q = 0; q < 3; q++) u[q] /= ul;
-        /* the point of the line nearest the origin */
-        double bu[3], ua[3], p0[3];
-        vec3_cross(n[b], u, bu);
-        vec3_cross(u, n[a], ua);
-        for (int q = 0; q < 3; q++) p0[q] = (d[a] * bu[q] + d[b] * ua[q]) / ul;
-        double t0 = -HUGE_VAL, t1 = HUGE_VAL;
-        int ok = 1;
-        for (int q = 0; q < np && ok; q++) {
-          if (q == a || q == b) continue;
-          double nu = vec3_dot(n[q], u), r = d[q] + eps - vec3_dot(n[q], p0);
-          if (fabs(nu) < 1e-12) ok = r >= 0;
-          else if (nu > 0) t1 = fmin(t1, r / nu);
-          else t0 = fmax(t0, r / nu);
-        }
-        if (!ok || !(t0 <= t1)) continue;
-        any = 1;
-        tight[a] = tight[b] = 1;
-      }
+    any = pair_segments(n, d, np, 0, eps, lo, hi, tight);
     if (!any) return 0;
     for (int i = 0; i < k; i++)
       if (!tight[6 + i]) {
@@ -2211,7 +2244,7 @@ static int refine_two(Mesher *m) {
     double side = ldexp(m->h, m->depth - lf->level), lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
       lo[a] = m->org[a] + side * lf->q[a];
-      hi[a] = lo[a] + side;
+      hi[a] = m->org[a] + side * (lf->q[a] + 1); /* as walk's */
     }
     const Scene *up = m->s;
     m->s = prune_cell(m, lf->level, lo, hi);
@@ -2231,7 +2264,7 @@ static int refine_two(Mesher *m) {
     double side = ldexp(m->h, m->depth - lf.level), lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
       lo[a] = m->org[a] + side * lf.q[a];
-      hi[a] = lo[a] + side;
+      hi[a] = m->org[a] + side * (lf.q[a] + 1); /* as walk's */
     }
     const Scene *up = m->s;
     m->s = prune_cell(m, lf.level, lo, hi);
@@ -3149,7 +3182,7 @@ static int cell(Mesher *m, size_t leaf, size_t *count) {
     double side = ldexp(m->h, m->depth - l), lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
       lo[a] = m->org[a] + side * (double)q[a];
-      hi[a] = lo[a] + side;
+      hi[a] = m->org[a] + side * (double)(q[a] + 1); /* as walk's */
     }
     int one, f = m->s->nodes[m->node].first;
     scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one, 0, m->forced);
