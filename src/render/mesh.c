@@ -752,7 +752,7 @@ static int grad_axes(const double gl[3], const double gh[3], GrBound *b) {
 enum { LEAF_PLANE, LEAF_SMOOTH, LEAF_FINE, LEAF_EXACT };
 
 /* The most planes a sharp cell (LEAF_EXACT) may hold. */
-#define PL_MAX 8
+#define PL_MAX MESH_PLANES_MAX
 
 typedef struct {
   uint32_t q[3];           /* its lowest corner, in units of its side */
@@ -1865,6 +1865,9 @@ static int pair_segments(const double (*n)[3], const double *d, int np,
   int any = 0;
   for (int a = 0; a < np; a++)
     for (int b = (a < 6 ? 6 : a + 1); b < np; b++) {
+      /* nothing to learn from a pair whose planes are both marked (the
+         box's faces need no mark), once one segment is found */
+      if (tight && any && (a < 6 || tight[a]) && tight[b]) continue;
       double u[3], ul;
       vec3_cross(n[a], n[b], u);
       ul = sqrt(vec3_dot(u, u));
@@ -2656,8 +2659,8 @@ static int face(Mesher *m, int l, const int64_t q[3], int a, int s,
    degenerate case differently, the mesh is made again without sharp cells
    (mesh_scene). */
 #define PV_MAX 32
-#define PC_MAX 64
-#define LV_MAX 256
+#define PC_MAX 128
+#define LV_MAX 512
 
 typedef struct {
   int n;

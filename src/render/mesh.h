@@ -13,7 +13,8 @@
  * proven within the tolerance: one plane (a halfspace, or a rounded tree
  * with one live leaf), a rounded node or a soft object whose gradient
  * bound over the cell grown by the tolerance bounds its triangles'
- * distance (mesh.c, grad_box; core/soft.h, soft_grad_box), or a CSG of at most 8 planes (a sharp cell, meshed exactly);
+ * distance (mesh.c, grad_box; core/soft.h, soft_grad_box), or a CSG
+ * of at most MESH_PLANES_MAX planes (a sharp cell, meshed exactly);
  * else it is split, down to the finest level whose side the tolerance
  * fixes. There, and below it, a cell is kept only when each surface in
  * it is proven one sheet (mesh.c, settled: every line along one
@@ -73,6 +74,9 @@
 
 #include "scene/scene.h"
 
+/* The most distinct planes a sharp cell holds (meshed exactly). */
+#define MESH_PLANES_MAX 12
+
 typedef struct MeshSettings {
   double tol;              /* the requested error, scene units (> 0) */
   int has_bounds;          /* mesh inside [lo, hi] only (an unbounded
@@ -108,8 +112,8 @@ typedef struct MeshReport {
                               surface proven one plane, or proven close
                               enough by the gradient bound */
   long sharp;              /* of them meshed exactly: the solid there is a
-                              CSG of at most 8 planes (edges and corners
-                              kept) */
+                              CSG of at most MESH_PLANES_MAX planes
+                              (edges and corners kept) */
   long sharp_pruned;       /* of them, cells whose other planes do not
                               reach the solid there (mesh.c,
                               cell_redundant) */

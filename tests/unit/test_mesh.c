@@ -1695,8 +1695,10 @@ static void flush_dome(void) {
    does not reach the cell (the box cut by the others lies inside them).
    Every triangle then lies in one face: on a cap, or its three vertices
    on one chord of the polygon (collinear across y, long double); the
-   volume is the polygon's area times the height to rounding. Before:
-   13,350 triangles for 200 sides, the rims cut by marching cells. */
+   volume is the polygon's area times the height to rounding; and the
+   faces are triangulated as polygons, 4 n - 4 triangles. Before:
+   13,350 triangles for 200 sides, the rims cut by marching cells; then
+   2,930 with sharp cells of at most 8 planes. */
 static void many_sides_exact(void) {
   const long double pi = 3.141592653589793238462643383279503L;
   static const int sides[] = {200, 300};
@@ -1730,6 +1732,10 @@ static void many_sides_exact(void) {
     snprintf(buf, sizeof buf, "%s: every triangle in one face (%ld of %zu not; %ld "
              "cells with planes left out)", name, off, m->nt, rep.sharp_pruned);
     CHECK(buf, off == 0 && rep.sharp_pruned > 0);
+    /* each cap an n-gon (n - 2 triangles), each side a rectangle (2) */
+    snprintf(buf, sizeof buf, "%s: %zu triangles, 2 (n - 2) + 2 n = %d (every face "
+             "one polygon)", name, m->nt, 4 * n - 4);
+    CHECK(buf, m->nt == (size_t)(4 * n - 4));
     long double area = 0.5L * n * sinl(2 * pi / n);
     snprintf(buf, sizeof buf, "%s: volume %.15g, the polygon's area times 0.3 to "
              "1e-12 (long double)", name, volume(m));
@@ -1754,7 +1760,7 @@ static void kit_round_parts(void) {
   one("a sharp 100-sided prism", "CylinderWith [Sides 100] 1 0.3", 0.02, 2, 1,
       (double)(area * 0.3L), 1);
   /* a 200-sided prism: some 11 side planes cross each finest cell at
-     its rim, more than a sharp cell takes; planes that do not meet in
+     its rim, more than a sharp cell took (8, now 12); planes that do not meet in
      the cell used to split it as a possible thin part, though the
      prism's sides are nested there (planes_nested): 9223 of 28139 cells
      split below the finest level, 165,842 triangles */
@@ -2548,6 +2554,14 @@ static void flat_merge(void) {
        straight runs counted towards a region's length) */
     {"a plate with a 50-sided hole", "Difference (Scale (2, 0.2, 2) UnitCube) (Shift "
      "(1, -0.5, 1) (CylinderWith [Sides 50] 0.5 2))", 0.02, 216},
+    /* 104 corners on each face: 2 * 104 + 2 * 100 + 4 * 2. Its rim's
+       cells hold up to 12 planes (8 was the most a sharp cell took: they
+       were marching cells), and a triangle of a side seeded that side's
+       region with a plane tilted 5.8e-13 by its vertices' rounding,
+       leaving a neighbour alone and the top counted as a rounded part's
+       face (seeds are now the largest triangles first): 6,540 */
+    {"a plate with a 100-sided hole", "Difference (Scale (2, 0.2, 2) UnitCube) (Shift "
+     "(1, -0.5, 1) (CylinderWith [Sides 100] 0.5 2))", 0.02, 416},
     {"a rotated plate with a 50-sided hole", "Rotate \"z\" 30 (Rotate \"x\" 20 "
      "(Difference (Scale (2, 0.2, 2) UnitCube) (Shift (1, -0.5, 1) (CylinderWith "
      "[Sides 50] 0.5 2))))", 0.001, -1},
