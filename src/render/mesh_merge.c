@@ -767,11 +767,22 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
     free(blen);
     goto out;
   }
+  /* a single triangle across counts when the surface bends smoothly
+     onto it (within 30 degrees: a fillet's first triangle beside a
+     rounded part's flat face), not across a crease (a prism's side
+     clipped by a box to one triangle: the face beside it was cut into
+     patches for it, 393 triangles where 26 do) */
   for (size_t i = 0; i < nt; i++)
     for (int e = 0; e < 3; e++) {
       int j = across(&A, (int)i, e);
-      if (j < 0 || (C.reg[j] != C.reg[i] && C.rcount[C.reg[j]] < 2))
-        curved[C.reg[i]] = 1;
+      if (j < 0) curved[C.reg[i]] = 1;
+      else if (C.reg[j] != C.reg[i] && C.rcount[C.reg[j]] < 2 && !curved[C.reg[i]]) {
+        double ni[3], nj[3];
+        tri_normal(m, (int)i, ni);
+        tri_normal(m, j, nj);
+        if (!(ni[0] * nj[0] + ni[1] * nj[1] + ni[2] * nj[2] < 0.8660254037844386))
+          curved[C.reg[i]] = 1;
+      }
     }
   for (size_t k = 0; k < C.nedges; k++) {
     int r = C.edges[k].r;

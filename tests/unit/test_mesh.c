@@ -2520,6 +2520,84 @@ static double mesh_gap(const Mesh *a, const Mesh *b, int n) {
   return worst;
 }
 
+/* Sharp polyhedra whose every face is triangulated as one polygon:
+   every vertex of the mesh is then a corner of the solid, where three or
+   more faces meet (its triangles' normals, in long double, take three
+   or more directions); a vertex inside a face or on a straight run of an
+   edge takes one or two. Random scene 44 of a review's generator (a
+   rotated box cut by two many-sided prisms at 0.005) has single-triangle
+   faces (a prism's side clipped by the box): the face beside such a
+   triangle counted as a rounded part's and went in patches of 64, 584
+   triangles with vertices inside faces, where 204 are all corners. */
+static void corners_only(void) {
+  static const struct { const char *name, *src; double tol; } objs[] = {
+    {"random scene 44 (a box cut by a 14- and a 17-sided prism)",
+     "Rotate \"x\" (-33.22) (Intersection (Difference (Union (Rotate \"x\" (-47.98) "
+     "(Box (-1.091,-0.229,-0.638) (0.262,0.151,0.42))) (Shift (-0.369,-0.84,0.644) "
+     "(Rotate \"x\" (-27.6) (CylinderWith [Sides 14] 0.613 2.112)))) (Shift "
+     "(-0.504,-1.466,0.347) (Rotate \"x\" (-29.0) (CylinderWith [Sides 17] 0.222 "
+     "2.476)))) (Box (-1.064,-0.481,-0.786) (1.41,0.242,0.871)))", 0.005},
+    {"a plate with a 100-sided hole", "Difference (Scale (2, 0.2, 2) UnitCube) (Shift "
+     "(1, -0.5, 1) (CylinderWith [Sides 100] 0.5 2))", 0.02},
+    {"a 200-sided prism", "CylinderWith [Sides 200] 1 0.3", 0.02},
+  };
+  for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
+    Scene *s = compile(objs[k].src);
+    CHECK(objs[k].name, s != NULL);
+    if (!s) continue;
+    MeshSettings ms = {0};
+    ms.tol = objs[k].tol;
+    Mesh *m = NULL;
+    MeshReport rep;
+    char err[300], buf[400];
+    int bad;
+    int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+    snprintf(buf, sizeof buf, "corners: %s meshed", objs[k].name);
+    CHECK(buf, rc == 0);
+    if (rc) {
+      scene_free(s);
+      continue;
+    }
+    /* each vertex's distinct normals, at most 8 kept */
+    long double(*nv)[8][3] = calloc(m->nv, sizeof *nv);
+    int *cnt = calloc(m->nv, sizeof *cnt);
+    for (size_t t = 0; t < m->nt && nv && cnt; t++) {
+      const double *p[3];
+      for (int i = 0; i < 3; i++) p[i] = m->v + 3 * m->t[3 * t + i];
+      long double u[3], w[3], c[3];
+      for (int a = 0; a < 3; a++) {
+        u[a] = (long double)p[1][a] - p[0][a];
+        w[a] = (long double)p[2][a] - p[0][a];
+      }
+      c[0] = u[1] * w[2] - u[2] * w[1];
+      c[1] = u[2] * w[0] - u[0] * w[2];
+      c[2] = u[0] * w[1] - u[1] * w[0];
+      long double l = sqrtl(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+      if (!(l > 0)) continue;
+      for (int a = 0; a < 3; a++) c[a] /= l;
+      for (int i = 0; i < 3; i++) {
+        int v = m->t[3 * t + i], seen = 0;
+        for (int q = 0; q < cnt[v] && !seen; q++)
+          seen = nv[v][q][0] * c[0] + nv[v][q][1] * c[1] + nv[v][q][2] * c[2] > 1 - 1e-9L;
+        if (!seen && cnt[v] < 8) {
+          memcpy(nv[v][cnt[v]], c, sizeof c);
+          cnt[v]++;
+        }
+      }
+    }
+    size_t inner = 0;
+    for (size_t v = 0; v < m->nv && cnt; v++) inner += cnt[v] < 3;
+    snprintf(buf, sizeof buf, "corners: %s: every one of its %zu vertices a corner "
+             "(three or more faces; %zu not), %zu triangles", objs[k].name, m->nv,
+             inner, m->nt);
+    CHECK(buf, nv && cnt && inner == 0);
+    free(nv);
+    free(cnt);
+    mesh_free(m);
+    scene_free(s);
+  }
+}
+
 /* Flat regions triangulated again (mesh_merge.h), against the octree's
    own triangles (MeshSettings.keep_flat) of the same object: fewer
    triangles (a unit cube 12, figure12's sharp obj1 28, OpenSCAD's count
@@ -2828,6 +2906,7 @@ int main(void) {
   self_check_failures();
   sharp_corners();
   flat_merge();
+  corners_only();
   thin_parts();
   property();
   sharp_kept();
