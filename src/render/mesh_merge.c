@@ -537,7 +537,8 @@ static int join_holes(const Poly *P, const Loops *L, int outer, int *seq, int ca
   return n;
 }
 
-/* Twice triangle i's area, squared, and its longest side squared. */
+/* Twice triangle i's area, squared (|u x w|^2, as tri_normal's cross
+   product before it is normalised). */
 static double tri_area2(const Mesh *m, int i) {
   const double *p[3];
   for (int k = 0; k < 3; k++) p[k] = m->v + 3 * m->t[3 * i + k];
@@ -548,6 +549,7 @@ static double tri_area2(const Mesh *m, int i) {
   return c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
 }
 
+/* Triangle i's longest side, squared. */
 static double tri_long2(const Mesh *m, int i) {
   double l2 = 0;
   for (int k = 0; k < 3; k++) {
