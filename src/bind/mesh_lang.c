@@ -55,6 +55,12 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "there (the first at (%.6g, %.6g, %.6g))\n",
             r->two, r->two_side, of, r->two_at[0], r->two_at[1], r->two_at[2]);
   }
+  if (r->welded)
+    fprintf(f, "  degenerate points: %ld triangles of no area dropped where "
+            "three planes meet in a line or four in a point, or all but "
+            "(sides decided exactly, ties by a symbolic perturbation; "
+            "vertices within 2^-40 of the object's size welded, the "
+            "certified bound grown by the largest move)\n", r->welded);
   if (r->sharp_apart && !r->sharp_off)
     fprintf(f, "  sharp cells given up locally: %ld about a crack or a "
             "self-intersection that two sharp cells left between them were "

@@ -21,6 +21,7 @@
 #include "render/image.h"
 #include "render/mesh_check.h"
 #include "render/mesh_cover.h"
+#include "render/mesh_exact.h"
 #include "render/mesh_merge.h"
 #include "render/render.h"
 #include "scene/ray.h"
@@ -844,6 +845,8 @@ typedef struct {
   uint64_t *fstart;        /* the keys of fpath, in order */
   size_t nfs, capfs;
   unsigned char *uni;      /* per mesh vertex: made by edge_vertex */
+  unsigned char *xact;     /* per mesh vertex: placed exactly (lv_exact) */
+  size_t capxact;
   size_t capuni;
   RayCtx *ray;
   MeshReport *rep;
@@ -2378,6 +2381,11 @@ static int edge_vertex(Mesher *m, int pa, int pb) {
     return -1;
   }
   m->uni[m->nv] = 1;
+  if (grow((void **)&m->xact, &m->capxact, m->nv + 1, 1) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->xact[m->nv] = 0;
   double *p = m->v + 3 * m->nv;
   for (int q = 0; q < 3; q++) p[q] = a[q] + t * (b[q] - a[q]);
   v = (int)m->nv++;
@@ -2654,10 +2662,16 @@ static int face(Mesher *m, int l, const int64_t q[3], int a, int s,
    to edge across tetrahedra and across the crease between two planes, and
    edges and corners of the solid are vertices and edges of the mesh. A
    plane's single crossing on an edge whose ends differ is the same vertex
-   the marching cells make there (edge_vertex). The whole mesh is checked
-   for closure at the end; if rounding ever made two neighbours decide a
-   degenerate case differently, the mesh is made again without sharp cells
-   (mesh_scene). */
+   the marching cells make there (edge_vertex). Every side is decided
+   exactly, a tie by a symbolic perturbation of the planes
+   (mesh_exact.h), so every tetrahedron that asks gets the same answer,
+   and the polygon's order comes from the corners' sides alone: where
+   three planes share a line or four a point (a polygon's sides that
+   mirror each other across a face), the pieces meet in vertices an
+   infinitesimal apart, which weld makes one. The whole mesh is checked
+   for closure at the end; should two neighbours still leave a crack, the
+   sharp cells there are meshed by their tetrahedra (sharp_apart) or, at
+   last, the mesh is made again without sharp cells (mesh_scene). */
 #define PV_MAX 32
 #define PC_MAX 128
 #define LV_MAX 512
@@ -2674,6 +2688,14 @@ typedef struct {
   uint64_t key[4];
   double x[3];
   int kind, la, lb, plane; /* kind 0: plane on a tetrahedron edge */
+  int pi, pj, ps;          /* kind 1: planes pi and pj, and ps (a plane,
+                              or -1 - the tetrahedron face) */
+  unsigned asked, inside;  /* the planes asked of it (mesh_exact), and
+                              the answers */
+  int tie;                 /* at a degenerate point (some plane through
+                              it exactly): placed exactly (mesh_exact) */
+  int boxed;               /* box: 0 not yet made, 1 made, -1 none */
+  MxBox box;               /* a box sure to hold it (mesh_exact) */
   int global;              /* mesh vertex, -1 until needed */
   int unified;             /* global is the marching cells' edge vertex */
 } LVert;
@@ -2683,6 +2705,13 @@ typedef struct ExTet {
   const int *p;            /* the tetrahedron's 4 points */
   double x[4][3];
   double s[PL_MAX][4];     /* each plane's signed distance at the corners */
+  unsigned char in[PL_MAX][4]; /* and its side there, exactly (mesh_exact) */
+  unsigned char on[PL_MAX][4]; /* 1 where the corner is on the plane */
+  double se[PL_MAX][4];    /* a bound of s's rounding error */
+  MxPlane pl[PL_MAX];      /* the planes, ranked by node */
+  MxPlane face[4];         /* the faces (face q misses corner q), through
+                              their corners in point order */
+  unsigned faces;          /* those made (lv_three) */
   LVert lv[LV_MAX];
   int nlv;
   Piece pc[2][PC_MAX];
@@ -2737,9 +2766,18 @@ static int lv_add(ExTet *e, const uint64_t k[4], const double x[3], int kind,
   v->la = la;
   v->lb = lb;
   v->plane = plane;
+  v->pi = v->pj = v->ps = -1;
+  v->asked = v->inside = 0;
+  v->tie = 0;
+  v->boxed = 0;
   v->global = -1;
   v->unified = 0;
   return e->nlv++;
+}
+
+/* t in [0, 1] (NaN, from 0 / 0, as 1/2). */
+static double clamp01(double t) {
+  return t >= 0 ? (t <= 1 ? t : 1) : t < 0 ? 0 : 0.5;
 }
 
 /* Plane i on the tetrahedron edge la - lb (its sides differ there). */
@@ -2752,11 +2790,17 @@ static int ex_edge(ExTet *e, int i, int la, int lb) {
     pa = e->p[la];
     pb = e->p[lb];
   }
-  double sa = e->s[i][la], sb = e->s[i][lb], t = sa / (sa - sb), x[3];
+  /* (the sides are exact; the distances rounded, so t is kept in [0, 1]) */
+  double sa = e->s[i][la], sb = e->s[i][lb], t = clamp01(sa / (sa - sb)), x[3];
+  /* a plane exactly through a corner crosses there */
+  if (e->on[i][la]) t = 0;
+  else if (e->on[i][lb]) t = 1;
   for (int q = 0; q < 3; q++) x[q] = e->x[la][q] + t * (e->x[lb][q] - e->x[la][q]);
   uint64_t k[4] = {5, (uint64_t)pa << 32 | (uint64_t)pb,
                    (uint64_t)e->m->pls[e->m->cur->pl0 + i], 0};
-  return lv_add(e, k, x, 0, la, lb, i);
+  int v = lv_add(e, k, x, 0, la, lb, i);
+  if (v >= 0 && (e->on[i][la] || e->on[i][lb])) e->lv[v].tie = 1;
+  return v;
 }
 
 /* The vertex where piece edge (a, b) with support sup meets plane j. */
@@ -2830,9 +2874,107 @@ static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
     pl_plane(m, j, n, &d);
     double sa = vec3_dot(n, e->lv[a].x) - d, sb = vec3_dot(n, e->lv[b].x) - d;
     double t = sa / (sa - sb);
+    t = clamp01(t);
     for (int q = 0; q < 3; q++) x[q] = e->lv[a].x[q] + t * (e->lv[b].x[q] - e->lv[a].x[q]);
   }
-  return lv_add(e, k, x, 1, -1, -1, -1);
+  int n0 = e->nlv, v = lv_add(e, k, x, 1, -1, -1, -1);
+  if (v >= 0 && e->nlv > n0) {
+    e->lv[v].pi = i;
+    e->lv[v].pj = j;
+    e->lv[v].ps = sup;
+  }
+  /* a split beside a degenerate point may be at it too (the edge's line
+     in a third plane, whose test at the edge's ends was a tie): placed
+     exactly like its ends */
+  if (v >= 0 && (e->lv[a].tie || e->lv[b].tie)) e->lv[v].tie = 1;
+  return v;
+}
+
+/* The three planes meeting at split vertex w. */
+static void lv_three(ExTet *e, const LVert *w, const MxPlane *three[3]) {
+  if (w->ps >= 0) {
+    three[0] = &e->pl[w->pi];
+    three[1] = &e->pl[w->pj];
+    three[2] = &e->pl[w->ps];
+    return;
+  }
+  int ex = -1 - w->ps;
+  if (!(e->faces >> ex & 1)) {
+    /* face ex through its corners in point order, as ex_split takes it */
+    int f[3], nf = 0;
+    for (int q = 0; q < 4; q++)
+      if (q != ex) f[nf++] = q;
+    for (int a = 0; a < 2; a++)
+      for (int c = 0; c < 2 - a; c++)
+        if (e->p[f[c]] > e->p[f[c + 1]]) {
+          int t = f[c];
+          f[c] = f[c + 1];
+          f[c + 1] = t;
+        }
+    MxPlane *fp = &e->face[ex];
+    for (int c = 0; c < 3; c++) fp->pts[c] = e->x[f[c]];
+    fp->rank = -1;
+    mx_plane_prep(fp);
+    e->faces |= 1u << ex;
+  }
+  three[0] = &e->face[ex];
+  three[1] = &e->pl[w->pi];
+  three[2] = &e->pl[w->pj];
+}
+
+static int lv_box(ExTet *e, LVert *w) {
+  if (w->kind == 0) {
+    /* the crossing a + t (b - a), t = sa / (sa - sb), from the corners'
+       rounded distances and their bounds (each operation's rounding
+       added, 2^-52 for 2^-53 to cover the bound's own) */
+    int i = w->plane, a = w->la, b = w->lb;
+    double sa = e->s[i][a], sb = e->s[i][b], ea = e->se[i][a], eb = e->se[i][b];
+    double den = sa - sb, eden = ea + eb + 0x1p-52 * fabs(den);
+    double md = fabs(den) - eden;
+    if (!(md > 0)) return -1;
+    double t = sa / den, et = (ea + fabs(t) * eden) / md + 0x1p-52 * fabs(t);
+    double rm = 0, xm = 0;
+    for (int k = 0; k < 3; k++) {
+      double d = e->x[b][k] - e->x[a][k], td = t * d, x = e->x[a][k] + td;
+      double r = fabs(d) * et + 0x1p-52 * (fabs(d * t) + fabs(td) + fabs(x));
+      r *= 1 + 0x1p-30;
+      w->box.x[k] = x;
+      w->box.r[k] = r;
+      if (!(r < 0x1p100) || !(fabs(x) <= 0x1p100)) return -1;
+      if (r > rm) rm = r;
+      if (fabs(x) > xm) xm = fabs(x);
+    }
+    w->box.q = (rm + 0x1p-50 * xm) * (1 + 0x1p-30);
+    return 0;
+  }
+  const MxPlane *three[3];
+  lv_three(e, w, three);
+  return mx_three_box(three, &w->box);
+}
+
+/* Whether local vertex v is inside plane j (list index), exactly and
+   perturbed (mesh_exact.h): the same answer in every tetrahedron that
+   asks, whatever rounding did to v's position. */
+static int lv_in(ExTet *e, int v, int j) {
+  LVert *w = &e->lv[v];
+  unsigned bit = 1u << j;
+  if (w->asked & bit) return (w->inside & bit) != 0;
+  int r, tie = 0;
+  if (!w->boxed) w->boxed = lv_box(e, w) == 0 ? 1 : -1;
+  if (w->boxed > 0 && (r = mx_box_in(&w->box, &e->pl[j])) >= 0) {
+    /* decided by the box: no tie */
+  } else if (w->kind == 0) {
+    r = mx_edge_in(e->x[w->la], e->x[w->lb], e->in[w->plane][w->la],
+                   &e->pl[w->plane], &e->pl[j], &tie);
+  } else {
+    const MxPlane *three[3];
+    lv_three(e, w, three);
+    r = mx_three_in(three, &e->pl[j], &tie);
+  }
+  if (tie) w->tie = 1;
+  w->asked |= bit;
+  if (r) w->inside |= bit;
+  return r;
 }
 
 /* pl_eval's program for the cell whose classes are in m->st: the nodes
@@ -2896,6 +3038,29 @@ static int pl_eval(const Mesher *m, unsigned bits) {
   return pl_val(m, f, m->node);
 }
 
+/* Plane j at plane a's crossing of the edge la - lb (whose box is ba, or
+   NULL), exactly. */
+static int edge_order(ExTet *e, int la, int lb, int a, const MxBox *ba, int j) {
+  int r, tie;
+  if (ba && (r = mx_box_in(ba, &e->pl[j])) >= 0) return r;
+  return mx_edge_in(e->x[la], e->x[lb], e->in[a][la], &e->pl[a], &e->pl[j], &tie);
+}
+
+/* A vertex at a degenerate point placed exactly (mesh_exact.h), so that
+   every vertex there has the same position and weld makes them one. */
+static void lv_exact(ExTet *e, LVert *v) {
+  if (v->kind == 0) {
+    if (e->on[v->plane][v->la]) memcpy(v->x, e->x[v->la], sizeof v->x);
+    else if (e->on[v->plane][v->lb]) memcpy(v->x, e->x[v->lb], sizeof v->x);
+    else mx_edge_point(e->x[v->la], e->x[v->lb], &e->pl[v->plane], v->x);
+    return;
+  }
+  const MxPlane *three[3];
+  lv_three(e, v, three);
+  double x[3];
+  if (mx_three_point(three, x) == 0) memcpy(v->x, x, sizeof x);
+}
+
 static int lv_global(ExTet *e, int i) {
   LVert *v = &e->lv[i];
   if (v->global >= 0) return v->global;
@@ -2904,29 +3069,35 @@ static int lv_global(ExTet *e, int i) {
     /* the solid's value along the edge, between the planes' crossings:
        one change, with the ends' signs differing, is the one crossing a
        marching neighbour finds there too */
-    int pa = e->p[v->la], pb = e->p[v->lb], k = m->cur->npl, nt = 0;
-    double t[PL_MAX + 1];
+    int la = v->la, lb = v->lb, pa = e->p[la], pb = e->p[lb];
+    int k = m->cur->npl, nt = 0, cr[PL_MAX], bx[PL_MAX];
+    MxBox box[PL_MAX];
+    unsigned bits = 0;
     for (int j = 0; j < k; j++) {
-      double sa = e->s[j][v->la], sb = e->s[j][v->lb];
-      if ((sa < 0) != (sb < 0)) t[nt++] = sa / (sa - sb);
-    }
-    for (int r = 0; r < nt; r++)
-      for (int q = 0; q + 1 < nt - r; q++)
-        if (t[q] > t[q + 1]) {
-          double x = t[q];
-          t[q] = t[q + 1];
-          t[q + 1] = x;
-        }
-    int changes = 0, prev = -1;
-    for (int r = 0; r <= nt; r++) {
-      double u = 0.5 * ((r ? t[r - 1] : 0) + (r < nt ? t[r] : 1));
-      unsigned bits = 0;
-      for (int j = 0; j < k; j++) {
-        double sa = e->s[j][v->la], sb = e->s[j][v->lb];
-        if (sa + u * (sb - sa) < 0) bits |= 1u << j;
+      if (e->in[j][la]) bits |= 1u << j;
+      if (e->in[j][la] == e->in[j][lb]) continue;
+      /* the crossings in their (perturbed) order from la: b's is after
+         a's when b is still on its la side at a's */
+      int r = nt++;
+      bx[r] = mx_edge_box(e->x[la], e->x[lb], &e->pl[j], &box[r]) == 0;
+      MxBox bj = box[r];
+      int bjok = bx[r];
+      while (r > 0 && edge_order(e, la, lb, cr[r - 1], bx[r - 1] ? &box[r - 1] : NULL,
+                                 j) != e->in[j][la]) {
+        box[r] = box[r - 1];
+        bx[r] = bx[r - 1];
+        cr[r] = cr[r - 1];
+        r--;
       }
+      cr[r] = j;
+      box[r] = bj;
+      bx[r] = bjok;
+    }
+    int changes = 0, prev = pl_eval(m, bits);
+    for (int r = 0; r < nt; r++) {
+      bits ^= 1u << cr[r];
       int val = pl_eval(m, bits);
-      changes += prev >= 0 && val != prev;
+      changes += val != prev;
       prev = val;
     }
     if (m->ps[pa] != m->ps[pb] && changes == 1) {
@@ -2934,8 +3105,16 @@ static int lv_global(ExTet *e, int i) {
       return v->global = edge_vertex(m, pa, pb);
     }
   }
+  if (v->tie) lv_exact(e, v);
   int g = kmap_get(&m->vert2, v->key);
-  if (g >= 0) return v->global = g;
+  if (g >= 0) {
+    if (v->tie && !m->xact[g]) { /* placed before by a tetrahedron that
+                                    did not see the degeneracy */
+      memcpy(m->v + 3 * (size_t)g, v->x, sizeof v->x);
+      m->xact[g] = 1;
+    }
+    return v->global = g;
+  }
   if (grow((void **)&m->v, &m->capv, 3 * (m->nv + 1), sizeof *m->v) < 0 ||
       kmap_put(&m->vert2, v->key, (int)m->nv) < 0) {
     m->err = MESH_ENOMEM;
@@ -2946,6 +3125,11 @@ static int lv_global(ExTet *e, int i) {
     return -1;
   }
   m->uni[m->nv] = 0;
+  if (grow((void **)&m->xact, &m->capxact, m->nv + 1, 1) < 0) {
+    m->err = MESH_ENOMEM;
+    return -1;
+  }
+  m->xact[m->nv] = (unsigned char)v->tie;
   memcpy(m->v + 3 * m->nv, v->x, sizeof v->x);
   return v->global = (int)m->nv++;
 }
@@ -2985,46 +3169,83 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
   int k = m->cur->npl;
   for (int q = 0; q < 4; q++)
     for (int a = 0; a < 3; a++) e->x[q][a] = m->org[a] + 0.5 * m->h * m->pc[3 * p[q] + a];
+  e->faces = 0;
   for (int j = 0; j < k; j++) {
-    double n[3], d;
-    pl_plane(m, j, n, &d);
-    for (int q = 0; q < 4; q++) e->s[j][q] = vec3_dot(n, e->x[q]) - d;
+    MxPlane *pl = &e->pl[j];
+    pl_plane(m, j, pl->n, &pl->d);
+    pl->pts[0] = pl->pts[1] = pl->pts[2] = NULL;
+    pl->rank = m->pls[m->cur->pl0 + j];
+    mx_plane_prep(pl);
+    for (int q = 0; q < 4; q++) {
+      int tie;
+      /* the rounded distance decides when it is beyond 2^-50 of the
+         permanent (3 ulps bound its error; mesh_exact.h) */
+      const double *x = e->x[q];
+      double p0 = pl->n[0] * x[0], p1 = pl->n[1] * x[1], p2 = pl->n[2] * x[2];
+      double sv = p0 + p1 + p2 - pl->d;
+      double eb = 0x1p-50 * (fabs(p0) + fabs(p1) + fabs(p2) + fabs(pl->d)) + 0x1p-400;
+      e->s[j][q] = sv; /* vec3_dot's order */
+      e->se[j][q] = eb;
+      if (sv > eb || sv < -eb) {
+        e->in[j][q] = sv < 0;
+        e->on[j][q] = 0;
+        continue;
+      }
+      e->in[j][q] = (unsigned char)mx_point_in(pl, x, &tie);
+      e->on[j][q] = (unsigned char)tie;
+    }
   }
-  static const int tedge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   for (int i = 0; i < k; i++) {
-    /* plane i's polygon: its crossings of the tetrahedron's edges */
-    int cv[4], ce[4][2], nc = 0;
-    for (int q = 0; q < 6; q++) {
-      int a = tedge[q][0], b = tedge[q][1];
-      if ((e->s[i][a] < 0) == (e->s[i][b] < 0)) continue;
-      if (nc == 4) return (void)(m->err = MESH_EINTERNAL), -1;
-      cv[nc] = ex_edge(e, i, a, b);
-      ce[nc][0] = a;
-      ce[nc][1] = b;
-      nc++;
-    }
-    if (nc < 3) continue;
-    if (e->bad) return (void)(m->err = MESH_EINTERNAL), -1;
-    /* order them counter-clockwise about +n_i */
-    double n[3], d, c[3] = {0, 0, 0}, u[3], w[3], ang[4];
-    pl_plane(m, i, n, &d);
-    for (int q = 0; q < nc; q++)
-      for (int a = 0; a < 3; a++) c[a] += e->lv[cv[q]].x[a] / nc;
-    for (int a = 0; a < 3; a++) u[a] = e->lv[cv[0]].x[a] - c[a];
-    vec3_cross(n, u, w);
-    for (int q = 0; q < nc; q++) {
-      double r[3];
-      for (int a = 0; a < 3; a++) r[a] = e->lv[cv[q]].x[a] - c[a];
-      ang[q] = atan2(vec3_dot(r, w), vec3_dot(r, u));
-    }
-    int ord[4] = {0, 1, 2, 3};
-    for (int r = 0; r < nc; r++)
-      for (int q = 0; q + 1 < nc - r; q++)
-        if (ang[ord[q]] > ang[ord[q + 1]]) {
-          int t = ord[q];
-          ord[q] = ord[q + 1];
-          ord[q + 1] = t;
+    /* plane i's polygon: its crossings of the tetrahedron's edges, in
+       counter-clockwise order about +n_i, decided from the corners' sides
+       alone (a plane through a corner, perturbed, has its crossings there
+       apart by an infinitesimal): with one corner L alone on its side
+       and the others a < b < c, (L a, L b, L c) when the permutation
+       (L a b c) of the positive tetrahedron is even and L inside, or odd
+       and L outside; with a < b on one side and c < d on the other,
+       (a c, a d, b d, b c) when (a b c d) is even and a, b inside, or
+       odd and a, b outside; else the reverse */
+    const unsigned char *si = e->in[i];
+    int nsi = si[0] + si[1] + si[2] + si[3];
+    if (nsi == 0 || nsi == 4) continue;
+    int ce[4][2], nc = 0, cv[4], ord[4] = {0, 1, 2, 3};
+    int odd = 0, ccw;
+    if (nsi == 1 || nsi == 3) {
+      int L = 0;
+      while ((si[L] != 0) != (nsi == 1)) L++;
+      for (int q = 0; q < 4; q++)
+        if (q != L) {
+          ce[nc][0] = L;
+          ce[nc][1] = q;
+          nc++;
         }
+      odd = L & 1; /* (L a b c): L transpositions */
+      ccw = !odd == !!si[L];
+    } else {
+      int in2[2], out2[2], ni = 0, no = 0;
+      for (int q = 0; q < 4; q++) {
+        if (si[q]) in2[ni++] = q;
+        else out2[no++] = q;
+      }
+      const int a = in2[0], b = in2[1], c = out2[0], d = out2[1];
+      const int seq[4] = {a, b, c, d};
+      for (int x = 0; x < 4; x++)
+        for (int y = x + 1; y < 4; y++) odd ^= seq[x] > seq[y];
+      ce[0][0] = a, ce[0][1] = c;
+      ce[1][0] = a, ce[1][1] = d;
+      ce[2][0] = b, ce[2][1] = d;
+      ce[3][0] = b, ce[3][1] = c;
+      nc = 4;
+      ccw = !odd; /* a, b are the inside pair */
+    }
+    for (int q = 0; q < nc; q++) cv[q] = ex_edge(e, i, ce[q][0], ce[q][1]);
+    if (e->bad) return (void)(m->err = MESH_EINTERNAL), -1;
+    if (!ccw)
+      for (int q = 0; q < nc / 2; q++) {
+        int t = ord[q];
+        ord[q] = ord[nc - 1 - q];
+        ord[nc - 1 - q] = t;
+      }
     Piece *cur = e->pc[0], *nxt = e->pc[1];
     int np = 1;
     cur[0].n = 0;
@@ -3039,13 +3260,11 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
     }
     for (int j = 0; j < k; j++) {
       if (j == i) continue;
-      double nj[3], dj;
-      pl_plane(m, j, nj, &dj);
       int nn = 0;
       for (int r = 0; r < np; r++) {
         Piece *P = &cur[r];
         int in[PV_MAX], nin = 0;
-        for (int q = 0; q < P->n; q++) nin += in[q] = vec3_dot(nj, e->lv[P->v[q]].x) - dj < 0;
+        for (int q = 0; q < P->n; q++) nin += in[q] = lv_in(e, P->v[q], j);
         if (nin == 0 || nin == P->n) {
           if (nn == PC_MAX) return (void)(m->err = MESH_EINTERNAL), -1;
           nxt[nn] = *P;
@@ -3129,6 +3348,96 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
     }
   }
   return 0;
+}
+
+/* Vertices within WELD (of the octree's side) of each other made one,
+   and the triangles that lose their area by it dropped. The sharp
+   cells' perturbed planes (mesh_exact.h) meet a degenerate point (three
+   planes through one line, four through one point: a polygon's sides
+   that mirror each other across a face) in several vertices an
+   infinitesimal apart, joined by edges of no length and triangles of no
+   area, the same in every tetrahedron: closed and consistently oriented,
+   but not a mesh to write. When the planes' doubles make the point only
+   nearly degenerate (a mirrored polygon's offsets rounded), those
+   vertices are 1e-16 apart and their rounded positions can cross.
+   Collapsing the edges that short takes both out; the closure and
+   self-intersection checks judge the result. 0, or -1 out of memory. */
+#define WELD 0x1p-40
+
+static int weld_find(int *p, int x) {
+  while (p[x] != x) x = p[x] = p[p[x]];
+  return x;
+}
+
+static int weld(Mesher *m) {
+  if (!m->nv) return 0;
+  /* grid cells of 1024 g: a vertex looks into a neighbour cell only when
+     it is within g of the side between them */
+  double g = ldexp(m->h, MAX_DEPTH) * WELD, cs = 1024 * g;
+  int *par = malloc(m->nv * sizeof *par), *next = malloc(m->nv * sizeof *next);
+  kmap at = {0}; /* grid cell -> the last vertex put there */
+  int rc = -1;
+  if (!par || !next) goto out;
+  for (size_t i = 0; i < m->nv; i++) par[i] = (int)i;
+  for (size_t i = 0; i < m->nv; i++) {
+    const double *x = m->v + 3 * i;
+    int64_t c[3];
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+      double f = floor(x[a] / cs);
+      c[a] = (int64_t)f;
+      lo[a] = x[a] - g < f * cs ? -1 : 0;
+      hi[a] = x[a] + g >= (f + 1) * cs ? 1 : 0;
+    }
+    for (int dx = lo[0]; dx <= hi[0]; dx++)
+      for (int dy = lo[1]; dy <= hi[1]; dy++)
+        for (int dz = lo[2]; dz <= hi[2]; dz++) {
+          uint64_t k[4] = {(uint64_t)(c[0] + dx), (uint64_t)(c[1] + dy),
+                           (uint64_t)(c[2] + dz), 0};
+          for (int j = kmap_get(&at, k); j >= 0; j = next[j]) {
+            const double *y = m->v + 3 * (size_t)j;
+            if (fabs(x[0] - y[0]) <= g && fabs(x[1] - y[1]) <= g &&
+                fabs(x[2] - y[2]) <= g) {
+              int ra = weld_find(par, (int)i), rb = weld_find(par, j);
+              if (ra != rb) par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
+            }
+          }
+        }
+    uint64_t k[4] = {(uint64_t)c[0], (uint64_t)c[1], (uint64_t)c[2], 0};
+    next[i] = kmap_get(&at, k);
+    if (kmap_put(&at, k, (int)i) < 0) goto out;
+  }
+  size_t w = 0;
+  for (size_t t = 0; t < m->nt; t++) {
+    int a = weld_find(par, m->t[3 * t]), b = weld_find(par, m->t[3 * t + 1]),
+        c = weld_find(par, m->t[3 * t + 2]);
+    if (a == b || b == c || c == a) continue;
+    m->t[3 * w] = a;
+    m->t[3 * w + 1] = b;
+    m->t[3 * w + 2] = c;
+    w++;
+  }
+  if (w < m->nt) {
+    /* a vertex moved to its class's first (a chain of near ones can
+       reach past g): each triangle's bound grows by the largest move */
+    double mv = 0;
+    for (size_t i = 0; i < m->nv; i++) {
+      size_t r = (size_t)weld_find(par, (int)i);
+      if (r == i) continue;
+      double d = dist3(m->v + 3 * i, m->v + 3 * r);
+      if (d > mv) mv = d;
+    }
+    m->rep->welded += (long)(m->nt - w);
+    m->rep->certified += mv;
+  }
+  m->nt = w;
+  rc = 0;
+out:
+  free(par);
+  free(next);
+  free(at.k);
+  free(at.v);
+  return rc;
 }
 
 /* The Kuhn split: 6 tetrahedra around the diagonal 0 - 7, each ordered to
@@ -4109,6 +4418,10 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     rc = MESH_ENOMEM;
     goto done;
   }
+  if (weld(&m) < 0) {
+    rc = MESH_ENOMEM;
+    goto done;
+  }
   if (over_memory(&m)) {
     rc = memory_error(&m, err, errlen, 0);
     goto done;
@@ -4314,6 +4627,7 @@ done:
   free(m.fpath.v);
   free(m.fstart);
   free(m.uni);
+  free(m.xact);
   hfree(&m.pt);
   hfree(&m.vert);
   if (m.ray) ray_ctx_free(m.ray);

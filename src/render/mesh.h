@@ -117,6 +117,8 @@ typedef struct MeshReport {
   long sharp_pruned;       /* of them, cells whose other planes do not
                               reach the solid there (mesh.c,
                               cell_redundant) */
+  long welded;             /* triangles of no area dropped where the
+                              sharp cells met a degenerate point */
   long sharp_apart;        /* sharp cells meshed by their tetrahedra's
                               crossings instead, where two sharp cells
                               left a crack or a self-intersection between
