@@ -3417,18 +3417,33 @@ static int weld(Mesher *m) {
     m->t[3 * w + 2] = c;
     w++;
   }
-  if (w < m->nt) {
-    /* a vertex moved to its class's first (a chain of near ones can
-       reach past g): each triangle's bound grows by the largest move */
-    double mv = 0;
-    for (size_t i = 0; i < m->nv; i++) {
-      size_t r = (size_t)weld_find(par, (int)i);
-      if (r == i) continue;
-      double d = dist3(m->v + 3 * i, m->v + 3 * r);
-      if (d > mv) mv = d;
-    }
+  /* a vertex moved to its class's first (a chain of near ones can reach
+     past g): each triangle's bound grows by the largest move */
+  double mv = 0;
+  int moved = 0;
+  for (size_t i = 0; i < m->nv; i++) {
+    size_t r = (size_t)weld_find(par, (int)i);
+    if (r == i) continue;
+    double d = dist3(m->v + 3 * i, m->v + 3 * r);
+    if (d > mv) mv = d;
+    moved = 1;
+  }
+  if (moved) {
     m->rep->welded += (long)(m->nt - w);
     m->rep->certified += mv;
+    /* the vertices no triangle uses any more left out (next[] reused as
+       the new numbers; the per-vertex flags are done with) */
+    for (size_t i = 0; i < m->nv; i++) next[i] = -1;
+    for (size_t t = 0; t < 3 * w; t++) next[m->t[t]] = 0;
+    size_t nv = 0;
+    for (size_t i = 0; i < m->nv; i++)
+      if (next[i] == 0) {
+        next[i] = (int)nv;
+        memmove(m->v + 3 * nv, m->v + 3 * i, 3 * sizeof *m->v);
+        nv++;
+      }
+    for (size_t t = 0; t < 3 * w; t++) m->t[t] = next[m->t[t]];
+    m->nv = nv;
   }
   m->nt = w;
   rc = 0;
