@@ -754,6 +754,9 @@ enum { LEAF_PLANE, LEAF_SMOOTH, LEAF_FINE, LEAF_EXACT };
 
 /* The most planes a sharp cell (LEAF_EXACT) may hold. */
 #define PL_MAX MESH_PLANES_MAX
+/* A cell of more planes than this tries leaving out the ones that do not
+   reach the solid (cell_redundant) */
+#define PL_PRUNE 12
 
 typedef struct {
   uint32_t q[3];           /* its lowest corner, in units of its side */
@@ -1903,7 +1906,7 @@ static int pair_segments(const double (*n)[3], const double *d, int np,
   return any;
 }
 
-/* Where more than PL_MAX distinct undecided halfspaces cross the box
+/* Where more than PL_PRUNE distinct undecided halfspaces cross the box
    [lo, hi] (classes in m->st), all of them reaching the object through
    one intersection (a group: a prism's sides and caps, or the hole cut
    by one, away from the plate's faces), those that take no part in the
@@ -1931,7 +1934,7 @@ static int cell_redundant(Mesher *m, const double lo[3], const double hi[3]) {
     for (int y = 0; y < nd && !dup; y++) dup = same_surface(s, pl[y], x);
     if (!dup) pl[nd++] = x;
   }
-  if (nd <= PL_MAX || !m->par || !m->grp || !m->frc) return 0;
+  if (nd <= PL_PRUNE || !m->par || !m->grp || !m->frc) return 0;
   /* one group holds every undecided plane, or nothing is forced: a
      plane of another part (a plate's face at a hole's rim) has its
      polygon split by every plane crossing the cell, so a neighbour that
@@ -2002,6 +2005,26 @@ static int cell_redundant(Mesher *m, const double lo[3], const double hi[3]) {
    (LEAF_PLANE), or one rounded node whose gradient bound over the box
    grown by the tolerance makes the triangles close enough (LEAF_SMOOTH,
    see mesh.h). */
+/* The distinct planes of the undecided halfspaces (m->st), appended to
+   m->pls from n0: their count, at most PL_MAX + 1 (more: not a sharp
+   cell), or -1 out of memory. */
+static int collect_planes(Mesher *m, int n0) {
+  int f = m->s->nodes[m->node].first, n = 0;
+  for (int x = f; x <= m->node && n <= PL_MAX; x++) {
+    if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+    int dup = 0;
+    for (int y = 0; y < n && !dup; y++) dup = same_surface(m->s, m->pls[n0 + y], x);
+    if (dup) continue;
+    if (grow((void **)&m->pls, &m->cappls, m->npls + 1, sizeof *m->pls) < 0) {
+      m->err = MESH_ENOMEM;
+      return -1;
+    }
+    m->pls[m->npls++] = x;
+    n++;
+  }
+  return n;
+}
+
 static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   double side = ldexp(m->h, m->depth - level), lo[3], hi[3];
   uint32_t q[3] = {i, j, k};
@@ -2094,40 +2117,23 @@ static int walk(Mesher *m, uint32_t i, uint32_t j, uint32_t k, int level) {
   if (pset == 2) m->rep->sharp_apart++;
   if (c == T_PL && clip_in && m->sharp && !pset) {
     /* the distinct planes of the undecided halfspaces */
-    int f = m->s->nodes[m->node].first, n0 = (int)m->npls, n = 0;
-    for (int x = f; x <= m->node && n <= PL_MAX; x++) {
-      if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
-      int dup = 0;
-      for (int y = 0; y < n && !dup; y++) dup = same_surface(m->s, m->pls[n0 + y], x);
-      if (dup) continue;
-      if (grow((void **)&m->pls, &m->cappls, m->npls + 1, sizeof *m->pls) < 0) {
-        m->err = MESH_ENOMEM;
-        return -1;
-      }
-      m->pls[m->npls++] = x;
-      n++;
-    }
-    if (n > PL_MAX && cell_redundant(m, lo, hi) > 0) {
-      /* again without the planes that do not reach the solid */
+    int n0 = (int)m->npls, n = collect_planes(m, n0);
+    if (n < 0) return -1;
+    if (n > PL_PRUNE && cell_redundant(m, lo, hi) > 0) {
+      /* again without the planes that do not reach the solid (a cell of
+         up to PL_MAX planes is exact with them all, but each tetrahedron
+         costs as the cube of their count) */
       int one2, c2 = scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one2, 1,
                                  m->frc);
+      int n1 = n;
       m->npls = (size_t)n0;
-      n = 0;
-      for (int x = f; x <= m->node && n <= PL_MAX && c2 == T_PL; x++) {
-        if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
-        int dup = 0;
-        for (int y = 0; y < n && !dup; y++) dup = same_surface(m->s, m->pls[n0 + y], x);
-        if (dup) continue;
-        if (grow((void **)&m->pls, &m->cappls, m->npls + 1, sizeof *m->pls) < 0) {
-          m->err = MESH_ENOMEM;
-          return -1;
-        }
-        m->pls[m->npls++] = x;
-        n++;
-      }
-      if (c2 != T_PL || n > PL_MAX) { /* as it was */
-        n = PL_MAX + 1;
+      n = c2 == T_PL ? collect_planes(m, n0) : PL_MAX + 1;
+      if (n < 0) return -1;
+      if (c2 != T_PL || n > PL_MAX || n >= n1) { /* as it was */
+        m->npls = (size_t)n0;
         scene_box_g(m->s, m->node, lo, hi, m->st, m->one, &one2, 1, m->forced);
+        n = collect_planes(m, n0);
+        if (n < 0) return -1;
       } else {
         m->rep->sharp_pruned++;
       }
@@ -2673,8 +2679,8 @@ static int face(Mesher *m, int l, const int64_t q[3], int a, int s,
    sharp cells there are meshed by their tetrahedra (sharp_apart) or, at
    last, the mesh is made again without sharp cells (mesh_scene). */
 #define PV_MAX 32
-#define PC_MAX 128
-#define LV_MAX 512
+#define PC_MAX 160
+#define LV_MAX 1024
 
 typedef struct {
   int n;

@@ -75,7 +75,7 @@
 #include "scene/scene.h"
 
 /* The most distinct planes a sharp cell holds (meshed exactly). */
-#define MESH_PLANES_MAX 12
+#define MESH_PLANES_MAX 16
 
 typedef struct MeshSettings {
   double tol;              /* the requested error, scene units (> 0) */

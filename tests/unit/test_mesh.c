@@ -2544,6 +2544,14 @@ static void corners_only(void) {
     {"a plate with a 100-sided hole", "Difference (Scale (2, 0.2, 2) UnitCube) (Shift "
      "(1, -0.5, 1) (CylinderWith [Sides 100] 0.5 2))", 0.02},
     {"a 200-sided prism", "CylinderWith [Sides 200] 1 0.3", 0.02},
+    /* holes whose rim cells hold the plate's face and 13 to 16 of the
+       hole's planes (marching cells there before: 26,346 and 3,974
+       triangles) */
+    {"a plate with a 200-sided hole", "SetDifference (Scale (2, 0.2, 2) UnitCube) "
+     "(Shift (1, -0.5, 1) (CylinderWith [Sides 200] 0.5 2))", 0.02},
+    {"a 10 x 1 x 10 plate with a hole of radius 0.2 (Cylinder's 50 sides)",
+     "SetDifference (Scale (10, 1, 10) UnitCube) (Shift (5, -1, 5) (Cylinder 0.2 3))",
+     0.1},
     /* degenerate points (mesh_exact.h): a polygon's sides that mirror
        each other across a face meet on it, three planes through a line
        and four through a point; rotated, only nearly */
