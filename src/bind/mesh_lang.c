@@ -59,7 +59,7 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
     fprintf(f, "  degenerate points: %ld triangles of no area dropped where "
             "three planes meet in a line or four in a point, or all but "
             "(sides decided exactly, ties by a symbolic perturbation; "
-            "vertices within 2^-40 of the object's size welded, the "
+            "edges shorter than 2^-46 of the object's size collapsed, the "
             "certified bound grown by the largest move)\n", r->welded);
   if (r->sharp_apart && !r->sharp_off)
     fprintf(f, "  sharp cells given up locally: %ld about a crack or a "

@@ -3356,7 +3356,7 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
   return 0;
 }
 
-/* Vertices within WELD (of the octree's side) of each other made one,
+/* The mesh's edges shorter than WELD (of the octree's side) collapsed,
    and the triangles that lose their area by it dropped. The sharp
    cells' perturbed planes (mesh_exact.h) meet a degenerate point (three
    planes through one line, four through one point: a polygon's sides
@@ -3365,100 +3365,168 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
    area, the same in every tetrahedron: closed and consistently oriented,
    but not a mesh to write. When the planes' doubles make the point only
    nearly degenerate (a mirrored polygon's offsets rounded), those
-   vertices are 1e-16 apart and their rounded positions can cross.
-   Collapsing the edges that short takes both out; the closure and
-   self-intersection checks judge the result. 0, or -1 out of memory. */
-#define WELD 0x1p-40
+   vertices are 1e-16 apart and their rounded positions can cross. Only
+   edges are collapsed: two sheets that nearly touch (a gap of 1e-13, a
+   pinch where a hole's edge meets a prism's) share no edge and stay
+   apart. The closure and self-intersection checks judge the result.
+   0, or -1 out of memory. */
+#define WELD 0x1p-46
 
 static int weld_find(int *p, int x) {
   while (p[x] != x) x = p[x] = p[p[x]];
   return x;
 }
 
+/* par: each vertex's class (its first vertex). Every class whose first
+   vertex would not be one fan once welded (its triangles' far edges,
+   b -> c of each (r, b, c) left with area, not one cycle) is undone:
+   its vertices map to themselves. 0, or -1 out of memory. */
+static int weld_fans(Mesher *m, int *par) {
+  size_t nv = m->nv, nt = m->nt;
+  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *lk = NULL;
+  if (!cnt) return -1;
+  /* the far edges of the welded triangles, by their class's vertex */
+  for (size_t t = 0; t < nt; t++) {
+    int v[3];
+    for (int k = 0; k < 3; k++) v[k] = par[m->t[3 * t + (size_t)k]];
+    if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) continue;
+    for (int k = 0; k < 3; k++) cnt[v[k] + 1]++;
+  }
+  for (size_t i = 0; i < nv; i++) cnt[i + 1] += cnt[i];
+  at = malloc(nv * sizeof *at);
+  lk = malloc(2 * (size_t)(cnt[nv] ? cnt[nv] : 1) * sizeof *lk);
+  if (!at || !lk) {
+    free(cnt);
+    free(at);
+    free(lk);
+    return -1;
+  }
+  for (size_t i = 0; i < nv; i++) at[i] = cnt[i];
+  for (size_t t = 0; t < nt; t++) {
+    int v[3];
+    for (int k = 0; k < 3; k++) v[k] = par[m->t[3 * t + (size_t)k]];
+    if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) continue;
+    for (int k = 0; k < 3; k++) {
+      int q = at[v[k]]++;
+      lk[2 * q] = v[(k + 1) % 3];
+      lk[2 * q + 1] = v[(k + 2) % 3];
+    }
+  }
+  /* which classes have more than one vertex */
+  unsigned char *multi = calloc(nv, 1), *bad = calloc(nv, 1);
+  if (!multi || !bad) {
+    free(cnt);
+    free(at);
+    free(lk);
+    free(multi);
+    free(bad);
+    return -1;
+  }
+  for (size_t i = 0; i < nv; i++)
+    if (par[i] != (int)i) multi[par[i]] = 1;
+  for (size_t r = 0; r < nv; r++) {
+    if (!multi[r]) continue;
+    int lo = cnt[r], n = cnt[r + 1] - lo;
+    if (n < 3) { /* none: a part of no size, gone whole; else not closed */
+      bad[r] = n > 0;
+      continue;
+    }
+    /* one cycle: every far edge's end starts exactly one far edge, and
+       walking from the first comes back after n steps */
+    int cur = lo, steps = 0;
+    do {
+      int next = -1, found = 0;
+      for (int q = lo; q < lo + n; q++)
+        if (lk[2 * q] == lk[2 * cur + 1]) {
+          next = q;
+          found++;
+        }
+      if (found != 1) {
+        steps = -1;
+        break;
+      }
+      cur = next;
+      steps++;
+    } while (cur != lo && steps <= n);
+    if (steps != n) bad[r] = 1;
+  }
+  for (size_t i = 0; i < nv; i++)
+    if (bad[par[i]]) par[i] = (int)i;
+  free(cnt);
+  free(at);
+  free(lk);
+  free(multi);
+  free(bad);
+  return 0;
+}
+
 static int weld(Mesher *m) {
   if (!m->nv) return 0;
-  /* grid cells of 1024 g: a vertex looks into a neighbour cell only when
-     it is within g of the side between them */
-  double g = ldexp(m->h, MAX_DEPTH) * WELD, cs = 1024 * g;
-  int *par = malloc(m->nv * sizeof *par), *next = malloc(m->nv * sizeof *next);
-  kmap at = {0}; /* grid cell -> the last vertex put there */
-  int rc = -1;
-  if (!par || !next) goto out;
+  double g = ldexp(m->h, MAX_DEPTH) * WELD;
+  int *par = malloc(m->nv * sizeof *par);
+  if (!par) return -1;
   for (size_t i = 0; i < m->nv; i++) par[i] = (int)i;
-  for (size_t i = 0; i < m->nv; i++) {
-    const double *x = m->v + 3 * i;
-    int64_t c[3];
-    int lo[3], hi[3];
-    for (int a = 0; a < 3; a++) {
-      double f = floor(x[a] / cs);
-      c[a] = (int64_t)f;
-      lo[a] = x[a] - g < f * cs ? -1 : 0;
-      hi[a] = x[a] + g >= (f + 1) * cs ? 1 : 0;
+  int moved = 0;
+  for (size_t t = 0; t < m->nt; t++)
+    for (int k = 0; k < 3; k++) {
+      int a = m->t[3 * t + (size_t)k], b = m->t[3 * t + (size_t)(k + 1) % 3];
+      const double *x = m->v + 3 * (size_t)a, *y = m->v + 3 * (size_t)b;
+      if (!(fabs(x[0] - y[0]) <= g && fabs(x[1] - y[1]) <= g &&
+            fabs(x[2] - y[2]) <= g))
+        continue;
+      int ra = weld_find(par, a), rb = weld_find(par, b);
+      if (ra == rb) continue;
+      par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
+      moved = 1;
     }
-    for (int dx = lo[0]; dx <= hi[0]; dx++)
-      for (int dy = lo[1]; dy <= hi[1]; dy++)
-        for (int dz = lo[2]; dz <= hi[2]; dz++) {
-          uint64_t k[4] = {(uint64_t)(c[0] + dx), (uint64_t)(c[1] + dy),
-                           (uint64_t)(c[2] + dz), 0};
-          for (int j = kmap_get(&at, k); j >= 0; j = next[j]) {
-            const double *y = m->v + 3 * (size_t)j;
-            if (fabs(x[0] - y[0]) <= g && fabs(x[1] - y[1]) <= g &&
-                fabs(x[2] - y[2]) <= g) {
-              int ra = weld_find(par, (int)i), rb = weld_find(par, j);
-              if (ra != rb) par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
-            }
-          }
-        }
-    uint64_t k[4] = {(uint64_t)c[0], (uint64_t)c[1], (uint64_t)c[2], 0};
-    next[i] = kmap_get(&at, k);
-    if (kmap_put(&at, k, (int)i) < 0) goto out;
+  if (!moved) {
+    free(par);
+    return 0;
+  }
+  for (size_t i = 0; i < m->nv; i++) par[i] = weld_find(par, (int)i);
+  /* a class whose vertex would not be one fan (two sheets that touch
+     at a point, joined by the perturbation through a neck of no width)
+     is not welded: its vertices stay as they were */
+  if (weld_fans(m, par) < 0) {
+    free(par);
+    return -1;
   }
   size_t w = 0;
   for (size_t t = 0; t < m->nt; t++) {
-    int a = weld_find(par, m->t[3 * t]), b = weld_find(par, m->t[3 * t + 1]),
-        c = weld_find(par, m->t[3 * t + 2]);
+    int a = par[m->t[3 * t]], b = par[m->t[3 * t + 1]], c = par[m->t[3 * t + 2]];
     if (a == b || b == c || c == a) continue;
     m->t[3 * w] = a;
     m->t[3 * w + 1] = b;
     m->t[3 * w + 2] = c;
     w++;
   }
-  /* a vertex moved to its class's first (a chain of near ones can reach
-     past g): each triangle's bound grows by the largest move */
+  /* a vertex moved to its class's first (a chain of short edges can
+     reach past g): each triangle's bound grows by the largest move */
   double mv = 0;
-  int moved = 0;
   for (size_t i = 0; i < m->nv; i++) {
-    size_t r = (size_t)weld_find(par, (int)i);
+    size_t r = (size_t)par[i];
     if (r == i) continue;
     double d = dist3(m->v + 3 * i, m->v + 3 * r);
     if (d > mv) mv = d;
-    moved = 1;
   }
-  if (moved) {
-    m->rep->welded += (long)(m->nt - w);
-    m->rep->certified += mv;
-    /* the vertices no triangle uses any more left out (next[] reused as
-       the new numbers; the per-vertex flags are done with) */
-    for (size_t i = 0; i < m->nv; i++) next[i] = -1;
-    for (size_t t = 0; t < 3 * w; t++) next[m->t[t]] = 0;
-    size_t nv = 0;
-    for (size_t i = 0; i < m->nv; i++)
-      if (next[i] == 0) {
-        next[i] = (int)nv;
-        memmove(m->v + 3 * nv, m->v + 3 * i, 3 * sizeof *m->v);
-        nv++;
-      }
-    for (size_t t = 0; t < 3 * w; t++) m->t[t] = next[m->t[t]];
-    m->nv = nv;
-  }
+  m->rep->welded += (long)(m->nt - w);
+  m->rep->certified += mv;
+  /* the vertices no triangle uses any more left out (par reused as the
+     new numbers; the per-vertex flags are done with) */
+  for (size_t i = 0; i < m->nv; i++) par[i] = -1;
+  for (size_t t = 0; t < 3 * w; t++) par[m->t[t]] = 0;
+  size_t nv = 0;
+  for (size_t i = 0; i < m->nv; i++)
+    if (par[i] == 0) {
+      par[i] = (int)nv;
+      memmove(m->v + 3 * nv, m->v + 3 * i, 3 * sizeof *m->v);
+      nv++;
+    }
+  for (size_t t = 0; t < 3 * w; t++) m->t[t] = par[m->t[t]];
+  m->nv = nv;
   m->nt = w;
-  rc = 0;
-out:
   free(par);
-  free(next);
-  free(at.k);
-  free(at.v);
-  return rc;
+  return 0;
 }
 
 /* The Kuhn split: 6 tetrahedra around the diagonal 0 - 7, each ordered to

@@ -2544,6 +2544,15 @@ static void corners_only(void) {
     {"a plate with a 100-sided hole", "Difference (Scale (2, 0.2, 2) UnitCube) (Shift "
      "(1, -0.5, 1) (CylinderWith [Sides 100] 0.5 2))", 0.02},
     {"a 200-sided prism", "CylinderWith [Sides 200] 1 0.3", 0.02},
+    /* sheets that nearly touch share no edge and are not welded (a
+       review's cases: welding by distance joined them) */
+    {"two cubes 1e-13 apart", "Union UnitCube (Shift (1.0000000000001, 0, 0) "
+     "UnitCube)", 0.02},
+    {"a triangular prism bored by another where their edges touch",
+     "Rotate \"y\" 30.0 (Rotate \"z\" 15.0 (SetDifference (Shift (0.0, (-1.0), "
+     "0.0) (CylinderWith [Sides 3] 0.7 2.0)) (Shift (0.0, 0.0, "
+     "(-0.9999999999999997)) (Rotate \"x\" 90.0 (CylinderWith [Sides 3] 0.7 "
+     "2.0)))))", 0.02},
     /* holes whose rim cells hold the plate's face and 13 to 16 of the
        hole's planes (marching cells there before: 26,346 and 3,974
        triangles) */
