@@ -834,6 +834,7 @@ typedef struct {
   int *plmap;              /* per node of the subtree: 2 (plane) + flip */
   unsigned char *pv;       /* pl_eval scratch */
   int *prog, nprog;        /* pl_eval's nodes in the cell (pl_prog) */
+  struct PlMemo *memo;     /* pl_eval's answers in the cell, or NULL */
   int *alias;              /* per node: the node whose value it takes in
                               the cell, or -1 when its class decides it */
   struct ExTet *ex;        /* exact_tet scratch */
@@ -2983,6 +2984,17 @@ static int lv_in(ExTet *e, int v, int j) {
   return r;
 }
 
+/* pl_eval's answers in one cell: its six tetrahedra ask of the same
+   sides again (a piece of the arrangement crosses several), and the
+   program is the cell's. A slot holds the bits it was asked for, from
+   the cell whose number (cur, counted by pl_prog) is in gen. */
+#define PL_MEMO 1024
+typedef struct PlMemo {
+  unsigned key[PL_MEMO], gen[PL_MEMO];
+  unsigned char val[PL_MEMO];
+  unsigned cur;
+} PlMemo;
+
 /* pl_eval's program for the cell whose classes are in m->st: the nodes
    its value depends on, children first. A node decided by its class
    takes no part; an operation one of whose operands leaves the other
@@ -2992,6 +3004,10 @@ static int lv_in(ExTet *e, int v, int j) {
    cross the cell is two nodes and one operation, not 2n nodes. */
 static void pl_prog(Mesher *m) {
   const Scene *s = m->s;
+  if (m->memo && ++m->memo->cur == 0) { /* a new cell's answers */
+    memset(m->memo->gen, 0, sizeof m->memo->gen);
+    m->memo->cur = 1;
+  }
   int f = s->nodes[m->node].first;
   m->nprog = 0;
   for (int i = f; i <= m->node; i++) {
@@ -3026,7 +3042,7 @@ static int pl_val(const Mesher *m, int f, int x) {
 
 /* The solid's value with each plane on the side its bit says (scene_box's
    classes in m->st decide every other node; pl_prog made the program). */
-static int pl_eval(const Mesher *m, unsigned bits) {
+static int pl_run(const Mesher *m, unsigned bits) {
   const Scene *s = m->s;
   int f = s->nodes[m->node].first;
   for (int k = 0; k < m->nprog; k++) {
@@ -3065,6 +3081,18 @@ static void lv_exact(ExTet *e, LVert *v) {
   lv_three(e, v, three);
   double x[3];
   if (mx_three_point(three, x) == 0) memcpy(v->x, x, sizeof x);
+}
+
+static int pl_eval(const Mesher *m, unsigned bits) {
+  PlMemo *c = m->memo;
+  if (!c) return pl_run(m, bits);
+  unsigned h = (bits * 0x9E3779B1u) >> 22; /* 10 bits: PL_MEMO */
+  if (c->gen[h] == c->cur && c->key[h] == bits) return c->val[h];
+  int v = pl_run(m, bits);
+  c->gen[h] = c->cur;
+  c->key[h] = bits;
+  c->val[h] = (unsigned char)v;
+  return v;
 }
 
 static int lv_global(ExTet *e, int i) {
@@ -4366,6 +4394,8 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     }
   }
   m.ex = malloc(sizeof *m.ex);
+  m.memo = calloc(1, sizeof *m.memo); /* none: pl_eval runs every time */
+  if (m.memo) m.memo->cur = 1;
   m.ray = ray_ctx_new(s, vtol);
   m.s0 = s;
   /* parents, for cell_redundant (no memory: it is left out) */
@@ -4691,6 +4721,7 @@ done:
   free(m.rel);
   free(m.one2);
   free(m.ex);
+  free(m.memo);
   prune_levels_free(&m);
   free(m.par);
   free(m.grp);
