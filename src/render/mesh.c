@@ -2810,6 +2810,21 @@ static int ex_edge(ExTet *e, int i, int la, int lb) {
   return v;
 }
 
+/* The corners of the tetrahedron's face ex (the one without corner ex),
+   in point order: every tetrahedron sharing the face takes them alike. */
+static void face_corners(const ExTet *e, int ex, int f[3]) {
+  int nf = 0;
+  for (int q = 0; q < 4; q++)
+    if (q != ex) f[nf++] = q;
+  for (int a = 0; a < 2; a++)
+    for (int c = 0; c < 2 - a; c++)
+      if (e->p[f[c]] > e->p[f[c + 1]]) {
+        int t = f[c];
+        f[c] = f[c + 1];
+        f[c + 1] = t;
+      }
+}
+
 /* The vertex where piece edge (a, b) with support sup meets plane j. */
 static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
   const Mesher *m = e->m;
@@ -2847,16 +2862,8 @@ static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
     memcpy(A, R, sizeof A);
     memcpy(B, Rb, sizeof B);
   } else { /* two planes on a tetrahedron face */
-    int ex = -1 - sup, f[3], nf = 0;
-    for (int q = 0; q < 4; q++)
-      if (q != ex) f[nf++] = q;
-    for (int r = 0; r < 2; r++)
-      for (int c = 0; c < 2 - r; c++)
-        if (e->p[f[c]] > e->p[f[c + 1]]) {
-          int t = f[c];
-          f[c] = f[c + 1];
-          f[c + 1] = t;
-        }
+    int f[3];
+    face_corners(e, -1 - sup, f);
     double u[3], w[3];
     for (int q = 0; q < 3; q++) {
       u[q] = e->x[f[1]][q] - e->x[f[0]][q];
@@ -2908,16 +2915,8 @@ static void lv_three(ExTet *e, const LVert *w, const MxPlane *three[3]) {
   int ex = -1 - w->ps;
   if (!(e->faces >> ex & 1)) {
     /* face ex through its corners in point order, as ex_split takes it */
-    int f[3], nf = 0;
-    for (int q = 0; q < 4; q++)
-      if (q != ex) f[nf++] = q;
-    for (int a = 0; a < 2; a++)
-      for (int c = 0; c < 2 - a; c++)
-        if (e->p[f[c]] > e->p[f[c + 1]]) {
-          int t = f[c];
-          f[c] = f[c + 1];
-          f[c + 1] = t;
-        }
+    int f[3];
+    face_corners(e, ex, f);
     MxPlane *fp = &e->face[ex];
     for (int c = 0; c < 3; c++) fp->pts[c] = e->x[f[c]];
     fp->rank = -1;
@@ -2930,30 +2929,10 @@ static void lv_three(ExTet *e, const LVert *w, const MxPlane *three[3]) {
 }
 
 static int lv_box(ExTet *e, LVert *w) {
-  if (w->kind == 0) {
-    /* the crossing a + t (b - a), t = sa / (sa - sb), from the corners'
-       rounded distances and their bounds (each operation's rounding
-       added, 2^-52 for 2^-53 to cover the bound's own) */
-    int i = w->plane, a = w->la, b = w->lb;
-    double sa = e->s[i][a], sb = e->s[i][b], ea = e->se[i][a], eb = e->se[i][b];
-    double den = sa - sb, eden = ea + eb + 0x1p-52 * fabs(den);
-    double md = fabs(den) - eden;
-    if (!(md > 0)) return -1;
-    double t = sa / den, et = (ea + fabs(t) * eden) / md + 0x1p-52 * fabs(t);
-    double rm = 0, xm = 0;
-    for (int k = 0; k < 3; k++) {
-      double d = e->x[b][k] - e->x[a][k], td = t * d, x = e->x[a][k] + td;
-      double r = fabs(d) * et + 0x1p-52 * (fabs(d * t) + fabs(td) + fabs(x));
-      r *= 1 + 0x1p-30;
-      w->box.x[k] = x;
-      w->box.r[k] = r;
-      if (!(r < 0x1p100) || !(fabs(x) <= 0x1p100)) return -1;
-      if (r > rm) rm = r;
-      if (fabs(x) > xm) xm = fabs(x);
-    }
-    w->box.q = (rm + 0x1p-50 * xm) * (1 + 0x1p-30);
-    return 0;
-  }
+  if (w->kind == 0) /* from the corners' rounded distances and bounds */
+    return mx_edge_box(e->x[w->la], e->x[w->lb], e->s[w->plane][w->la],
+                       e->se[w->plane][w->la], e->s[w->plane][w->lb],
+                       e->se[w->plane][w->lb], &w->box);
   const MxPlane *three[3];
   lv_three(e, w, three);
   return mx_three_box(three, &w->box);
@@ -3113,7 +3092,8 @@ static int lv_global(ExTet *e, int i) {
       /* the crossings in their (perturbed) order from la: b's is after
          a's when b is still on its la side at a's */
       int r = nt++;
-      bx[r] = mx_edge_box(e->x[la], e->x[lb], &e->pl[j], &box[r]) == 0;
+      bx[r] = mx_edge_box(e->x[la], e->x[lb], e->s[j][la], e->se[j][la],
+                          e->s[j][lb], e->se[j][lb], &box[r]) == 0;
       MxBox bj = box[r];
       int bjok = bx[r];
       while (r > 0 && edge_order(e, la, lb, cr[r - 1], bx[r - 1] ? &box[r - 1] : NULL,
@@ -3400,11 +3380,6 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
    0, or -1 out of memory. */
 #define WELD 0x1p-46
 
-static int weld_find(int *p, int x) {
-  while (p[x] != x) x = p[x] = p[p[x]];
-  return x;
-}
-
 /* par: each vertex's class (its first vertex). Every class whose first
    vertex would not be one fan once welded (its triangles' far edges,
    b -> c of each (r, b, c) left with area, not one cycle) is undone:
@@ -3502,7 +3477,7 @@ static int weld(Mesher *m) {
       if (!(fabs(x[0] - y[0]) <= g && fabs(x[1] - y[1]) <= g &&
             fabs(x[2] - y[2]) <= g))
         continue;
-      int ra = weld_find(par, a), rb = weld_find(par, b);
+      int ra = find(par, a), rb = find(par, b);
       if (ra == rb) continue;
       par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
       moved = 1;
@@ -3511,7 +3486,7 @@ static int weld(Mesher *m) {
     free(par);
     return 0;
   }
-  for (size_t i = 0; i < m->nv; i++) par[i] = weld_find(par, (int)i);
+  for (size_t i = 0; i < m->nv; i++) par[i] = find(par, (int)i);
   /* a class whose vertex would not be one fan (two sheets that touch
      at a point, joined by the perturbation through a neck of no width)
      is not welded: its vertices stay as they were */

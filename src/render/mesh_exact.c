@@ -165,13 +165,27 @@ static int box_done(const ev x[3], MxBox *b) {
   return 0;
 }
 
-int mx_edge_box(const double a[3], const double b[3], const MxPlane *i,
-                MxBox *out) {
-  if (!tame_plane(i) || !tame(a, 3) || !tame(b, 3)) return -1;
-  ev sa = ev_s(i, a), sb = ev_s(i, b), t = ev_div(sa, ev_sub(sa, sb)), x[3];
-  for (int k = 0; k < 3; k++)
-    x[k] = ev_add(ev_of(a[k]), ev_mul(t, ev_sub(ev_of(b[k]), ev_of(a[k]))));
-  return box_done(x, out);
+int mx_edge_box(const double a[3], const double b[3], double sa, double ea,
+                double sb, double eb, MxBox *out) {
+  /* a + t (b - a), t = sa / (sa - sb), each operation's rounding added
+     (2^-52 for 2^-53 to cover the bound's own) */
+  double den = sa - sb, eden = ea + eb + 0x1p-52 * fabs(den);
+  double md = fabs(den) - eden;
+  if (!(md > 0)) return -1;
+  double t = sa / den, et = (ea + fabs(t) * eden) / md + 0x1p-52 * fabs(t);
+  double rm = 0, xm = 0;
+  for (int k = 0; k < 3; k++) {
+    double d = b[k] - a[k], td = t * d, x = a[k] + td;
+    double r = fabs(d) * et + 0x1p-52 * (fabs(d * t) + fabs(td) + fabs(x));
+    r *= 1 + 0x1p-30;
+    out->x[k] = x;
+    out->r[k] = r;
+    if (!(r < BIG) || !(fabs(x) <= BIG)) return -1;
+    if (r > rm) rm = r;
+    if (fabs(x) > xm) xm = fabs(x);
+  }
+  out->q = (rm + 0x1p-50 * xm) * (1 + 0x1p-30);
+  return 0;
 }
 
 int mx_three_box(const MxPlane *const p[3], MxBox *out) {

@@ -70,8 +70,9 @@ void mx_edge_point(const double a[3], const double b[3], const MxPlane *i,
 int mx_three_point(const MxPlane *const p[3], double x[3]);
 
 /* A box about a point (centre x, half-sides r) that holds it for sure:
-   the crossing of segment a - b with plane i, the meeting point of
-   p[0..2]; -1 when the doubles cannot bound it. Plane j over it: 1 all
+   the crossing of segment a - b with a plane whose n . x - d is within
+   ea of sa at a and within eb of sb at b, the meeting point of p[0..2];
+   -1 when the doubles cannot bound it. Plane j over it: 1 all
    inside, 0 all outside, -1 undecided. A point asked about many planes
    is boxed once and each answer is then a dot product; the predicates
    above answer what a box leaves undecided (and every tie). */
@@ -79,8 +80,8 @@ typedef struct {
   double x[3], r[3];
   double q;             /* max r_k + 2^-50 max |x_k| */
 } MxBox;
-int mx_edge_box(const double a[3], const double b[3], const MxPlane *i,
-                MxBox *out);
+int mx_edge_box(const double a[3], const double b[3], double sa, double ea,
+                double sb, double eb, MxBox *out);
 int mx_three_box(const MxPlane *const p[3], MxBox *out);
 
 static inline int mx_box_in(const MxBox *b, const MxPlane *j) {

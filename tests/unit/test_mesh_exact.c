@@ -217,7 +217,16 @@ static void ask_edge(const double a[3], const double b[3], const MxPlane *i,
   *bad += got != want || tie != zero;
   *ties += zero;
   MxBox bx;
-  if (mx_edge_box(a, b, i, &bx) == 0) {
+  /* the ends' distances as the mesher rounds them, with its bound
+     (2^-50 of the permanent) */
+  double se[2], ee[2];
+  for (int q = 0; q < 2; q++) {
+    const double *e = q ? b : a;
+    double p0 = i->n[0] * e[0], p1 = i->n[1] * e[1], p2 = i->n[2] * e[2];
+    se[q] = p0 + p1 + p2 - i->d;
+    ee[q] = 0x1p-50 * (fabs(p0) + fabs(p1) + fabs(p2) + fabs(i->d)) + 0x1p-400;
+  }
+  if (mx_edge_box(a, b, se[0], ee[0], se[1], ee[1], &bx) == 0) {
     *boxbad += !in_box(&bx, y, dy);
     int r = mx_box_in(&bx, j);
     *boxbad += r >= 0 && (zero || r != want);
