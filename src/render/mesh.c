@@ -3374,19 +3374,46 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
    but not a mesh to write. When the planes' doubles make the point only
    nearly degenerate (a mirrored polygon's offsets rounded), those
    vertices are 1e-16 apart and their rounded positions can cross. Only
-   edges are collapsed: two sheets that nearly touch (a gap of 1e-13, a
-   pinch where a hole's edge meets a prism's) share no edge and stay
-   apart. The closure and self-intersection checks judge the result.
+   edges are collapsed: two sheets that nearly touch (a gap of 1e-13)
+   share no edge and stay apart; a pinch is parted (weld_fans). The
+   closure and self-intersection checks judge the result.
    0, or -1 out of memory. */
 #define WELD 0x1p-46
+
+/* A pinch: where two parts of the solid touch at a point (a bore whose
+   edge grazes a prism's edge), the perturbation joins them through a
+   neck of no width or parts them; joined, the neck's vertices are one
+   class whose triangles' far edges make two or more cycles, a cone of
+   each part. Each cone gets a vertex of its own, moved by PINCH of the
+   octree's side or of the point's largest coordinate, whichever is
+   larger (32 of its ulps at least; a thousandth of its nearest ring
+   vertex's distance, if less), into its part, towards its ring's
+   centroid (or against its normal where that points out): the parts no
+   longer touch, and the mesh is a manifold again. The move is within
+   the flat regions' flatness (2^-44 of the size, mesh_merge_flat), so
+   the faces about the point are still merged whole. */
+#define PINCH 0x1p-47
 
 /* par: each vertex's class (its first vertex). Every class whose first
    vertex would not be one fan once welded (its triangles' far edges,
    b -> c of each (r, b, c) left with area, not one cycle) is undone:
-   its vertices map to themselves. 0, or -1 out of memory. */
-static int weld_fans(Mesher *m, int *par) {
+   its vertices map to themselves; unless those far edges make several
+   cycles, each vertex starting and ending one: a pinch, split into a
+   vertex per cycle (appended to m->v, *par grown with them; the
+   triangles' corners renumbered) each moved into its part by *moved at
+   most (the largest distance from a class's vertex to its new one).
+   0, or -1 out of memory. */
+static int weld_fans(Mesher *m, int **parp, double *moved) {
+  int *par = *parp;
   size_t nv = m->nv, nt = m->nt;
-  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *lk = NULL;
+  int rc = -1;
+  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *lk = NULL, *nx = NULL,
+      *cy = NULL;
+  size_t *lt = NULL;
+  unsigned char *multi = NULL, *bad = NULL;
+  double *np = NULL; /* a split class's first cycle's new position */
+  double *dl = NULL; /* and its move's length */
+  *moved = 0;
   if (!cnt) return -1;
   /* the far edges of the welded triangles, by their class's vertex */
   for (size_t t = 0; t < nt; t++) {
@@ -3396,14 +3423,15 @@ static int weld_fans(Mesher *m, int *par) {
     for (int k = 0; k < 3; k++) cnt[v[k] + 1]++;
   }
   for (size_t i = 0; i < nv; i++) cnt[i + 1] += cnt[i];
+  size_t ne = (size_t)(cnt[nv] ? cnt[nv] : 1);
   at = malloc(nv * sizeof *at);
-  lk = malloc(2 * (size_t)(cnt[nv] ? cnt[nv] : 1) * sizeof *lk);
-  if (!at || !lk) {
-    free(cnt);
-    free(at);
-    free(lk);
-    return -1;
-  }
+  lk = malloc(2 * ne * sizeof *lk);
+  lt = malloc(ne * sizeof *lt);
+  nx = malloc(ne * sizeof *nx);
+  cy = malloc(ne * sizeof *cy);
+  multi = calloc(nv, 1);
+  bad = calloc(nv, 1);
+  if (!at || !lk || !lt || !nx || !cy || !multi || !bad) goto done;
   for (size_t i = 0; i < nv; i++) at[i] = cnt[i];
   for (size_t t = 0; t < nt; t++) {
     int v[3];
@@ -3413,54 +3441,138 @@ static int weld_fans(Mesher *m, int *par) {
       int q = at[v[k]]++;
       lk[2 * q] = v[(k + 1) % 3];
       lk[2 * q + 1] = v[(k + 2) % 3];
+      lt[q] = 3 * t + (size_t)k;
     }
   }
   /* which classes have more than one vertex */
-  unsigned char *multi = calloc(nv, 1), *bad = calloc(nv, 1);
-  if (!multi || !bad) {
-    free(cnt);
-    free(at);
-    free(lk);
-    free(multi);
-    free(bad);
-    return -1;
-  }
   for (size_t i = 0; i < nv; i++)
     if (par[i] != (int)i) multi[par[i]] = 1;
+  size_t extra = 0; /* vertices the pinches add */
+  /* a vertex of the sharp cells alone can be a pinch too (two boxes
+     whose corners meet at a grid point: one vertex, two cones) */
+  int all = m->rep->sharp > 0;
   for (size_t r = 0; r < nv; r++) {
-    if (!multi[r]) continue;
+    if (!multi[r] && (!all || par[r] != (int)r)) continue;
     int lo = cnt[r], n = cnt[r + 1] - lo;
     if (n < 3) { /* none: a part of no size, gone whole; else not closed */
       bad[r] = n > 0;
       continue;
     }
-    /* one cycle: every far edge's end starts exactly one far edge, and
-       walking from the first comes back after n steps */
-    int cur = lo, steps = 0;
-    do {
-      int next = -1, found = 0;
-      for (int q = lo; q < lo + n; q++)
-        if (lk[2 * q] == lk[2 * cur + 1]) {
-          next = q;
+    /* cycles: every far edge's end starts exactly one far edge, and
+       each walk comes back to where it started in 3 steps or more */
+    for (int q = lo; q < lo + n && !bad[r]; q++) {
+      int found = 0;
+      cy[q] = -1;
+      for (int p = lo; p < lo + n; p++)
+        if (lk[2 * p] == lk[2 * q + 1]) {
+          nx[q] = p;
           found++;
         }
-      if (found != 1) {
-        steps = -1;
-        break;
+      if (found != 1) bad[r] = 1;
+    }
+    int nc = 0;
+    for (int q = lo; q < lo + n && !bad[r]; q++) {
+      if (cy[q] >= 0) continue;
+      int cur = q, len = 0;
+      do {
+        if (cy[cur] >= 0) { /* into another cycle: not a permutation */
+          bad[r] = 1;
+          break;
+        }
+        cy[cur] = nc;
+        cur = nx[cur];
+        len++;
+      } while (cur != q);
+      if (len < 3) bad[r] = 1;
+      nc++;
+    }
+    if (!bad[r] && nc > 1) extra += (size_t)nc;
+  }
+  if (extra) {
+    if (!(np = malloc(3 * nv * sizeof *np)) || !(dl = calloc(nv, sizeof *dl)) ||
+        grow((void **)&m->v, &m->capv, 3 * (nv + extra), sizeof *m->v) < 0)
+      goto done;
+    int *p2 = realloc(par, (nv + extra) * sizeof *par);
+    if (!p2) goto done;
+    *parp = par = p2;
+    double size = ldexp(m->h, MAX_DEPTH);
+    for (size_t r = 0; r < nv; r++) {
+      if ((!multi[r] && (!all || par[r] != (int)r)) || bad[r]) continue;
+      int lo = cnt[r], n = cnt[r + 1] - lo, nc = 0;
+      for (int q = lo; q < lo + n; q++)
+        if (cy[q] + 1 > nc) nc = cy[q] + 1;
+      if (nc < 2) continue;
+      const double *P = m->v + 3 * r;
+      size_t first = m->nv;
+      int ok = 1;
+      for (int c = 0; c < nc && ok; c++) {
+        double C[3] = {0, 0, 0}, N[3] = {0, 0, 0}, dmin = INFINITY;
+        int k = 0;
+        for (int q = lo; q < lo + n; q++) {
+          if (cy[q] != c) continue;
+          const double *a = m->v + 3 * (size_t)lk[2 * q],
+                       *b = m->v + 3 * (size_t)lk[2 * q + 1];
+          double u[3], w[3], x[3];
+          for (int i = 0; i < 3; i++) {
+            u[i] = a[i] - P[i];
+            w[i] = b[i] - P[i];
+            C[i] += a[i];
+          }
+          vec3_cross(u, w, x);
+          for (int i = 0; i < 3; i++) N[i] += x[i];
+          dmin = fmin(dmin, sqrt(vec3_dot(u, u)));
+          k++;
+        }
+        double u[3];
+        for (int i = 0; i < 3; i++) u[i] = C[i] / k - P[i];
+        if (!(vec3_dot(u, N) < 0))
+          for (int i = 0; i < 3; i++) u[i] = -N[i];
+        double big = fmax(size, fmax(fabs(P[0]), fmax(fabs(P[1]), fabs(P[2]))));
+        double l = sqrt(vec3_dot(u, u)), d = fmin(PINCH * big, 1e-3 * dmin);
+        if (!(l > 0) || !(d > 0)) {
+          ok = 0;
+          break;
+        }
+        double *to = c ? m->v + 3 * (m->nv + (size_t)c - 1) : np + 3 * r;
+        for (int i = 0; i < 3; i++) to[i] = P[i] + d * u[i] / l;
+        dl[r] = fmax(dl[r], d);
       }
-      cur = next;
-      steps++;
-    } while (cur != lo && steps <= n);
-    if (steps != n) bad[r] = 1;
+      if (!ok) { /* as it was: not welded */
+        bad[r] = 1;
+        dl[r] = 0;
+        continue;
+      }
+      /* cycle 0 keeps the class's vertex (moved below); the others' corners
+         go to the new vertices */
+      for (int q = lo; q < lo + n; q++)
+        if (cy[q] > 0) m->t[lt[q]] = (int)(first + (size_t)cy[q] - 1);
+      for (int c = 1; c < nc; c++) par[m->nv] = (int)m->nv, m->nv++;
+      m->rep->pinches++;
+    }
+    /* each vertex of a split class to its new places: at most its
+       distance to the class's vertex and the move */
+    for (size_t i = 0; i < nv; i++)
+      if (!bad[par[i]] && dl[par[i]] > 0)
+        *moved = fmax(*moved, dist3(m->v + 3 * i, m->v + 3 * (size_t)par[i]) +
+                                  dl[par[i]]);
+    for (size_t r = 0; r < nv; r++)
+      if (!bad[r] && dl[r] > 0) memcpy(m->v + 3 * r, np + 3 * r, 3 * sizeof *np);
   }
   for (size_t i = 0; i < nv; i++)
     if (bad[par[i]]) par[i] = (int)i;
+  rc = 0;
+done:
   free(cnt);
   free(at);
   free(lk);
+  free(lt);
+  free(nx);
+  free(cy);
   free(multi);
   free(bad);
-  return 0;
+  free(np);
+  free(dl);
+  return rc;
 }
 
 static int weld(Mesher *m) {
@@ -3482,7 +3594,7 @@ static int weld(Mesher *m) {
       par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
       moved = 1;
     }
-  if (!moved) {
+  if (!moved && !m->rep->sharp) {
     free(par);
     return 0;
   }
@@ -3490,7 +3602,8 @@ static int weld(Mesher *m) {
   /* a class whose vertex would not be one fan (two sheets that touch
      at a point, joined by the perturbation through a neck of no width)
      is not welded: its vertices stay as they were */
-  if (weld_fans(m, par) < 0) {
+  double pinch = 0;
+  if (weld_fans(m, &par, &pinch) < 0) {
     free(par);
     return -1;
   }
@@ -3513,7 +3626,7 @@ static int weld(Mesher *m) {
     if (d > mv) mv = d;
   }
   m->rep->welded += (long)(m->nt - w);
-  m->rep->certified += mv;
+  m->rep->certified += fmax(mv, pinch);
   /* the vertices no triangle uses any more left out (par reused as the
      new numbers; the per-vertex flags are done with) */
   for (size_t i = 0; i < m->nv; i++) par[i] = -1;

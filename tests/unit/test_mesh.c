@@ -2579,6 +2579,13 @@ static void corners_only(void) {
     {"a 24-sided prism on a 24-sided one",
      "Union (CylinderWith [Sides 24] 1 1) (Shift (0, 1, 0) (CylinderWith "
      "[Sides 24] 0.5 1))", 0.02},
+    /* pinches (mesh.c, PINCH): parts of the solid that touch at a point
+       (26,924 and 4,410 triangles before, sharp cells given up) */
+    {"an 8-sided prism bored through by a 6-sided one of its radius",
+     "SetDifference (Shift (0,-1,0) (CylinderWith [Sides 8] 0.3 2)) (Shift "
+     "(0,0,-1) (Rotate \"x\" 90 (CylinderWith [Sides 6] 0.3 2)))", 0.02},
+    {"two cubes whose corners touch", "Union UnitCube (Shift (1,1,1) UnitCube)",
+     0.02},
   };
   for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
     Scene *s = compile(objs[k].src);
@@ -2634,6 +2641,88 @@ static void corners_only(void) {
     CHECK(buf, nv && cnt && inner == 0);
     free(nv);
     free(cnt);
+    mesh_free(m);
+    scene_free(s);
+  }
+}
+
+/* Pinches (mesh.c, PINCH): a solid whose parts touch at points (a bore
+   of a prism's radius through it, both prisms' edges meeting on the
+   bore's axis plane; boxes corner to corner, rotated or not) meshes as
+   its parts apart: the components and Euler characteristic of that
+   many spheres, the report's pinches, the closest vertices of two
+   components (long double, brute force) apart but within 2^-44 of the
+   object's size, and every sharp cell kept. */
+static void pinches(void) {
+  static const struct { const char *name, *src; long parts, pinched; } objs[] = {
+    {"an 8-sided prism bored through by a 6-sided one of its radius",
+     "SetDifference (Shift (0,-1,0) (CylinderWith [Sides 8] 0.3 2)) (Shift "
+     "(0,0,-1) (Rotate \"x\" 90 (CylinderWith [Sides 6] 0.3 2)))", 2, 1},
+    {"a 16-sided prism bored through by an 8-sided one of its radius",
+     "SetDifference (Shift (0,-1,0) (CylinderWith [Sides 16] 0.3 2)) (Shift "
+     "(0,0,-1) (Rotate \"x\" 90 (CylinderWith [Sides 8] 0.3 2)))", 2, 2},
+    {"two cubes whose corners touch", "Union UnitCube (Shift (1,1,1) UnitCube)",
+     2, 1},
+    {"a cube on a rotated cube's corner", "Union UnitCube (Shift (1,1,1) "
+     "(Rotate \"z\" 45 UnitCube))", 2, 1},
+    {"three cubes corner to corner", "Union (Union UnitCube (Shift (1,1,1) "
+     "UnitCube)) (Shift (2,2,2) UnitCube)", 3, 2},
+  };
+  for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
+    Scene *s = compile(objs[k].src);
+    CHECK(objs[k].name, s != NULL);
+    if (!s) continue;
+    MeshSettings ms = {0};
+    ms.tol = 0.02;
+    Mesh *m = NULL;
+    MeshReport rep;
+    char err[300], buf[500];
+    int bad;
+    int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
+    snprintf(buf, sizeof buf, "pinches: %s meshed (%s), %ld components, "
+             "Euler characteristic %ld, %ld pinches, %ld sharp cells given up, "
+             "%zu triangles", objs[k].name, rc ? err : "ok", rep.components,
+             rep.euler, rep.pinches, rep.sharp_apart + rep.sharp_off,
+             m ? m->nt : 0);
+    CHECK(buf, rc == 0 && rep.components == objs[k].parts &&
+                   rep.euler == 2 * objs[k].parts &&
+                   rep.pinches == objs[k].pinched && rep.sharp_apart == 0 &&
+                   rep.sharp_off == 0 && m->nt < 400);
+    if (rc) {
+      scene_free(s);
+      continue;
+    }
+    /* components by the triangles' shared vertices */
+    int *par = malloc(m->nv * sizeof *par);
+    for (size_t i = 0; i < m->nv; i++) par[i] = (int)i;
+    for (size_t t = 0; t < m->nt; t++)
+      for (int i = 1; i < 3; i++) {
+        int a = m->t[3 * t], b = m->t[3 * t + (size_t)i];
+        while (par[a] != a) a = par[a];
+        while (par[b] != b) b = par[b];
+        if (a != b) par[a] = b;
+      }
+    long double gap = INFINITY, size = 0;
+    for (size_t i = 0; i < 3 * m->nv; i++) size = fmaxl(size, fabsl((long double)m->v[i]));
+    for (size_t i = 0; i < m->nv; i++)
+      for (size_t j = i + 1; j < m->nv; j++) {
+        int a = (int)i, b = (int)j;
+        while (par[a] != a) a = par[a];
+        while (par[b] != b) b = par[b];
+        if (a == b) continue;
+        long double d = 0;
+        for (int c = 0; c < 3; c++) {
+          long double x = (long double)m->v[3 * i + (size_t)c] - m->v[3 * j + (size_t)c];
+          d += x * x;
+        }
+        gap = fminl(gap, sqrtl(d));
+      }
+    snprintf(buf, sizeof buf, "pinches: %s: the parts' closest vertices %.3Lg "
+             "apart (more than 0, less than 2^-44 of the size %.3Lg); the "
+             "certified bound %.3g within the tolerance", objs[k].name, gap,
+             size, rep.certified);
+    CHECK(buf, gap > 0 && gap < ldexpl(size, -44) && rep.certified <= ms.tol);
+    free(par);
     mesh_free(m);
     scene_free(s);
   }
@@ -2948,6 +3037,7 @@ int main(void) {
   sharp_corners();
   flat_merge();
   corners_only();
+  pinches();
   thin_parts();
   property();
   sharp_kept();
