@@ -63,9 +63,9 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "certified bound grown by the largest move)\n", r->welded);
   if (r->pinches)
     fprintf(f, "  pinches: %ld point%s where two parts of the solid touch "
-            "parted, each part's vertex moved into it by at most 2^-47 of the "
-            "object's size (in the certified bound)\n", r->pinches,
-            r->pinches == 1 ? "" : "s");
+            "(at a point or along a line) parted, each part's vertex moved "
+            "into it by at most 2^-47 of the object's size (in the certified "
+            "bound)\n", r->pinches, r->pinches == 1 ? "" : "s");
   if (r->sharp_apart && !r->sharp_off)
     fprintf(f, "  sharp cells given up locally: %ld about a crack or a "
             "self-intersection that two sharp cells left between them were "

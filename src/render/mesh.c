@@ -3380,40 +3380,18 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
    0, or -1 out of memory. */
 #define WELD 0x1p-46
 
-/* A pinch: where two parts of the solid touch at a point (a bore whose
-   edge grazes a prism's edge), the perturbation joins them through a
-   neck of no width or parts them; joined, the neck's vertices are one
-   class whose triangles' far edges make two or more cycles, a cone of
-   each part. Each cone gets a vertex of its own, moved by PINCH of the
-   octree's side or of the point's largest coordinate, whichever is
-   larger (32 of its ulps at least; a thousandth of its nearest ring
-   vertex's distance, if less), into its part, towards its ring's
-   centroid (or against its normal where that points out): the parts no
-   longer touch, and the mesh is a manifold again. The move is within
-   the flat regions' flatness (2^-44 of the size, mesh_merge_flat), so
-   the faces about the point are still merged whole. */
-#define PINCH 0x1p-47
-
 /* par: each vertex's class (its first vertex). Every class whose first
-   vertex would not be one fan once welded (its triangles' far edges,
-   b -> c of each (r, b, c) left with area, not one cycle) is undone:
-   its vertices map to themselves; unless those far edges make several
-   cycles, each vertex starting and ending one: a pinch, split into a
-   vertex per cycle (appended to m->v, *par grown with them; the
-   triangles' corners renumbered) each moved into its part by *moved at
-   most (the largest distance from a class's vertex to its new one).
-   0, or -1 out of memory. */
-static int weld_fans(Mesher *m, int **parp, double *moved) {
-  int *par = *parp;
+   vertex would not be made of closed fans once welded (its triangles'
+   far edges, b -> c of each (r, b, c) left with area: each end must
+   start exactly one far edge, so that they make disjoint cycles) is
+   undone: its vertices map to themselves. A class of several cycles (a
+   pinch joined by a neck of no width) is welded, and part_contacts
+   parts it. 0, or -1 out of memory. */
+static int weld_fans(Mesher *m, int *par) {
   size_t nv = m->nv, nt = m->nt;
-  int rc = -1;
-  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *lk = NULL, *nx = NULL,
-      *cy = NULL;
-  size_t *lt = NULL;
+  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *lk = NULL;
   unsigned char *multi = NULL, *bad = NULL;
-  double *np = NULL; /* a split class's first cycle's new position */
-  double *dl = NULL; /* and its move's length */
-  *moved = 0;
+  int rc = -1;
   if (!cnt) return -1;
   /* the far edges of the welded triangles, by their class's vertex */
   for (size_t t = 0; t < nt; t++) {
@@ -3426,12 +3404,9 @@ static int weld_fans(Mesher *m, int **parp, double *moved) {
   size_t ne = (size_t)(cnt[nv] ? cnt[nv] : 1);
   at = malloc(nv * sizeof *at);
   lk = malloc(2 * ne * sizeof *lk);
-  lt = malloc(ne * sizeof *lt);
-  nx = malloc(ne * sizeof *nx);
-  cy = malloc(ne * sizeof *cy);
   multi = calloc(nv, 1);
   bad = calloc(nv, 1);
-  if (!at || !lk || !lt || !nx || !cy || !multi || !bad) goto done;
+  if (!at || !lk || !multi || !bad) goto done;
   for (size_t i = 0; i < nv; i++) at[i] = cnt[i];
   for (size_t t = 0; t < nt; t++) {
     int v[3];
@@ -3441,122 +3416,29 @@ static int weld_fans(Mesher *m, int **parp, double *moved) {
       int q = at[v[k]]++;
       lk[2 * q] = v[(k + 1) % 3];
       lk[2 * q + 1] = v[(k + 2) % 3];
-      lt[q] = 3 * t + (size_t)k;
     }
   }
   /* which classes have more than one vertex */
   for (size_t i = 0; i < nv; i++)
     if (par[i] != (int)i) multi[par[i]] = 1;
-  size_t extra = 0; /* vertices the pinches add */
-  /* a vertex of the sharp cells alone can be a pinch too (two boxes
-     whose corners meet at a grid point: one vertex, two cones) */
-  int all = m->rep->sharp > 0;
   for (size_t r = 0; r < nv; r++) {
-    if (!multi[r] && (!all || par[r] != (int)r)) continue;
+    if (!multi[r]) continue;
     int lo = cnt[r], n = cnt[r + 1] - lo;
     if (n < 3) { /* none: a part of no size, gone whole; else not closed */
       bad[r] = n > 0;
       continue;
     }
-    /* cycles: every far edge's end starts exactly one far edge, and
-       each walk comes back to where it started in 3 steps or more */
+    /* closed: every far edge's end starts as many far edges as end
+       there (one each: one fan or disjoint fans; more: parts touching
+       along a line through the vertex, part_contacts pairs them) */
     for (int q = lo; q < lo + n && !bad[r]; q++) {
-      int found = 0;
-      cy[q] = -1;
-      for (int p = lo; p < lo + n; p++)
-        if (lk[2 * p] == lk[2 * q + 1]) {
-          nx[q] = p;
-          found++;
-        }
-      if (found != 1) bad[r] = 1;
-    }
-    int nc = 0;
-    for (int q = lo; q < lo + n && !bad[r]; q++) {
-      if (cy[q] >= 0) continue;
-      int cur = q, len = 0;
-      do {
-        if (cy[cur] >= 0) { /* into another cycle: not a permutation */
-          bad[r] = 1;
-          break;
-        }
-        cy[cur] = nc;
-        cur = nx[cur];
-        len++;
-      } while (cur != q);
-      if (len < 3) bad[r] = 1;
-      nc++;
-    }
-    if (!bad[r] && nc > 1) extra += (size_t)nc;
-  }
-  if (extra) {
-    if (!(np = malloc(3 * nv * sizeof *np)) || !(dl = calloc(nv, sizeof *dl)) ||
-        grow((void **)&m->v, &m->capv, 3 * (nv + extra), sizeof *m->v) < 0)
-      goto done;
-    int *p2 = realloc(par, (nv + extra) * sizeof *par);
-    if (!p2) goto done;
-    *parp = par = p2;
-    double size = ldexp(m->h, MAX_DEPTH);
-    for (size_t r = 0; r < nv; r++) {
-      if ((!multi[r] && (!all || par[r] != (int)r)) || bad[r]) continue;
-      int lo = cnt[r], n = cnt[r + 1] - lo, nc = 0;
-      for (int q = lo; q < lo + n; q++)
-        if (cy[q] + 1 > nc) nc = cy[q] + 1;
-      if (nc < 2) continue;
-      const double *P = m->v + 3 * r;
-      size_t first = m->nv;
-      int ok = 1;
-      for (int c = 0; c < nc && ok; c++) {
-        double C[3] = {0, 0, 0}, N[3] = {0, 0, 0}, dmin = INFINITY;
-        int k = 0;
-        for (int q = lo; q < lo + n; q++) {
-          if (cy[q] != c) continue;
-          const double *a = m->v + 3 * (size_t)lk[2 * q],
-                       *b = m->v + 3 * (size_t)lk[2 * q + 1];
-          double u[3], w[3], x[3];
-          for (int i = 0; i < 3; i++) {
-            u[i] = a[i] - P[i];
-            w[i] = b[i] - P[i];
-            C[i] += a[i];
-          }
-          vec3_cross(u, w, x);
-          for (int i = 0; i < 3; i++) N[i] += x[i];
-          dmin = fmin(dmin, sqrt(vec3_dot(u, u)));
-          k++;
-        }
-        double u[3];
-        for (int i = 0; i < 3; i++) u[i] = C[i] / k - P[i];
-        if (!(vec3_dot(u, N) < 0))
-          for (int i = 0; i < 3; i++) u[i] = -N[i];
-        double big = fmax(size, fmax(fabs(P[0]), fmax(fabs(P[1]), fabs(P[2]))));
-        double l = sqrt(vec3_dot(u, u)), d = fmin(PINCH * big, 1e-3 * dmin);
-        if (!(l > 0) || !(d > 0)) {
-          ok = 0;
-          break;
-        }
-        double *to = c ? m->v + 3 * (m->nv + (size_t)c - 1) : np + 3 * r;
-        for (int i = 0; i < 3; i++) to[i] = P[i] + d * u[i] / l;
-        dl[r] = fmax(dl[r], d);
+      int starts = 0, ends = 0;
+      for (int p = lo; p < lo + n; p++) {
+        starts += lk[2 * p] == lk[2 * q + 1];
+        ends += lk[2 * p + 1] == lk[2 * q + 1];
       }
-      if (!ok) { /* as it was: not welded */
-        bad[r] = 1;
-        dl[r] = 0;
-        continue;
-      }
-      /* cycle 0 keeps the class's vertex (moved below); the others' corners
-         go to the new vertices */
-      for (int q = lo; q < lo + n; q++)
-        if (cy[q] > 0) m->t[lt[q]] = (int)(first + (size_t)cy[q] - 1);
-      for (int c = 1; c < nc; c++) par[m->nv] = (int)m->nv, m->nv++;
-      m->rep->pinches++;
+      if (starts != ends || lk[2 * q] == lk[2 * q + 1]) bad[r] = 1;
     }
-    /* each vertex of a split class to its new places: at most its
-       distance to the class's vertex and the move */
-    for (size_t i = 0; i < nv; i++)
-      if (!bad[par[i]] && dl[par[i]] > 0)
-        *moved = fmax(*moved, dist3(m->v + 3 * i, m->v + 3 * (size_t)par[i]) +
-                                  dl[par[i]]);
-    for (size_t r = 0; r < nv; r++)
-      if (!bad[r] && dl[r] > 0) memcpy(m->v + 3 * r, np + 3 * r, 3 * sizeof *np);
   }
   for (size_t i = 0; i < nv; i++)
     if (bad[par[i]]) par[i] = (int)i;
@@ -3565,14 +3447,268 @@ done:
   free(cnt);
   free(at);
   free(lk);
-  free(lt);
-  free(nx);
-  free(cy);
   free(multi);
   free(bad);
-  free(np);
-  free(dl);
   return rc;
+}
+
+/* Parts of the solid that touch, at a point (a prism bored through by
+   another of its radius, whose edges meet on the bore's axis plane; two
+   boxes corner to corner) or along a line (boxes or prisms edge to
+   edge): the perturbation of the sharp cells joins them by a neck of no
+   width (welded into one vertex) or meets them at shared vertices and
+   edges. A vertex whose triangles make several fans (joined across its
+   edges: an edge of two triangles joins them; an edge of more is a
+   line where parts touch, whose triangles are paired about it, each
+   with the one that closes its part's wedge) gets a vertex per fan,
+   each moved into its part by PINCH of the octree's side or of the
+   point's largest coordinate, whichever is larger (32 of its ulps at
+   least; a thousandth of its nearest neighbour's distance, if less),
+   towards its neighbours' centroid, or against its normal when that
+   points out, less its component along the lines of contact: the parts
+   touch no more, the mesh is a manifold, and the move, within the flat
+   regions' flatness (2^-44 of the size, mesh_merge_flat), leaves the
+   faces about the point to be merged whole. *moved: the largest move.
+   0 (nothing parted when a line's triangles do not alternate in and
+   out about it), or -1 out of memory. */
+#define PINCH 0x1p-47
+#define FACES_MAX 16 /* triangles about a line of contact */
+
+static int corner_find(int *p, int x) {
+  while (p[x] != x) x = p[x] = p[p[x]];
+  return x;
+}
+
+static int part_contacts(Mesher *m, double *moved) {
+  size_t nv = m->nv, nt = m->nt, nc = 3 * nt;
+  *moved = 0;
+  if (!nv || !nt) return 0;
+  int rc = -1;
+  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *wt = NULL, *up = NULL,
+      *root = NULL, *re = NULL;
+  unsigned char *wc = NULL, *line = NULL;
+  double *np = NULL; /* each fan's place: x, y, z, the vertex it goes to */
+  size_t nnew = 0, capnew = 0, nadd = 0;
+  long pinches = m->rep->pinches;
+  int applied = 0;
+  if (!cnt) return -1;
+  for (size_t i = 0; i < nc; i++) cnt[m->t[i] + 1]++;
+  for (size_t i = 0; i < nv; i++) cnt[i + 1] += cnt[i];
+  at = malloc(nv * sizeof *at);
+  wt = malloc(nc * sizeof *wt);
+  wc = malloc(nc);
+  up = malloc(nc * sizeof *up);
+  line = calloc(nv, 1);
+  if (!at || !wt || !wc || !up || !line) goto done;
+  for (size_t i = 0; i < nv; i++) at[i] = cnt[i];
+  for (size_t t = 0; t < nt; t++)
+    for (int k = 0; k < 3; k++) {
+      int q = at[m->t[3 * t + (size_t)k]]++;
+      wt[q] = (int)t;
+      wc[q] = (unsigned char)k;
+    }
+  for (size_t q = 0; q < nc; q++) up[q] = (int)q;
+#define NXT(q) m->t[3 * (size_t)wt[q] + (size_t)(wc[q] + 1) % 3]
+#define PRV(q) m->t[3 * (size_t)wt[q] + (size_t)(wc[q] + 2) % 3]
+  for (size_t v = 0; v < nv; v++)
+    for (int q = cnt[v]; q < cnt[v + 1]; q++) {
+      int x = NXT(q), out = 0, in = 0, qin = -1;
+      for (int r = cnt[v]; r < cnt[v + 1]; r++) {
+        out += NXT(r) == x;
+        if (PRV(r) == x) in++, qin = r;
+      }
+      if (out == 1 && in == 1) {
+        int a = corner_find(up, q), b = corner_find(up, qin);
+        if (a != b) up[a] = b;
+        continue;
+      }
+      if (out != in || (size_t)x < v) continue; /* not closed; or from x */
+      /* a line of contact: its triangles by their angle about v -> x */
+      int f[FACES_MAX], n = 0;
+      double ang[FACES_MAX];
+      line[v] = line[x] = 1;
+      const double *pv = m->v + 3 * v, *px = m->v + 3 * (size_t)x;
+      double e[3], e2 = 0, rx[3] = {0, 0, 0}, ry[3];
+      for (int i = 0; i < 3; i++) e[i] = px[i] - pv[i], e2 += e[i] * e[i];
+      for (int r = cnt[v]; r < cnt[v + 1]; r++) {
+        int c;
+        if (NXT(r) == x) c = PRV(r);
+        else if (PRV(r) == x) c = NXT(r);
+        else continue;
+        if (n == FACES_MAX) goto flat;
+        double w[3], d = 0;
+        for (int i = 0; i < 3; i++) w[i] = m->v[3 * (size_t)c + (size_t)i] - pv[i];
+        for (int i = 0; i < 3; i++) d += w[i] * e[i];
+        for (int i = 0; i < 3; i++) w[i] -= d / e2 * e[i];
+        if (!n) {
+          memcpy(rx, w, sizeof w);
+          vec3_cross(e, rx, ry);
+        }
+        ang[n] = atan2(vec3_dot(w, ry), vec3_dot(w, rx) * sqrt(e2));
+        f[n++] = r;
+      }
+      /* sorted about the line, counter-clockwise seen from x */
+      for (int i = 1; i < n; i++)
+        for (int j = i; j > 0 && ang[j] < ang[j - 1]; j--) {
+          double ta = ang[j];
+          ang[j] = ang[j - 1];
+          ang[j - 1] = ta;
+          int tf = f[j];
+          f[j] = f[j - 1];
+          f[j - 1] = tf;
+        }
+      /* a triangle v -> x has its part clockwise of it, one x -> v
+         counter-clockwise: they alternate, each x -> v paired with the
+         next */
+      for (int i = 0; i < n; i++)
+        if (ang[i] == ang[(i + 1) % n] ||
+            (NXT(f[i]) == x) == (NXT(f[(i + 1) % n]) == x))
+          goto flat;
+      int s0 = NXT(f[0]) == x ? 1 : 0;
+      for (int i = s0; i < n + s0; i += 2) {
+        int q1 = f[i % n], q2 = f[(i + 1) % n];
+        int a = corner_find(up, q1), b = corner_find(up, q2);
+        if (a != b) up[a] = b;
+        /* the same two triangles at x */
+        int r1 = -1, r2 = -1;
+        for (int r = cnt[x]; r < cnt[x + 1]; r++) {
+          if (wt[r] == wt[q1]) r1 = r;
+          if (wt[r] == wt[q2]) r2 = r;
+        }
+        if (r1 < 0 || r2 < 0) goto flat;
+        a = corner_find(up, r1);
+        b = corner_find(up, r2);
+        if (a != b) up[a] = b;
+      }
+    }
+  /* each vertex's fans: a vertex of several gets one more vertex for
+     each fan but the first, placed after all are decided */
+  root = malloc(nc * sizeof *root);
+  if (!root) goto done;
+  double size = ldexp(m->h, MAX_DEPTH);
+  for (size_t v = 0; v < nv; v++) {
+    int lo = cnt[v], hi = cnt[v + 1], nf = 0;
+    for (int q = lo; q < hi; q++) {
+      int r = corner_find(up, q);
+      int j = lo;
+      while (j < q && root[j] != r) j++;
+      root[q] = r;
+      if (j == q) nf++;
+    }
+    if (nf < 2) continue;
+    const double *P = m->v + 3 * v;
+    /* the lines of contact through v, made orthonormal */
+    double ln[2][3];
+    int nl = 0;
+    for (int q = lo; q < hi && line[v] && nl < 2; q++) {
+      int x = NXT(q), out = 0, in = 0;
+      for (int r = lo; r < hi; r++) out += NXT(r) == x, in += PRV(r) == x;
+      if (out + in <= 2) continue;
+      double d[3];
+      for (int i = 0; i < 3; i++) d[i] = m->v[3 * (size_t)x + (size_t)i] - P[i];
+      for (int k = 0; k < nl; k++) {
+        double p = vec3_dot(d, ln[k]);
+        for (int i = 0; i < 3; i++) d[i] -= p * ln[k][i];
+      }
+      double l = sqrt(vec3_dot(d, d));
+      if (!(l > 1e-6 * dist3(m->v + 3 * (size_t)x, P))) continue;
+      for (int i = 0; i < 3; i++) ln[nl][i] = d[i] / l;
+      nl++;
+    }
+    double big = fmax(size, fmax(fabs(P[0]), fmax(fabs(P[1]), fabs(P[2]))));
+    int first = 1;
+    for (int q0 = lo; q0 < hi; q0++) {
+      int j = lo;
+      while (j < q0 && root[j] != root[q0]) j++;
+      if (j < q0) continue; /* a fan already placed */
+      double C[3] = {0, 0, 0}, N[3] = {0, 0, 0}, dmin = INFINITY;
+      int k = 0;
+      for (int q = q0; q < hi; q++) {
+        if (root[q] != root[q0]) continue;
+        const double *a = m->v + 3 * (size_t)NXT(q), *b = m->v + 3 * (size_t)PRV(q);
+        double u[3], w[3], x[3];
+        for (int i = 0; i < 3; i++) {
+          u[i] = a[i] - P[i];
+          w[i] = b[i] - P[i];
+          C[i] += a[i];
+        }
+        vec3_cross(u, w, x);
+        for (int i = 0; i < 3; i++) N[i] += x[i];
+        dmin = fmin(dmin, sqrt(vec3_dot(u, u)));
+        k++;
+      }
+      double u[3];
+      for (int i = 0; i < 3; i++) u[i] = C[i] / k - P[i];
+      if (!(vec3_dot(u, N) < 0))
+        for (int i = 0; i < 3; i++) u[i] = -N[i];
+      for (int l = 0; l < nl; l++) {
+        double p = vec3_dot(u, ln[l]);
+        for (int i = 0; i < 3; i++) u[i] -= p * ln[l][i];
+      }
+      double l = sqrt(vec3_dot(u, u)), d = fmin(PINCH * big, 1e-3 * dmin);
+      if (!(l > 0) || !(d > 0)) goto flat;
+      if (grow((void **)&np, &capnew, 4 * (nnew + 1), sizeof *np) < 0) goto done;
+      if (!re) { /* each corner's new vertex, -1 if none: set at the end, so
+                    that the fans still to place see the triangles as made */
+        if (!(re = malloc(nc * sizeof *re))) goto done;
+        for (size_t i = 0; i < nc; i++) re[i] = -1;
+      }
+      double *to = np + 4 * nnew++;
+      for (int i = 0; i < 3; i++) to[i] = P[i] + d * u[i] / l;
+      /* the fan's vertex: v itself, or the next new one */
+      to[3] = first ? (double)v : (double)(nv + nadd);
+      if (!first) {
+        for (int q = q0; q < hi; q++)
+          if (root[q] == root[q0]) re[3 * (size_t)wt[q] + wc[q]] = (int)(nv + nadd);
+        nadd++;
+      }
+      *moved = fmax(*moved, d);
+      first = 0;
+    }
+    m->rep->pinches++;
+  }
+  if (nnew) {
+    if (grow((void **)&m->v, &m->capv, 3 * (nv + nadd), sizeof *m->v) < 0)
+      goto done;
+    for (size_t i = 0; i < nnew; i++)
+      memcpy(m->v + 3 * (size_t)np[4 * i + 3], np + 4 * i, 3 * sizeof *np);
+    for (size_t i = 0; i < nc; i++)
+      if (re[i] >= 0) m->t[i] = re[i];
+    m->nv = nv + nadd;
+  }
+  rc = 0;
+  applied = 1;
+  goto done;
+flat: /* not parted: the checks judge the mesh as it is */
+  rc = 0;
+done:
+  if (!applied) {
+    *moved = 0;
+    m->rep->pinches = pinches;
+  }
+#undef NXT
+#undef PRV
+  free(cnt);
+  free(at);
+  free(wt);
+  free(wc);
+  free(up);
+  free(root);
+  free(line);
+  free(np);
+  free(re);
+  return rc;
+}
+
+/* part_contacts where the sharp cells met (elsewhere nothing touches:
+   each marching triangle lies in its own tetrahedron), its moves in the
+   certified bound. 0, or -1 out of memory. */
+static int contacts(Mesher *m) {
+  double mv = 0;
+  if (!m->rep->sharp) return 0;
+  if (part_contacts(m, &mv) < 0) return -1;
+  m->rep->certified += mv;
+  return 0;
 }
 
 static int weld(Mesher *m) {
@@ -3594,16 +3730,14 @@ static int weld(Mesher *m) {
       par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
       moved = 1;
     }
-  if (!moved && !m->rep->sharp) {
+  if (!moved) {
     free(par);
-    return 0;
+    return contacts(m);
   }
   for (size_t i = 0; i < m->nv; i++) par[i] = find(par, (int)i);
-  /* a class whose vertex would not be one fan (two sheets that touch
-     at a point, joined by the perturbation through a neck of no width)
-     is not welded: its vertices stay as they were */
-  double pinch = 0;
-  if (weld_fans(m, &par, &pinch) < 0) {
+  /* a class whose vertex would not be closed fans is not welded: its
+     vertices stay as they were */
+  if (weld_fans(m, par) < 0) {
     free(par);
     return -1;
   }
@@ -3626,7 +3760,7 @@ static int weld(Mesher *m) {
     if (d > mv) mv = d;
   }
   m->rep->welded += (long)(m->nt - w);
-  m->rep->certified += fmax(mv, pinch);
+  m->rep->certified += mv;
   /* the vertices no triangle uses any more left out (par reused as the
      new numbers; the per-vertex flags are done with) */
   for (size_t i = 0; i < m->nv; i++) par[i] = -1;
@@ -3642,7 +3776,7 @@ static int weld(Mesher *m) {
   m->nv = nv;
   m->nt = w;
   free(par);
-  return 0;
+  return contacts(m);
 }
 
 /* The Kuhn split: 6 tetrahedra around the diagonal 0 - 7, each ordered to
