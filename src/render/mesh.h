@@ -119,8 +119,9 @@ typedef struct MeshReport {
                               cell_redundant) */
   long welded;             /* triangles of no area dropped where the
                               sharp cells met a degenerate point */
-  long pinches;            /* points where two parts of the solid touch,
-                              parted (mesh.c, PINCH) */
+  long pinches;            /* vertices where two parts of the solid touch
+                              (at a point or along a line), parted
+                              (mesh.c, part_contacts) */
   long sharp_apart;        /* sharp cells meshed by their tetrahedra's
                               crossings instead, where two sharp cells
                               left a crack or a self-intersection between
