@@ -62,10 +62,13 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "edges shorter than 2^-46 of the object's size collapsed, the "
             "certified bound grown by the largest move)\n", r->welded);
   if (r->pinches)
-    fprintf(f, "  pinches: %ld point%s where two parts of the solid touch "
-            "(at a point or along a line) parted, each part's vertex moved "
-            "into it by at most 2^-47 of the object's size (in the certified "
-            "bound)\n", r->pinches, r->pinches == 1 ? "" : "s");
+    fprintf(f, "  pinches: %ld vert%s where two parts of the solid touch "
+            "or all but touch (at a point or along a line) parted, each "
+            "part's vertex moved "
+            "into it by 2^-18 of the object's size (at most a sixteenth of "
+            "the tolerance; in the certified bound), so that the parts stay "
+            "apart in an STL's floats\n", r->pinches,
+            r->pinches == 1 ? "ex" : "ices");
   if (r->sharp_apart && !r->sharp_off)
     fprintf(f, "  sharp cells given up locally: %ld about a crack or a "
             "self-intersection that two sharp cells left between them were "

@@ -865,6 +865,9 @@ typedef struct {
   int *grp;                /* per node: the top of the intersections above
                               it (its group, cell_redundant), or -1 */
   unsigned char *frc;      /* cell_redundant's forced classes */
+  double *pin;             /* part_contacts' parted vertices: each its
+                              place (3) and where widen puts it (3) */
+  size_t npin, cappin;
 } Mesher;
 
 /* Whether halfspace nd's open solid (n . p < d) misses the open box
@@ -3468,11 +3471,56 @@ done:
    points out, less its component along the lines of contact: the parts
    touch no more, the mesh is a manifold, and the move, within the flat
    regions' flatness (2^-44 of the size, mesh_merge_flat), leaves the
-   faces about the point to be merged whole. *moved: the largest move.
-   0 (nothing parted when a line's triangles do not alternate in and
-   out about it), or -1 out of memory. */
+   faces about the point to be merged whole. After the merge, widen
+   moves each such vertex on, the same way, to PINCH_OUT of that size
+   (at most a sixteenth of the tolerance): STL, PLY and 3MF keep floats,
+   whose rounding (2^-24) would put the parts' vertices back together.
+   *moved: the largest move, widened. 0 (nothing parted when a line's
+   triangles do not alternate in and out about it), or -1 out of
+   memory. */
 #define PINCH 0x1p-47
+#define PINCH_OUT 0x1p-18
 #define FACES_MAX 16 /* triangles about a line of contact */
+
+/* The way from P into the part of a fan (its corners cnr[0 .. k-1],
+   each a triangle's corner 3 t + c): towards its far vertices'
+   centroid, or against its normal when that points out, less the
+   components along ln[0 .. nl-1] (orthonormal); unit, in u; *dmin: the
+   nearest far vertex's distance; N, if not NULL: the fan's normal (its
+   triangles' area-weighted). 0, or -1 if there is none. */
+static int fan_dir(const Mesher *m, const double *P, const int *cnr, int k,
+                   const double (*ln)[3], int nl, double u[3], double *dmin,
+                   double *Nout) {
+  double C[3] = {0, 0, 0}, N[3] = {0, 0, 0};
+  *dmin = INFINITY;
+  for (int j = 0; j < k; j++) {
+    size_t t = (size_t)cnr[j] / 3, c = (size_t)cnr[j] % 3;
+    const double *a = m->v + 3 * (size_t)m->t[3 * t + (c + 1) % 3],
+                 *b = m->v + 3 * (size_t)m->t[3 * t + (c + 2) % 3];
+    double x[3], w[3], y[3];
+    for (int i = 0; i < 3; i++) {
+      x[i] = a[i] - P[i];
+      w[i] = b[i] - P[i];
+      C[i] += a[i];
+    }
+    vec3_cross(x, w, y);
+    for (int i = 0; i < 3; i++) N[i] += y[i];
+    *dmin = fmin(*dmin, sqrt(vec3_dot(x, x)));
+  }
+  if (Nout) memcpy(Nout, N, sizeof N);
+  if (k < 1) return -1;
+  for (int i = 0; i < 3; i++) u[i] = C[i] / k - P[i];
+  if (!(vec3_dot(u, N) < 0))
+    for (int i = 0; i < 3; i++) u[i] = -N[i];
+  for (int l = 0; l < nl; l++) {
+    double p = vec3_dot(u, ln[l]);
+    for (int i = 0; i < 3; i++) u[i] -= p * ln[l][i];
+  }
+  double l = sqrt(vec3_dot(u, u));
+  if (!(l > 0) || !(*dmin > 0)) return -1;
+  for (int i = 0; i < 3; i++) u[i] /= l;
+  return 0;
+}
 
 static int corner_find(int *p, int x) {
   while (p[x] != x) x = p[x] = p[p[x]];
@@ -3485,11 +3533,12 @@ static int part_contacts(Mesher *m, double *moved) {
   if (!nv || !nt) return 0;
   int rc = -1;
   int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *wt = NULL, *up = NULL,
-      *root = NULL, *re = NULL;
+      *root = NULL, *re = NULL, *fc = NULL;
   unsigned char *wc = NULL, *line = NULL;
   double *np = NULL; /* each fan's place: x, y, z, the vertex it goes to */
-  size_t nnew = 0, capnew = 0, nadd = 0;
+  size_t nnew = 0, capnew = 0, nadd = 0, capfc = 0;
   long pinches = m->rep->pinches;
+  size_t npin = m->npin;
   int applied = 0;
   if (!cnt) return -1;
   for (size_t i = 0; i < nc; i++) cnt[m->t[i] + 1]++;
@@ -3621,40 +3670,31 @@ static int part_contacts(Mesher *m, double *moved) {
       int j = lo;
       while (j < q0 && root[j] != root[q0]) j++;
       if (j < q0) continue; /* a fan already placed */
-      double C[3] = {0, 0, 0}, N[3] = {0, 0, 0}, dmin = INFINITY;
       int k = 0;
       for (int q = q0; q < hi; q++) {
         if (root[q] != root[q0]) continue;
-        const double *a = m->v + 3 * (size_t)NXT(q), *b = m->v + 3 * (size_t)PRV(q);
-        double u[3], w[3], x[3];
-        for (int i = 0; i < 3; i++) {
-          u[i] = a[i] - P[i];
-          w[i] = b[i] - P[i];
-          C[i] += a[i];
-        }
-        vec3_cross(u, w, x);
-        for (int i = 0; i < 3; i++) N[i] += x[i];
-        dmin = fmin(dmin, sqrt(vec3_dot(u, u)));
-        k++;
+        if (grow((void **)&fc, &capfc, (size_t)k + 1, sizeof *fc) < 0) goto done;
+        fc[k++] = 3 * wt[q] + wc[q];
       }
-      double u[3];
-      for (int i = 0; i < 3; i++) u[i] = C[i] / k - P[i];
-      if (!(vec3_dot(u, N) < 0))
-        for (int i = 0; i < 3; i++) u[i] = -N[i];
-      for (int l = 0; l < nl; l++) {
-        double p = vec3_dot(u, ln[l]);
-        for (int i = 0; i < 3; i++) u[i] -= p * ln[l][i];
-      }
-      double l = sqrt(vec3_dot(u, u)), d = fmin(PINCH * big, 1e-3 * dmin);
-      if (!(l > 0) || !(d > 0)) goto flat;
-      if (grow((void **)&np, &capnew, 4 * (nnew + 1), sizeof *np) < 0) goto done;
+      double u[3], dmin;
+      if (fan_dir(m, P, fc, k, (const double (*)[3])ln, nl, u, &dmin, NULL) < 0)
+        goto flat;
+      double d = fmin(PINCH * big, 1e-3 * dmin),
+             d2 = fmax(d, fmin(PINCH_OUT * big, fmin(m->tol / 16, 1e-3 * dmin)));
+      if (!(d > 0)) goto flat;
+      if (grow((void **)&np, &capnew, 4 * (nnew + 1), sizeof *np) < 0 ||
+          grow((void **)&m->pin, &m->cappin, 6 * (m->npin + 1), sizeof *m->pin) < 0)
+        goto done;
       if (!re) { /* each corner's new vertex, -1 if none: set at the end, so
                     that the fans still to place see the triangles as made */
         if (!(re = malloc(nc * sizeof *re))) goto done;
         for (size_t i = 0; i < nc; i++) re[i] = -1;
       }
-      double *to = np + 4 * nnew++;
-      for (int i = 0; i < 3; i++) to[i] = P[i] + d * u[i] / l;
+      double *to = np + 4 * nnew++, *pn = m->pin + 6 * m->npin++;
+      for (int i = 0; i < 3; i++) {
+        to[i] = pn[i] = P[i] + d * u[i];
+        pn[3 + i] = P[i] + d2 * u[i];
+      }
       /* the fan's vertex: v itself, or the next new one */
       to[3] = first ? (double)v : (double)(nv + nadd);
       if (!first) {
@@ -3662,7 +3702,7 @@ static int part_contacts(Mesher *m, double *moved) {
           if (root[q] == root[q0]) re[3 * (size_t)wt[q] + wc[q]] = (int)(nv + nadd);
         nadd++;
       }
-      *moved = fmax(*moved, d);
+      *moved = fmax(*moved, d2);
       first = 0;
     }
     m->rep->pinches++;
@@ -3685,6 +3725,7 @@ done:
   if (!applied) {
     *moved = 0;
     m->rep->pinches = pinches;
+    m->npin = npin;
   }
 #undef NXT
 #undef PRV
@@ -3697,17 +3738,149 @@ done:
   free(line);
   free(np);
   free(re);
+  free(fc);
   return rc;
+}
+
+/* Vertices of different sheets nearer than floats resolve: where two
+   parts touch at a point the perturbation can also leave them apart,
+   their tips two vertices 1e-16 apart, which an STL's floats would make
+   one. Every two vertices within 2^-21 of the size (the octree's side or
+   the largest coordinate) not joined by an edge, of two parts of the
+   mesh or whose fans face each other (their normals more than 90
+   degrees apart), are each moved into
+   its part (fan_dir over all its corners) by widen, after the flat
+   merge, by PINCH_OUT of that size (at most a sixteenth of the
+   tolerance and a thousandth of its nearest neighbour); *moved: the
+   largest move. 0, or -1 out of memory. */
+typedef struct { double x; int i; } XKey;
+
+static int xkey_cmp(const void *a, const void *b) {
+  double x = ((const XKey *)a)->x, y = ((const XKey *)b)->x;
+  return (x > y) - (x < y);
+}
+
+static int near_vertices(Mesher *m, double *moved) {
+  size_t nv = m->nv, nt = m->nt;
+  if (nv < 2 || !nt) return 0;
+  double big = ldexp(m->h, MAX_DEPTH);
+  for (size_t i = 0; i < 3 * nv; i++) big = fmax(big, fabs(m->v[i]));
+  double thr = 0x1p-21 * big;
+  int rc = -1;
+  XKey *xs = malloc(nv * sizeof *xs);
+  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *cn = NULL,
+      *comp = malloc(nv * sizeof *comp);
+  unsigned char *near = calloc(nv, 1);
+  if (!xs || !cnt || !near || !comp) goto done;
+  for (size_t i = 0; i < nv; i++) comp[i] = (int)i;
+  for (size_t t = 0; t < nt; t++)
+    for (int k = 1; k < 3; k++) {
+      int a = corner_find(comp, m->t[3 * t]), b = corner_find(comp, m->t[3 * t + (size_t)k]);
+      if (a != b) comp[a] = b;
+    }
+  for (size_t i = 0; i < nv; i++) xs[i] = (XKey){m->v[3 * i], (int)i};
+  qsort(xs, nv, sizeof *xs, xkey_cmp);
+  for (size_t i = 0; i < 3 * nt; i++) cnt[m->t[i] + 1]++;
+  for (size_t i = 0; i < nv; i++) cnt[i + 1] += cnt[i];
+  at = malloc(nv * sizeof *at);
+  cn = malloc(3 * nt * sizeof *cn);
+  if (!at || !cn) goto done;
+  for (size_t i = 0; i < nv; i++) at[i] = cnt[i];
+  for (size_t i = 0; i < 3 * nt; i++) cn[at[m->t[i]]++] = (int)i;
+  size_t found = 0;
+  for (size_t a = 0; a < nv; a++)
+    for (size_t b = a + 1; b < nv && xs[b].x - xs[a].x <= thr; b++) {
+      int i = xs[a].i, j = xs[b].i;
+      const double *p = m->v + 3 * (size_t)i, *q = m->v + 3 * (size_t)j;
+      if (!(fabs(p[1] - q[1]) <= thr && fabs(p[2] - q[2]) <= thr)) continue;
+      int joined = 0;
+      for (int c = cnt[i]; c < cnt[i + 1] && !joined; c++) {
+        size_t t = (size_t)cn[c] / 3, k = (size_t)cn[c] % 3;
+        joined = m->t[3 * t + (k + 1) % 3] == j || m->t[3 * t + (k + 2) % 3] == j;
+      }
+      if (joined) continue;
+      /* of two parts, or facing: two sheets of one (a vertex of one sheet
+         near another of the same, a sliver's corners, has its normal
+         alike) */
+      if (corner_find(comp, i) == corner_find(comp, j)) {
+        double u[3], dm, Ni[3], Nj[3];
+        fan_dir(m, p, cn + cnt[i], cnt[i + 1] - cnt[i], NULL, 0, u, &dm, Ni);
+        fan_dir(m, q, cn + cnt[j], cnt[j + 1] - cnt[j], NULL, 0, u, &dm, Nj);
+        if (!(vec3_dot(Ni, Nj) < 0)) continue;
+      }
+      near[i] = near[j] = 1;
+      found++;
+    }
+  for (size_t v = 0; found && v < nv; v++) {
+    if (!near[v]) continue;
+    const double *P = m->v + 3 * v;
+    double u[3], dmin;
+    if (fan_dir(m, P, cn + cnt[v], cnt[v + 1] - cnt[v], NULL, 0, u, &dmin, NULL) < 0)
+      continue;
+    double bv = fmax(ldexp(m->h, MAX_DEPTH), fmax(fabs(P[0]), fmax(fabs(P[1]), fabs(P[2]))));
+    double d2 = fmin(PINCH_OUT * bv, fmin(m->tol / 16, 1e-3 * dmin));
+    if (grow((void **)&m->pin, &m->cappin, 6 * (m->npin + 1), sizeof *m->pin) < 0)
+      goto done;
+    double *pn = m->pin + 6 * m->npin++;
+    for (int i = 0; i < 3; i++) {
+      pn[i] = P[i];
+      pn[3 + i] = P[i] + d2 * u[i];
+    }
+    *moved = fmax(*moved, d2);
+    m->rep->pinches++;
+  }
+  rc = 0;
+done:
+  free(xs);
+  free(cnt);
+  free(at);
+  free(cn);
+  free(near);
+  free(comp);
+  return rc;
+}
+
+/* The parted vertices of me (found by their places, to the bit) moved
+   on to where part_contacts put them for the writing (PINCH_OUT). */
+static int widen(const Mesher *m, Mesh *me) {
+  if (!m->npin || !me) return 0;
+  hmap at = {0};
+  for (size_t i = 0; i < m->npin; i++) {
+    uint64_t k = 1469598103934665603ull;
+    for (int a = 0; a < 3; a++) {
+      uint64_t b;
+      memcpy(&b, m->pin + 6 * i + a, sizeof b);
+      k = (k ^ b) * 1099511628211ull;
+    }
+    if (hput(&at, k >> 1, (int)i) < 0) {
+      hfree(&at);
+      return -1;
+    }
+  }
+  for (size_t v = 0; v < me->nv; v++) {
+    double *p = me->v + 3 * v;
+    uint64_t k = 1469598103934665603ull;
+    for (int a = 0; a < 3; a++) {
+      uint64_t b;
+      memcpy(&b, p + a, sizeof b);
+      k = (k ^ b) * 1099511628211ull;
+    }
+    int i = hget(&at, k >> 1);
+    if (i >= 0 && !memcmp(p, m->pin + 6 * (size_t)i, 3 * sizeof *p))
+      memcpy(p, m->pin + 6 * (size_t)i + 3, 3 * sizeof *p);
+  }
+  hfree(&at);
+  return 0;
 }
 
 /* part_contacts where the sharp cells met (elsewhere nothing touches:
    each marching triangle lies in its own tetrahedron), its moves in the
    certified bound. 0, or -1 out of memory. */
 static int contacts(Mesher *m) {
-  double mv = 0;
+  double mv = 0, mv2 = 0;
   if (!m->rep->sharp) return 0;
-  if (part_contacts(m, &mv) < 0) return -1;
-  m->rep->certified += mv;
+  if (near_vertices(m, &mv2) < 0 || part_contacts(m, &mv) < 0) return -1;
+  m->rep->certified += fmax(mv, mv2);
   return 0;
 }
 
@@ -4832,6 +5005,12 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
       made = NULL;
     }
   }
+  if (widen(&m, me) < 0 || widen(&m, made) < 0) {
+    mesh_free(me);
+    mesh_free(made);
+    rc = MESH_ENOMEM;
+    goto done;
+  }
   MeshCheck ck;
   int cr = mesh_check(me, &ck);
   if (cr == -1 && made) {
@@ -4944,6 +5123,7 @@ done:
   free(m.one2);
   free(m.ex);
   free(m.memo);
+  free(m.pin);
   prune_levels_free(&m);
   free(m.par);
   free(m.grp);

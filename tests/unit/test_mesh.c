@@ -2654,13 +2654,15 @@ static void corners_only(void) {
    bore's axis plane; boxes corner to corner, rotated or not) or along
    lines (boxes edge to edge) meshes as its parts apart: the components and Euler characteristic of that
    many spheres, the report's pinches, the closest vertices of two
-   components (long double, brute force) apart but within 2^-44 of the
-   object's size, and every sharp cell kept. */
+   components (long double, brute force) apart by more than floats
+   resolve (2^-22 of the object's size) and less than 2^-15, the mesh
+   rounded to floats (an STL) still closed and oriented with every edge
+   once each way, and every sharp cell kept. */
 static void pinches(void) {
   static const struct { const char *name, *src; long parts, pinched; } objs[] = {
     {"an 8-sided prism bored through by a 6-sided one of its radius",
      "SetDifference (Shift (0,-1,0) (CylinderWith [Sides 8] 0.3 2)) (Shift "
-     "(0,0,-1) (Rotate \"x\" 90 (CylinderWith [Sides 6] 0.3 2)))", 2, 1},
+     "(0,0,-1) (Rotate \"x\" 90 (CylinderWith [Sides 6] 0.3 2)))", 2, 3},
     {"a 16-sided prism bored through by an 8-sided one of its radius",
      "SetDifference (Shift (0,-1,0) (CylinderWith [Sides 16] 0.3 2)) (Shift "
      "(0,0,-1) (Rotate \"x\" 90 (CylinderWith [Sides 8] 0.3 2)))", 2, 2},
@@ -2731,10 +2733,41 @@ static void pinches(void) {
         gap = fminl(gap, sqrtl(d));
       }
     snprintf(buf, sizeof buf, "pinches: %s: the parts' closest vertices %.3Lg "
-             "apart (more than 0, less than 2^-44 of the size %.3Lg); the "
+             "apart (more than 2^-22, less than 2^-15 of the size %.3Lg); the "
              "certified bound %.3g within the tolerance", objs[k].name, gap,
              size, rep.certified);
-    CHECK(buf, gap > 0 && gap < ldexpl(size, -44) && rep.certified <= ms.tol);
+    CHECK(buf, gap > ldexpl(size, -22) && gap < ldexpl(size, -15) &&
+                   rep.certified <= ms.tol);
+    /* as an STL keeps it: the vertices rounded to floats and joined where
+       they are equal, every directed edge once and its reverse once */
+    int *same = malloc(m->nv * sizeof *same);
+    for (size_t i = 0; i < m->nv; i++) {
+      same[i] = (int)i;
+      for (size_t j = 0; j < i; j++)
+        if ((float)m->v[3 * i] == (float)m->v[3 * j] &&
+            (float)m->v[3 * i + 1] == (float)m->v[3 * j + 1] &&
+            (float)m->v[3 * i + 2] == (float)m->v[3 * j + 2]) {
+          same[i] = same[j];
+          break;
+        }
+    }
+    long badedge = 0;
+    for (size_t t = 0; t < m->nt; t++)
+      for (int e = 0; e < 3; e++) {
+        int a = same[m->t[3 * t + (size_t)e]], b = same[m->t[3 * t + (size_t)(e + 1) % 3]];
+        long fw = 0, bw = 0;
+        for (size_t u = 0; u < m->nt; u++)
+          for (int f = 0; f < 3; f++) {
+            int c = same[m->t[3 * u + (size_t)f]], d = same[m->t[3 * u + (size_t)(f + 1) % 3]];
+            fw += c == a && d == b;
+            bw += c == b && d == a;
+          }
+        badedge += a == b || fw != 1 || bw != 1;
+      }
+    snprintf(buf, sizeof buf, "pinches: %s: rounded to floats (as an STL keeps "
+             "it), every edge once each way (%ld not)", objs[k].name, badedge);
+    CHECK(buf, badedge == 0);
+    free(same);
     free(par);
     mesh_free(m);
     scene_free(s);
