@@ -282,7 +282,25 @@ else
   echo "skip mesh: openscad or xvfb-run is not installed (apt-get install openscad xvfb)"
 fi
 
+# parts touching along an edge, parted so that the STL's floats keep
+# them apart: admesh reads two parts of volume 2, every facet oriented;
+# boxes overlapping by a sliver of 1e-9 (below the floats) warn that the
+# STL is not the mesh that was checked, and the parted pair does not
+printf 'scene = Union UnitCube (Shift (1, 1, 0) UnitCube)\n' > "$tmp/edge.qcs"
+printf 'scene = Union UnitCube (Shift (0.999999999, 1, 0) UnitCube)\n' > "$tmp/sliver.qcs"
+"$top/$QCS" -o "$tmp/edge.stl" "$tmp/edge.qcs" > "$tmp/out" 2> "$tmp/err.edge"
+"$top/$QCS" -o "$tmp/sliver.stl" "$tmp/sliver.qcs" > "$tmp/out" 2> "$tmp/err.sliver"
+if grep -q "^  pinches: 4 vertices" "$tmp/err.edge" && ! grep -q "warning" "$tmp/err.edge" &&
+   grep -q "keeps floats, and 1 of the mesh's vertices falls" "$tmp/err.sliver"; then
+  echo "ok mesh: two cubes edge to edge parted (4 vertices), no float warning; a 1e-9 sliver warns"
+else echo "FAIL mesh: parting and the float warning: $(cat "$tmp/err.edge" "$tmp/err.sliver" | grep -E 'pinches|warning' | tr '\n' ' ')"; fi
+
 if command -v admesh > /dev/null 2>&1; then
+  admesh "$tmp/edge.stl" > "$tmp/adm" 2>&1
+  if grep -q "Number of parts *: *2" "$tmp/adm" && grep -q "Facets reversed *: *0" "$tmp/adm" &&
+     grep -q "Volume *: *1.99999" "$tmp/adm"; then
+    echo "ok mesh: admesh reads the parted edge-to-edge cubes: 2 parts, volume 2, none reversed"
+  else echo "FAIL mesh: admesh on the parted cubes: $(grep -iE 'parts|volume|reversed' "$tmp/adm" | tr '\n' ' ')"; fi
   for f in cli.stl soft.stl slab.stl plate.stl; do
     admesh "$tmp/$f" > "$tmp/adm" 2>&1
     if grep -q "No holes need to be filled" "$tmp/adm" &&

@@ -205,8 +205,16 @@ static int do_mesh(const struct Scene *s0, const MeshSettings *ms,
     }
   }
   rc = mesh_write(m, path, err, errlen) ? -1 : 0;
+  long joined = pl > 4 && strcmp(path + pl - 4, ".obj") ? mesh_float_joined(m) : 0;
   mesh_free(m);
   if (!rc && !quiet) report(stderr, &rep, path, m2.tol);
+  if (!rc && joined > 0)
+    fprintf(stderr, "qcs: warning: %s keeps floats, and %ld of the mesh's "
+            "vertices fall%s on another's place in them (a feature below "
+            "2^-24 of its coordinates, a sliver or gap about 1e-7 of them "
+            "wide): the file is not the closed mesh that was checked; a .obj "
+            "keeps the checked one to the bit\n", path, joined,
+            joined == 1 ? "s" : "");
 out:
   if (s == &boxed) free(boxed.nodes);
   return rc;

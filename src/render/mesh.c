@@ -5593,6 +5593,32 @@ out:
   return rc;
 }
 
+long mesh_float_joined(const Mesh *m) {
+  hmap at = {0};
+  long joined = 0;
+  for (size_t v = 0; v < m->nv; v++) {
+    float f[3];
+    for (int a = 0; a < 3; a++) f[a] = (float)m->v[3 * v + (size_t)a];
+    uint64_t k = 1469598103934665603ull;
+    unsigned char b[sizeof f];
+    memcpy(b, f, sizeof f);
+    for (size_t i = 0; i < sizeof b; i++) k = (k ^ b[i]) * 1099511628211ull;
+    int w = hget(&at, k >> 1);
+    if (w >= 0) {
+      int same = 1;
+      for (int a = 0; a < 3; a++) same &= (float)m->v[3 * (size_t)w + (size_t)a] == f[a];
+      joined += same;
+      continue;
+    }
+    if (hput(&at, k >> 1, (int)v) < 0) {
+      hfree(&at);
+      return -1;
+    }
+  }
+  hfree(&at);
+  return joined;
+}
+
 int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen) {
   buf b = {0};
   if (!strcmp(ext_of(path), "stl")) {

@@ -260,4 +260,8 @@ int mesh_is_mesh_path(const char *path);
    libzip, one base material per colour); whole or not at all (a
    temporary file renamed into place). */
 int mesh_write(const Mesh *m, const char *path, char *err, size_t errlen);
+/* How many of m's vertices fall on another's place when rounded to
+   floats, as STL, PLY and 3MF keep them (features below 2^-24 of the
+   coordinates: a sliver 1e-9 wide); -1 out of memory. */
+long mesh_float_joined(const Mesh *m);
 #endif
