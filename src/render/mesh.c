@@ -3484,14 +3484,14 @@ done:
 
 /* The way from P into the part of a fan (its corners cnr[0 .. k-1],
    each a triangle's corner 3 t + c): towards its far vertices'
-   centroid, or against its normal when that points out, less the
+   centroid, or against its normal when the fan is flat, less the
    components along ln[0 .. nl-1] (orthonormal); unit, in u; *dmin: the
    nearest far vertex's distance; N, if not NULL: the fan's normal (its
    triangles' area-weighted). 0, or -1 if there is none. */
 static int fan_dir(const Mesher *m, const double *P, const int *cnr, int k,
                    const double (*ln)[3], int nl, double u[3], double *dmin,
                    double *Nout) {
-  double C[3] = {0, 0, 0}, N[3] = {0, 0, 0};
+  double C[3] = {0, 0, 0}, N[3] = {0, 0, 0}, area = 0;
   *dmin = INFINITY;
   for (int j = 0; j < k; j++) {
     size_t t = (size_t)cnr[j] / 3, c = (size_t)cnr[j] % 3;
@@ -3505,12 +3505,16 @@ static int fan_dir(const Mesher *m, const double *P, const int *cnr, int k,
     }
     vec3_cross(x, w, y);
     for (int i = 0; i < 3; i++) N[i] += y[i];
+    area += sqrt(vec3_dot(y, y));
     *dmin = fmin(*dmin, sqrt(vec3_dot(x, x)));
   }
   if (Nout) memcpy(Nout, N, sizeof N);
   if (k < 1) return -1;
+  /* into the fan's own cone, the solid's (a tip) or the space's (a
+     cavity's corner): parts that touch have cones that meet only at P;
+     a flat fan (its triangles' normals alike) has none: into the solid */
   for (int i = 0; i < 3; i++) u[i] = C[i] / k - P[i];
-  if (!(vec3_dot(u, N) < 0))
+  if (sqrt(vec3_dot(N, N)) >= (1 - 1e-9) * area)
     for (int i = 0; i < 3; i++) u[i] = -N[i];
   for (int l = 0; l < nl; l++) {
     double p = vec3_dot(u, ln[l]);
@@ -3646,24 +3650,6 @@ static int part_contacts(Mesher *m, double *moved) {
     }
     if (nf < 2) continue;
     const double *P = m->v + 3 * v;
-    /* the lines of contact through v, made orthonormal */
-    double ln[2][3];
-    int nl = 0;
-    for (int q = lo; q < hi && line[v] && nl < 2; q++) {
-      int x = NXT(q), out = 0, in = 0;
-      for (int r = lo; r < hi; r++) out += NXT(r) == x, in += PRV(r) == x;
-      if (out + in <= 2) continue;
-      double d[3];
-      for (int i = 0; i < 3; i++) d[i] = m->v[3 * (size_t)x + (size_t)i] - P[i];
-      for (int k = 0; k < nl; k++) {
-        double p = vec3_dot(d, ln[k]);
-        for (int i = 0; i < 3; i++) d[i] -= p * ln[k][i];
-      }
-      double l = sqrt(vec3_dot(d, d));
-      if (!(l > 1e-6 * dist3(m->v + 3 * (size_t)x, P))) continue;
-      for (int i = 0; i < 3; i++) ln[nl][i] = d[i] / l;
-      nl++;
-    }
     double big = fmax(size, fmax(fabs(P[0]), fmax(fabs(P[1]), fabs(P[2]))));
     int first = 1;
     for (int q0 = lo; q0 < hi; q0++) {
@@ -3671,10 +3657,36 @@ static int part_contacts(Mesher *m, double *moved) {
       while (j < q0 && root[j] != root[q0]) j++;
       if (j < q0) continue; /* a fan already placed */
       int k = 0;
+      /* the lines of contact this fan borders at v, made orthonormal
+         (three parts meeting at a corner: each part's vertex moves
+         along the third axis, away from both lines it touches) */
+      double ln[2][3];
+      int nl = 0, many = 0;
       for (int q = q0; q < hi; q++) {
         if (root[q] != root[q0]) continue;
         if (grow((void **)&fc, &capfc, (size_t)k + 1, sizeof *fc) < 0) goto done;
         fc[k++] = 3 * wt[q] + wc[q];
+        for (int e = 0; e < 2 && line[v] && !many; e++) {
+          int x = e ? PRV(q) : NXT(q), out = 0, in = 0;
+          for (int r = lo; r < hi; r++) out += NXT(r) == x, in += PRV(r) == x;
+          if (out + in <= 2) continue;
+          double d[3];
+          for (int i = 0; i < 3; i++) d[i] = m->v[3 * (size_t)x + (size_t)i] - P[i];
+          for (int c = 0; c < nl; c++) {
+            double p = vec3_dot(d, ln[c]);
+            for (int i = 0; i < 3; i++) d[i] -= p * ln[c][i];
+          }
+          double l = sqrt(vec3_dot(d, d));
+          if (!(l > 1e-6 * dist3(m->v + 3 * (size_t)x, P))) continue;
+          if (nl == 2) { /* three lines (a corner of a checkerboard's
+                            cube): along none, into the fan's cone */
+            many = 1;
+            nl = 0;
+            break;
+          }
+          for (int i = 0; i < 3; i++) ln[nl][i] = d[i] / l;
+          nl++;
+        }
       }
       double u[3], dmin;
       if (fan_dir(m, P, fc, k, (const double (*)[3])ln, nl, u, &dmin, NULL) < 0)

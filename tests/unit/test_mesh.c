@@ -2680,6 +2680,18 @@ static void pinches(void) {
     {"four cubes in a ring, each edge to edge with the next", "Union (Union "
      "UnitCube (Shift (1,1,0) UnitCube)) (Union (Shift (2,0,0) UnitCube) "
      "(Shift (1,-1,0) UnitCube))", 4, 12},
+    /* three and four parts at a corner, each part's vertex moved away
+       from the lines it touches (5,122 and 5,304 triangles before) */
+    {"three cubes at a corner, two lines of contact each",
+     "Union (Union UnitCube (Shift (1,1,0) UnitCube)) (Shift (1,0,1) UnitCube)",
+     3, -1},
+    {"a 2 x 2 x 2 checkerboard of four cubes", "Union (Union UnitCube (Shift "
+     "(1,1,0) UnitCube)) (Union (Shift (1,0,1) UnitCube) (Shift (0,1,1) "
+     "UnitCube))", 4, -1},
+    /* the space's parts touching: two notches of a box meeting at its
+       centre (22,982 before): one part, its notches' corners apart */
+    {"a box with two notches whose corners touch", "SetDifference (Box "
+     "(0,0,0) (2,2,2)) (Union UnitCube (Shift (1,1,1) UnitCube))", 1, 1},
   };
   for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
     Scene *s = compile(objs[k].src);
@@ -2736,7 +2748,8 @@ static void pinches(void) {
              "apart (more than 2^-22, less than 2^-15 of the size %.3Lg); the "
              "certified bound %.3g within the tolerance", objs[k].name, gap,
              size, rep.certified);
-    CHECK(buf, gap > ldexpl(size, -22) && gap < ldexpl(size, -15) &&
+    CHECK(buf, (objs[k].parts == 1 ||
+                (gap > ldexpl(size, -22) && gap < ldexpl(size, -15))) &&
                    rep.certified <= ms.tol);
     /* as an STL keeps it: the vertices rounded to floats and joined where
        they are equal, every directed edge once and its reverse once */
