@@ -235,6 +235,18 @@ static int set_node(Compile *C, ScKind kind, Pos pos, int a, int b) {
   return add(C, &n, pos);
 }
 
+/* A set operation of x and y, each compiled by f: y first, then x, in
+   every build. (Written as set_node's two arguments, the order was C's
+   to choose: gcc compiled y first and clang x, so the nodes' numbers,
+   which the meshes' exact sides take as the planes' ranks, differed
+   between builds, and so did meshes where parts touch.) */
+static int set_of(Compile *C, ScKind kind, Pos pos, Value *x, Value *y,
+                  int (*f)(Compile *, Value *)) {
+  int b = f(C, y);
+  int a = f(C, x);
+  return set_node(C, kind, pos, a, b);
+}
+
 /* A density tree with no radius: the sharp polyhedron it describes. */
 static int compile_sharp(Compile *C, Value *v) {
   Node N = node_of(C, v);
@@ -243,14 +255,11 @@ static int compile_sharp(Compile *C, Value *v) {
   Value **a = N.a;
   switch (k) {
   case K_SUM: case K_DUNION: case K_UNION:
-    return set_node(C, SC_UNION, pos, compile_sharp(C, a[0]),
-                    compile_sharp(C, a[1]));
+    return set_of(C, SC_UNION, pos, a[0], a[1], compile_sharp);
   case K_PRODUCT: case K_INTER:
-    return set_node(C, SC_INTER, pos, compile_sharp(C, a[0]),
-                    compile_sharp(C, a[1]));
+    return set_of(C, SC_INTER, pos, a[0], a[1], compile_sharp);
   case K_DIFFERENCE: case K_SETDIFF:
-    return set_node(C, SC_DIFF, pos, compile_sharp(C, a[0]),
-                    compile_sharp(C, a[1]));
+    return set_of(C, SC_DIFF, pos, a[0], a[1], compile_sharp);
   case K_DHALFSPACE: case K_HALFSPACE: case K_RHALFSPACE: {
     double n[3], d;
     get_plane(C, a[k == K_RHALFSPACE ? 1 : 0], pos, n, &d);
@@ -519,11 +528,11 @@ static int compile_obj(Compile *C, Value *v) {
   Value **a = N.a;
   switch (k) {
   case K_UNION:
-    return set_node(C, SC_UNION, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
+    return set_of(C, SC_UNION, pos, a[0], a[1], compile_obj);
   case K_INTER:
-    return set_node(C, SC_INTER, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
+    return set_of(C, SC_INTER, pos, a[0], a[1], compile_obj);
   case K_SETDIFF:
-    return set_node(C, SC_DIFF, pos, compile_obj(C, a[0]), compile_obj(C, a[1]));
+    return set_of(C, SC_DIFF, pos, a[0], a[1], compile_obj);
   case K_HALFSPACE:
     return compile_sharp(C, N.v);
   case K_ROUNDED:

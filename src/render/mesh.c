@@ -3754,13 +3754,23 @@ done:
   return rc;
 }
 
+/* A place's bits hashed (widen, near_vertices: a parted vertex is found
+   by its place). */
+static uint64_t place_key(const double *p) {
+  uint64_t k = 1469598103934665603ull;
+  for (int a = 0; a < 3; a++) {
+    uint64_t b;
+    memcpy(&b, p + a, sizeof b);
+    k = (k ^ b) * 1099511628211ull;
+  }
+  return k >> 1;
+}
+
 /* Vertices of different sheets nearer than floats resolve: where two
    parts touch at a point the perturbation can also leave them apart,
    their tips two vertices 1e-16 apart, which an STL's floats would make
-   one. Every two vertices within 2^-21 of the size (the octree's side or
-   the largest coordinate) not joined by an edge, of two parts of the
-   mesh or whose fans face each other (their normals more than 90
-   degrees apart), are each moved into
+   one. Every two vertices of two parts of the mesh within 2^-22 of the
+   size (the octree's side or the largest coordinate) are each moved into
    its part (fan_dir over all its corners) by widen, after the flat
    merge, by PINCH_OUT of that size (at most a sixteenth of the
    tolerance and a thousandth of its nearest neighbour); *moved: the
@@ -3777,12 +3787,13 @@ static int near_vertices(Mesher *m, double *moved) {
   if (nv < 2 || !nt) return 0;
   double big = ldexp(m->h, MAX_DEPTH);
   for (size_t i = 0; i < 3 * nv; i++) big = fmax(big, fabs(m->v[i]));
-  double thr = 0x1p-21 * big;
+  double thr = 0x1p-22 * big;
   int rc = -1;
   XKey *xs = malloc(nv * sizeof *xs);
   int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *cn = NULL,
       *comp = malloc(nv * sizeof *comp);
   unsigned char *near = calloc(nv, 1);
+  hmap pinned = {0};
   if (!xs || !cnt || !near || !comp) goto done;
   for (size_t i = 0; i < nv; i++) comp[i] = (int)i;
   for (size_t t = 0; t < nt; t++)
@@ -3811,21 +3822,21 @@ static int near_vertices(Mesher *m, double *moved) {
         joined = m->t[3 * t + (k + 1) % 3] == j || m->t[3 * t + (k + 2) % 3] == j;
       }
       if (joined) continue;
-      /* of two parts, or facing: two sheets of one (a vertex of one sheet
-         near another of the same, a sliver's corners, has its normal
-         alike) */
-      if (corner_find(comp, i) == corner_find(comp, j)) {
-        double u[3], dm, Ni[3], Nj[3];
-        fan_dir(m, p, cn + cnt[i], cnt[i + 1] - cnt[i], NULL, 0, u, &dm, Ni);
-        fan_dir(m, q, cn + cnt[j], cnt[j + 1] - cnt[j], NULL, 0, u, &dm, Nj);
-        if (!(vec3_dot(Ni, Nj) < 0)) continue;
-      }
+      /* of two parts (one part's vertices this near are a sharp edge's
+         chamfer in a mixed cell, figure12's obj2, or a sliver's corners,
+         and stay) */
+      if (corner_find(comp, i) == corner_find(comp, j)) continue;
       near[i] = near[j] = 1;
       found++;
     }
+  /* those part_contacts moved already stay its */
+  for (size_t i = 0; found && i < m->npin; i++)
+    if (hput(&pinned, place_key(m->pin + 6 * i), (int)i) < 0) goto done;
   for (size_t v = 0; found && v < nv; v++) {
     if (!near[v]) continue;
     const double *P = m->v + 3 * v;
+    int pi = hget(&pinned, place_key(P));
+    if (pi >= 0 && !memcmp(P, m->pin + 6 * (size_t)pi, 3 * sizeof *P)) continue;
     double u[3], dmin;
     if (fan_dir(m, P, cn + cnt[v], cnt[v + 1] - cnt[v], NULL, 0, u, &dmin, NULL) < 0)
       continue;
@@ -3849,6 +3860,7 @@ done:
   free(cn);
   free(near);
   free(comp);
+  hfree(&pinned);
   return rc;
 }
 
@@ -3857,27 +3869,14 @@ done:
 static int widen(const Mesher *m, Mesh *me) {
   if (!m->npin || !me) return 0;
   hmap at = {0};
-  for (size_t i = 0; i < m->npin; i++) {
-    uint64_t k = 1469598103934665603ull;
-    for (int a = 0; a < 3; a++) {
-      uint64_t b;
-      memcpy(&b, m->pin + 6 * i + a, sizeof b);
-      k = (k ^ b) * 1099511628211ull;
-    }
-    if (hput(&at, k >> 1, (int)i) < 0) {
+  for (size_t i = 0; i < m->npin; i++)
+    if (hput(&at, place_key(m->pin + 6 * i), (int)i) < 0) {
       hfree(&at);
       return -1;
     }
-  }
   for (size_t v = 0; v < me->nv; v++) {
     double *p = me->v + 3 * v;
-    uint64_t k = 1469598103934665603ull;
-    for (int a = 0; a < 3; a++) {
-      uint64_t b;
-      memcpy(&b, p + a, sizeof b);
-      k = (k ^ b) * 1099511628211ull;
-    }
-    int i = hget(&at, k >> 1);
+    int i = hget(&at, place_key(p));
     if (i >= 0 && !memcmp(p, m->pin + 6 * (size_t)i, 3 * sizeof *p))
       memcpy(p, m->pin + 6 * (size_t)i + 3, 3 * sizeof *p);
   }
@@ -3891,7 +3890,7 @@ static int widen(const Mesher *m, Mesh *me) {
 static int contacts(Mesher *m) {
   double mv = 0, mv2 = 0;
   if (!m->rep->sharp) return 0;
-  if (near_vertices(m, &mv2) < 0 || part_contacts(m, &mv) < 0) return -1;
+  if (part_contacts(m, &mv) < 0 || near_vertices(m, &mv2) < 0) return -1;
   m->rep->certified += fmax(mv, mv2);
   return 0;
 }

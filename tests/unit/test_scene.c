@@ -1339,11 +1339,41 @@ static void test_halfspace_normals(void) {
   scene_free(s);
 }
 
+/* The nodes' order is the language's, not the compiler's: a set
+   operation's right operand is compiled before its left (bind/compile.c
+   set_of), so its nodes come first, in every build. The meshes' exact
+   sides rank planes by node number; when the order was C's unspecified
+   order of a call's arguments, a clang build numbered them the other
+   way from gcc's and meshed touching parts differently. */
+static void test_node_order(void) {
+  static const char *const ops[] = {"Union", "Intersection", "SetDifference"};
+  for (int k = 0; k < 3; k++) {
+    char src[300], buf[300];
+    snprintf(src, sizeof src, "%s (Halfspace ((1, 0, 0), 1)) (%s "
+             "(Halfspace ((0, 1, 0), 2)) (Halfspace ((0, 0, 1), 3)))",
+             ops[k], ops[k]);
+    Scene *s = compile(src);
+    CHECK(src, s != NULL);
+    if (!s) continue;
+    /* right to left: z (3), y (2), their node, then x (1), the root */
+    int at[3] = {-1, -1, -1};
+    for (int i = 0; i < s->n; i++)
+      if (s->nodes[i].kind == SC_HALFSPACE)
+        for (int a = 0; a < 3; a++)
+          if (s->nodes[i].n[a] == 1) at[a] = i;
+    snprintf(buf, sizeof buf, "%s: the right operand's nodes first (x at %d, "
+             "y at %d, z at %d)", ops[k], at[0], at[1], at[2]);
+    CHECK(buf, at[2] == 0 && at[1] == 1 && at[0] == 3 && s->root == 4);
+    scene_free(s);
+  }
+}
+
 int main(void) {
   check_prefix = "scene";
   I = bind_interp_new();
   char probe;
   interp_set_stack(I, &probe, 4u << 20);
+  test_node_order();
   test_compile();
   test_radius_sweep();
   test_far_and_scaled();
