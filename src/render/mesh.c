@@ -3531,38 +3531,48 @@ static int corner_find(int *p, int x) {
   return x;
 }
 
+/* Each vertex's corners: *cntp (nv + 1 offsets) and *cnp (each corner as
+   3 t + c, vertex by vertex). 0, or -1 out of memory (nothing kept). */
+static int vertex_corners(const Mesher *m, int **cntp, int **cnp) {
+  size_t nv = m->nv, nc = 3 * m->nt;
+  int *cnt = calloc(nv + 1, sizeof *cnt), *at = malloc((nv ? nv : 1) * sizeof *at),
+      *cn = malloc((nc ? nc : 1) * sizeof *cn);
+  if (!cnt || !at || !cn) {
+    free(cnt);
+    free(at);
+    free(cn);
+    return -1;
+  }
+  for (size_t i = 0; i < nc; i++) cnt[m->t[i] + 1]++;
+  for (size_t i = 0; i < nv; i++) cnt[i + 1] += cnt[i];
+  for (size_t i = 0; i < nv; i++) at[i] = cnt[i];
+  for (size_t i = 0; i < nc; i++) cn[at[m->t[i]]++] = (int)i;
+  free(at);
+  *cntp = cnt;
+  *cnp = cn;
+  return 0;
+}
+
 static int part_contacts(Mesher *m, double *moved) {
   size_t nv = m->nv, nt = m->nt, nc = 3 * nt;
   *moved = 0;
   if (!nv || !nt) return 0;
   int rc = -1;
-  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *wt = NULL, *up = NULL,
-      *root = NULL, *re = NULL, *fc = NULL;
-  unsigned char *wc = NULL, *line = NULL;
+  int *cnt = NULL, *cn = NULL, *up = NULL, *root = NULL, *re = NULL,
+      *fc = NULL;
+  unsigned char *line = NULL;
   double *np = NULL; /* each fan's place: x, y, z, the vertex it goes to */
   size_t nnew = 0, capnew = 0, nadd = 0, capfc = 0;
   long pinches = m->rep->pinches;
   size_t npin = m->npin;
   int applied = 0;
-  if (!cnt) return -1;
-  for (size_t i = 0; i < nc; i++) cnt[m->t[i] + 1]++;
-  for (size_t i = 0; i < nv; i++) cnt[i + 1] += cnt[i];
-  at = malloc(nv * sizeof *at);
-  wt = malloc(nc * sizeof *wt);
-  wc = malloc(nc);
+  if (vertex_corners(m, &cnt, &cn) < 0) return -1;
   up = malloc(nc * sizeof *up);
   line = calloc(nv, 1);
-  if (!at || !wt || !wc || !up || !line) goto done;
-  for (size_t i = 0; i < nv; i++) at[i] = cnt[i];
-  for (size_t t = 0; t < nt; t++)
-    for (int k = 0; k < 3; k++) {
-      int q = at[m->t[3 * t + (size_t)k]]++;
-      wt[q] = (int)t;
-      wc[q] = (unsigned char)k;
-    }
+  if (!up || !line) goto done;
   for (size_t q = 0; q < nc; q++) up[q] = (int)q;
-#define NXT(q) m->t[3 * (size_t)wt[q] + (size_t)(wc[q] + 1) % 3]
-#define PRV(q) m->t[3 * (size_t)wt[q] + (size_t)(wc[q] + 2) % 3]
+#define NXT(q) m->t[(size_t)cn[q] / 3 * 3 + ((size_t)cn[q] % 3 + 1) % 3]
+#define PRV(q) m->t[(size_t)cn[q] / 3 * 3 + ((size_t)cn[q] % 3 + 2) % 3]
   for (size_t v = 0; v < nv; v++)
     for (int q = cnt[v]; q < cnt[v + 1]; q++) {
       int x = NXT(q), out = 0, in = 0, qin = -1;
@@ -3625,8 +3635,8 @@ static int part_contacts(Mesher *m, double *moved) {
         /* the same two triangles at x */
         int r1 = -1, r2 = -1;
         for (int r = cnt[x]; r < cnt[x + 1]; r++) {
-          if (wt[r] == wt[q1]) r1 = r;
-          if (wt[r] == wt[q2]) r2 = r;
+          if (cn[r] / 3 == cn[q1] / 3) r1 = r;
+          if (cn[r] / 3 == cn[q2] / 3) r2 = r;
         }
         if (r1 < 0 || r2 < 0) goto flat;
         a = corner_find(up, r1);
@@ -3665,7 +3675,7 @@ static int part_contacts(Mesher *m, double *moved) {
       for (int q = q0; q < hi; q++) {
         if (root[q] != root[q0]) continue;
         if (grow((void **)&fc, &capfc, (size_t)k + 1, sizeof *fc) < 0) goto done;
-        fc[k++] = 3 * wt[q] + wc[q];
+        fc[k++] = cn[q];
         for (int e = 0; e < 2 && line[v] && !many; e++) {
           int x = e ? PRV(q) : NXT(q), out = 0, in = 0;
           for (int r = lo; r < hi; r++) out += NXT(r) == x, in += PRV(r) == x;
@@ -3711,7 +3721,7 @@ static int part_contacts(Mesher *m, double *moved) {
       to[3] = first ? (double)v : (double)(nv + nadd);
       if (!first) {
         for (int q = q0; q < hi; q++)
-          if (root[q] == root[q0]) re[3 * (size_t)wt[q] + wc[q]] = (int)(nv + nadd);
+          if (root[q] == root[q0]) re[cn[q]] = (int)(nv + nadd);
         nadd++;
       }
       *moved = fmax(*moved, d2);
@@ -3742,9 +3752,7 @@ done:
 #undef NXT
 #undef PRV
   free(cnt);
-  free(at);
-  free(wt);
-  free(wc);
+  free(cn);
   free(up);
   free(root);
   free(line);
@@ -3790,11 +3798,10 @@ static int near_vertices(Mesher *m, double *moved) {
   double thr = 0x1p-22 * big;
   int rc = -1;
   XKey *xs = malloc(nv * sizeof *xs);
-  int *cnt = calloc(nv + 1, sizeof *cnt), *at = NULL, *cn = NULL,
-      *comp = malloc(nv * sizeof *comp);
+  int *cnt = NULL, *cn = NULL, *comp = malloc(nv * sizeof *comp);
   unsigned char *near = calloc(nv, 1);
   hmap pinned = {0};
-  if (!xs || !cnt || !near || !comp) goto done;
+  if (!xs || !near || !comp || vertex_corners(m, &cnt, &cn) < 0) goto done;
   for (size_t i = 0; i < nv; i++) comp[i] = (int)i;
   for (size_t t = 0; t < nt; t++)
     for (int k = 1; k < 3; k++) {
@@ -3803,13 +3810,6 @@ static int near_vertices(Mesher *m, double *moved) {
     }
   for (size_t i = 0; i < nv; i++) xs[i] = (XKey){m->v[3 * i], (int)i};
   qsort(xs, nv, sizeof *xs, xkey_cmp);
-  for (size_t i = 0; i < 3 * nt; i++) cnt[m->t[i] + 1]++;
-  for (size_t i = 0; i < nv; i++) cnt[i + 1] += cnt[i];
-  at = malloc(nv * sizeof *at);
-  cn = malloc(3 * nt * sizeof *cn);
-  if (!at || !cn) goto done;
-  for (size_t i = 0; i < nv; i++) at[i] = cnt[i];
-  for (size_t i = 0; i < 3 * nt; i++) cn[at[m->t[i]]++] = (int)i;
   size_t found = 0;
   for (size_t a = 0; a < nv; a++)
     for (size_t b = a + 1; b < nv && xs[b].x - xs[a].x <= thr; b++) {
@@ -3856,7 +3856,6 @@ static int near_vertices(Mesher *m, double *moved) {
 done:
   free(xs);
   free(cnt);
-  free(at);
   free(cn);
   free(near);
   free(comp);

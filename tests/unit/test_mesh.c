@@ -2694,31 +2694,22 @@ static void pinches(void) {
      "(0,0,0) (2,2,2)) (Union UnitCube (Shift (1,1,1) UnitCube))", 1, 1},
   };
   for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
-    Scene *s = compile(objs[k].src);
-    CHECK(objs[k].name, s != NULL);
-    if (!s) continue;
-    MeshSettings ms = {0};
-    ms.tol = 0.02;
+    const double tol = 0.02;
     Mesh *m = NULL;
     MeshReport rep;
-    char err[300], buf[500];
-    int bad;
-    int rc = mesh_scene(s, s->root, &ms, &m, &rep, &bad, err, sizeof err);
-    snprintf(buf, sizeof buf, "pinches: %s meshed (%s), %ld components, "
-             "Euler characteristic %ld, %ld pinches, %ld sharp cells given up, "
-             "%zu triangles", objs[k].name, rc ? err : "ok", rep.components,
-             rep.euler, rep.pinches, rep.sharp_apart + rep.sharp_off,
-             m ? m->nt : 0);
-    CHECK(buf, rc == 0 && rep.components == objs[k].parts &&
+    char buf[500];
+    Scene *s = compile_mesh(objs[k].name, objs[k].src, tol, &m, &rep);
+    if (!s) continue;
+    snprintf(buf, sizeof buf, "pinches: %s: %ld components, Euler "
+             "characteristic %ld, %ld pinches, %ld sharp cells given up, %zu "
+             "triangles", objs[k].name, rep.components, rep.euler, rep.pinches,
+             rep.sharp_apart + rep.sharp_off, m->nt);
+    CHECK(buf, rep.components == objs[k].parts &&
                    rep.euler == 2 * objs[k].parts &&
                    (objs[k].pinched < 0 ? rep.pinches > 0
                                         : rep.pinches == objs[k].pinched) &&
                    rep.sharp_apart == 0 &&
                    rep.sharp_off == 0 && m->nt < 400);
-    if (rc) {
-      scene_free(s);
-      continue;
-    }
     /* components by the triangles' shared vertices */
     int *par = malloc(m->nv * sizeof *par);
     for (size_t i = 0; i < m->nv; i++) par[i] = (int)i;
@@ -2750,7 +2741,7 @@ static void pinches(void) {
              size, rep.certified);
     CHECK(buf, (objs[k].parts == 1 ||
                 (gap > ldexpl(size, -22) && gap < ldexpl(size, -15))) &&
-                   rep.certified <= ms.tol);
+                   rep.certified <= tol);
     /* as an STL keeps it: the vertices rounded to floats and joined where
        they are equal, every directed edge once and its reverse once */
     int *same = malloc(m->nv * sizeof *same);
