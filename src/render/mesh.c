@@ -27,6 +27,8 @@
 #include "scene/ray.h"
 
 #define MAX_DEPTH 19       /* grid coordinates fit 20 bits */
+/* weld joins edges shorter than this (of the octree's side) */
+#define WELD 0x1p-46
 /* Cells where two surfaces, each one sheet, are not proven one sheet
    together split this many levels below the finest at most (walk). */
 #define TWO_LEVELS 2
@@ -826,6 +828,8 @@ typedef struct {
   size_t nft, capft;
   const Leaf *cur;         /* the leaf being meshed */
   int sharp;               /* make LEAF_EXACT cells */
+  int near_exact;          /* place the meeting points of near parallel
+                              planes exactly (ex_split) */
   int uniform;             /* no leaf above the finest level */
   int refining;            /* walk splits cells where settled gives 2
                               (refine_two) */
@@ -1439,34 +1443,51 @@ static int planes_nested(const Mesher *m, int x, int y, const double lo[3],
 /* The most surfaces solid_along follows in a box. */
 #define SH_MAX 16
 
-/* The surfaces the solid over a box depends on, from scene_box's classes
-   st and one: the undecided leaves reached from the root through
-   undecided nodes, a node decided by one child (T_ONE) passing only to
-   that child's leaf. Into xs; their number, or -1 when there are more
-   than SH_MAX, or when two surfaces were taken as one plane (same_surface,
-   same_plane_box), whose side of it the classes do not give. */
-static int live_surfaces(const Mesher *m, const unsigned char *st,
-                         const int *one, int *xs) {
+/* The nodes the solid over a box depends on, from scene_box's classes
+   st and one, into m->rel: those reached from the root through undecided
+   nodes, a node decided by one child (T_ONE) passing only to that
+   child's leaf (both children's, when two surfaces were taken as one
+   plane: same_surface, same_plane_box). 1 when there were such two,
+   whose side of the plane the classes do not give; else 0. */
+static int mark_relevant(const Mesher *m, const unsigned char *st,
+                         const int *one) {
   const Scene *s = m->s;
-  int f = s->nodes[m->node].first, n = 0;
+  int f = s->nodes[m->node].first, two = 0;
   memset(m->rel, 0, (size_t)(m->node - f + 1));
   m->rel[m->node - f] = st[m->node - f] != T_IN && st[m->node - f] != T_OUT;
   for (int x = m->node; x >= f; x--) { /* parents before children */
     if (!m->rel[x - f]) continue;
     const ScNode *nd = &s->nodes[x];
-    if (nd->kind == SC_UNION || nd->kind == SC_INTER || nd->kind == SC_DIFF) {
-      int a = nd->a - f, b = nd->b - f;
-      if (st[x - f] == T_ONE) {
-        if (st[a] == T_ONE && st[b] == T_ONE) return -1;
-        m->rel[one[x - f] - f] = 1;
-      } else {
-        m->rel[a] = st[a] != T_IN && st[a] != T_OUT;
-        m->rel[b] = st[b] != T_IN && st[b] != T_OUT;
-      }
+    if (nd->kind != SC_UNION && nd->kind != SC_INTER && nd->kind != SC_DIFF)
+      continue;
+    int a = nd->a - f, b = nd->b - f;
+    if (st[x - f] == T_ONE && st[a] == T_ONE && st[b] == T_ONE) {
+      m->rel[one[a] - f] = m->rel[one[b] - f] = 1;
+      two = 1;
+    } else if (st[x - f] == T_ONE) {
+      m->rel[one[x - f] - f] = 1;
     } else {
-      if (n == SH_MAX) return -1;
-      xs[n++] = x;
+      m->rel[a] = st[a] != T_IN && st[a] != T_OUT;
+      m->rel[b] = st[b] != T_IN && st[b] != T_OUT;
     }
+  }
+  return two;
+}
+
+/* The surfaces the solid over a box depends on (mark_relevant's leaves)
+   into xs; their number, or -1 when there are more than SH_MAX, or when
+   two surfaces were taken as one plane. */
+static int live_surfaces(const Mesher *m, const unsigned char *st,
+                         const int *one, int *xs) {
+  const Scene *s = m->s;
+  int f = s->nodes[m->node].first, n = 0;
+  if (mark_relevant(m, st, one)) return -1;
+  for (int x = m->node; x >= f; x--) {
+    ScKind k = s->nodes[x].kind;
+    if (!m->rel[x - f] || k == SC_UNION || k == SC_INTER || k == SC_DIFF)
+      continue;
+    if (n == SH_MAX) return -1;
+    xs[n++] = x;
   }
   return n;
 }
@@ -1651,10 +1672,17 @@ static int settled(Mesher *m, int c, int one, const double lo[3],
   if (c == T_ONE)
     return one_sheet(m, one, lo, hi) ? 1 : ((void)(m->badnode = one), 0);
   int f = m->s->nodes[m->node].first;
+  /* only the planes the solid in the cell depends on: one of a part
+     proven outside it (the far side of a prism touching this one) makes
+     no thin part with another */
+  mark_relevant(m, m->st, m->one);
   for (int x = f; x <= m->node; x++) {
-    if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE) continue;
+    if (m->s->nodes[x].kind != SC_HALFSPACE || m->st[x - f] != T_ONE ||
+        !m->rel[x - f])
+      continue;
     for (int y = f; y < x; y++)
       if (m->s->nodes[y].kind == SC_HALFSPACE && m->st[y - f] == T_ONE &&
+          m->rel[y - f] &&
           !same_surface(m->s, x, y) && planes_face(m, x, y, lo, hi) &&
           !planes_nested(m, x, y, lo, hi))
         return (void)(m->badnode = x), 0;
@@ -2829,6 +2857,8 @@ static void face_corners(const ExTet *e, int ex, int f[3]) {
 }
 
 /* The vertex where piece edge (a, b) with support sup meets plane j. */
+static void lv_three(ExTet *e, const LVert *w, const MxPlane *three[3]);
+
 static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
   const Mesher *m = e->m;
   uint64_t k[4];
@@ -2886,7 +2916,8 @@ static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
     k[2] = (uint64_t)e->p[f[2]];
     k[3] = ni << 32 | nj;
   }
-  if (solve3(A, B, x) < 0) { /* near parallel: between the two ends */
+  int near = solve3(A, B, x) < 0;
+  if (near) { /* near parallel: between the two ends, unless placed below */
     double n[3], d;
     pl_plane(m, j, n, &d);
     double sa = vec3_dot(n, e->lv[a].x) - d, sb = vec3_dot(n, e->lv[b].x) - d;
@@ -2899,6 +2930,26 @@ static int ex_split(ExTet *e, int i, int sup, int j, int a, int b) {
     e->lv[v].pi = i;
     e->lv[v].pj = j;
     e->lv[v].ps = sup;
+    /* near parallel planes (a face of one prism and the same face of a
+       prism touching it, their doubles rounded apart) meet where the
+       doubles cannot say: the two ends' sides of plane j are then both
+       rounding, and a point between them anywhere on the edge (0.12
+       away on two 8-sided prisms side by side: a spike folding the
+       face over itself). In the second try (mesh_scene) placed exactly
+       (rounded toward 0) instead, when that is farther than the weld
+       joins. (Not always: where two faces of parts touching face to face
+       cross at a tiny angle, the exact points made sharp cells the first
+       way kept fail their checks: 4 of 400 fuzzed contact scenes.) */
+    const MxPlane *three[3];
+    double y[3];
+    if (near && m->near_exact) {
+      lv_three(e, &e->lv[v], three);
+      double g = ldexp(m->h, MAX_DEPTH) * WELD, *xv = e->lv[v].x;
+      if (mx_three_point(three, y) == 0 &&
+          !(fabs(y[0] - xv[0]) <= g && fabs(y[1] - xv[1]) <= g &&
+            fabs(y[2] - xv[2]) <= g))
+        memcpy(xv, y, sizeof y);
+    }
   }
   /* a split beside a degenerate point may be at it too (the edge's line
      in a third plane, whose test at the edge's ends was a tie): placed
@@ -3381,7 +3432,6 @@ static int exact_tet(Mesher *m, const int p[4], size_t *count) {
    share no edge and stay apart; a pinch is parted (weld_fans). The
    closure and self-intersection checks judge the result.
    0, or -1 out of memory. */
-#define WELD 0x1p-46
 
 /* par: each vertex's class (its first vertex). Every class whose first
    vertex would not be made of closed fans once welded (its triangles'
@@ -4748,6 +4798,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
   m.tol = e;
   m.vtol = vtol;
   m.sharp = sharp && !ms->uniform;
+  m.near_exact = sharp == 2;
   m.force = force;
   m.plainc = plainc;
   m.uniform = ms->uniform;
@@ -5821,12 +5872,23 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
      tetrahedra and the rest kept (sharp_apart), a few times; then every
      sharp cell given up */
   double t0 = 0;   /* the tries that failed */
-  int rc, tries = 0;
+  int rc, tries = 0, near = 1;
   for (;;) {
-    rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 1, &force,
+    rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, near, &force,
                      &plainc, mem0);
     if (rc != MESH_RESHARP) break;
     t0 += rep->seconds;
+    if (near == 1) {
+      /* once, before any sharp cell is given up: the meeting points of
+         near parallel planes placed exactly (ex_split; two 8-sided
+         prisms side by side, their faces beside the line of contact in
+         one plane but for rounding, were refused) */
+      near = 2;
+      hfree(&plainc);
+      memset(&plainc, 0, sizeof plainc);
+      memset(rep, 0, sizeof *rep);
+      continue;
+    }
     if (++tries == RESHARP_TRIES) { /* the last failure's kind */
       rc = rep->resharp == 2 ? MESH_ESELF : MESH_EINTERNAL;
       rep->seconds = 0;

@@ -2778,6 +2778,98 @@ static void pinches(void) {
   }
 }
 
+/* Prisms side by side whose edges meet, one's corner on the other's: the
+   faces beside the line of contact lie in one plane but for rounding
+   (two 8-sided prisms), or the doubles overlap them by 1e-16 (a neck of
+   no width). Before: three planes all but parallel met where the doubles
+   could not say, placed anywhere on the edge (0.12 away: a face folded
+   over itself, its sharp cells given up, then refused as thinner than
+   the finest cell: the 8-sided pair, a row of three); and the flat merge
+   dropped both creases of the neck's top and bottom into one edge of
+   four triangles (undone: 222 triangles for 8 and 6 sides, 64,202 for 24
+   and 8). Now each is meshed with its sharp cells and its flat regions
+   kept, closed and oriented, of 1 to k spheres (the neck is there or not
+   as the doubles say), the volume the prisms' own (long double), every
+   sampled triangle point within the tolerance, and about as many
+   triangles as the prisms alone (4 n - 4 each). */
+static void touching_prisms(void) {
+  static const struct { const char *name, *src; int n[3]; double tol; } objs[] = {
+    {"two 8-sided prisms side by side, corner to corner",
+     "Union (CylinderWith [Sides 8] 0.5 1) (Shift (1,0,0) (CylinderWith [Sides 8] 0.5 1))",
+     {8, 8, 0}, 0.02},
+    {"an 8-sided prism beside a 6-sided one, corner to corner",
+     "Union (CylinderWith [Sides 8] 0.5 1) (Shift (1,0,0) (CylinderWith [Sides 6] 0.5 1))",
+     {8, 6, 0}, 0.02},
+    {"a 24-sided prism beside an 8-sided one, corner to corner",
+     "Union (CylinderWith [Sides 24] 0.5 1) (Shift (1,0,0) (CylinderWith [Sides 8] 0.5 1))",
+     {24, 8, 0}, 0.01}, /* at 0.02 still 4 sharp cells given up */
+    {"a 12-sided prism beside another, corner to corner",
+     "Union (CylinderWith [Sides 12] 0.5 1) (Shift (1,0,0) (CylinderWith [Sides 12] 0.5 1))",
+     {12, 12, 0}, 0.02},
+    {"an 8-sided prism beside a 6-sided one, rotated",
+     "Rotate \"z\" 17 (Union (CylinderWith [Sides 8] 0.5 1) (Shift (1,0,0) "
+     "(CylinderWith [Sides 6] 0.5 1)))", {8, 6, 0}, 0.02},
+    {"a row of three 8-sided prisms, corner to corner",
+     "Union (Union (CylinderWith [Sides 8] 0.5 1) (Shift (1,0,0) (CylinderWith "
+     "[Sides 8] 0.5 1))) (Shift (2,0,0) (CylinderWith [Sides 8] 0.5 1))", {8, 8, 8}, 0.02},
+  };
+  for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
+    const double tol = objs[k].tol, r = 0.5;
+    Mesh *m = NULL;
+    MeshReport rep;
+    char buf[600];
+    Scene *s = compile_mesh(objs[k].name, objs[k].src, tol, &m, &rep);
+    if (!s) continue;
+    long parts = 0, eu = 0, want = 0;
+    long double vol = 0;
+    for (int i = 0; i < 3 && objs[k].n[i]; i++) {
+      long double n = objs[k].n[i];
+      vol += n * r * r * sinl(2 * acosl(-1) / n) / 2; /* height 1 */
+      want += 4 * objs[k].n[i] - 4;
+      parts++;
+    }
+    MeshCheck ck;
+    int co = closed_oriented(m, &eu), mc = mesh_check(m, &ck);
+    snprintf(buf, sizeof buf, "touching prisms: %s: closed and oriented, %ld "
+             "component(s) of %ld prisms, Euler characteristic %ld, sharp cells "
+             "kept (%ld given up, %d whole), flat regions kept (undone %d), %zu "
+             "triangles (the prisms alone %ld)", objs[k].name, ck.components,
+             parts, eu, rep.sharp_apart, rep.sharp_off, rep.flat_undone, m->nt,
+             want);
+    CHECK(buf, co && mc == 0 && ck.components >= 1 && ck.components <= parts &&
+                   eu == 2 * ck.components && rep.sharp_apart == 0 &&
+                   rep.sharp_off == 0 && rep.flat_undone == 0 &&
+                   m->nt <= (size_t)want + 16);
+    /* a surface within c of the true one holds a volume within its area
+       times c of the true one's (parted vertices move by 2^-18 of the
+       size, in the certified bound) */
+    long double area = 0;
+    for (size_t t = 0; t < m->nt; t++) {
+      const double *p0 = m->v + 3 * m->t[3 * t], *p1 = m->v + 3 * m->t[3 * t + 1],
+                   *p2 = m->v + 3 * m->t[3 * t + 2];
+      long double u[3], w[3];
+      for (int a = 0; a < 3; a++) {
+        u[a] = (long double)p1[a] - p0[a];
+        w[a] = (long double)p2[a] - p0[a];
+      }
+      long double c0 = u[1] * w[2] - u[2] * w[1], c1 = u[2] * w[0] - u[0] * w[2],
+                  c2 = u[0] * w[1] - u[1] * w[0];
+      area += sqrtl(c0 * c0 + c1 * c1 + c2 * c2) / 2;
+    }
+    double v = volume(m);
+    snprintf(buf, sizeof buf, "touching prisms: %s: volume %.15g, the prisms' "
+             "%.15Lg (within the area %.4Lg times the certified %.3g)",
+             objs[k].name, v, vol, area, rep.certified);
+    CHECK(buf, fabsl((long double)v - vol) <= area * rep.certified + 1e-12L);
+    long far = mesh_to_surface(s, m, tol, 3000);
+    snprintf(buf, sizeof buf, "touching prisms: %s: 3000 triangle points within "
+             "the tolerance of the surface (%ld not)", objs[k].name, far);
+    CHECK(buf, far == 0);
+    mesh_free(m);
+    scene_free(s);
+  }
+}
+
 /* Flat regions triangulated again (mesh_merge.h), against the octree's
    own triangles (MeshSettings.keep_flat) of the same object: fewer
    triangles (a unit cube 12, figure12's sharp obj1 28, OpenSCAD's count
@@ -3088,6 +3180,7 @@ int main(void) {
   flat_merge();
   corners_only();
   pinches();
+  touching_prisms();
   thin_parts();
   property();
   sharp_kept();
