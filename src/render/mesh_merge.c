@@ -312,21 +312,11 @@ static int region_normal_ok(const Ctx *C, int j, const double n[3], double d) {
 
 static int grow_ints(int **p, size_t *cap, size_t need);
 
-/* Whether vertices p and q share a triangle of m. */
-static int joined(const Adj *A, int p, int q) {
-  const Mesh *m = A->m;
-  for (size_t k = A->vs[p]; k < A->vs[p + 1]; k++) {
-    const int *t = m->t + 3 * (size_t)A->vt[k];
-    if (t[0] == q || t[1] == q || t[2] == q) return 1;
-  }
-  return 0;
-}
-
 /* Straight vertices: on the common boundary of exactly two merged regions
    and nothing else, between the same two neighbours on both; removed in
    chains whose every vertex is within delta of the chord between the
-   chain's ends, unless those ends are joined already or by a chain
-   removed before: two creases between the same two corners (the top and
+   chain's ends, unless a chain removed before had the same two ends:
+   two creases between the same two corners (the top and
    bottom of a neck of no width, where two prisms touching edge to edge
    overlap by a rounding) would become one edge of four triangles. */
 static void straight(Ctx *C, const Adj *A, unsigned char *gone) {
@@ -397,7 +387,6 @@ static void straight(Ctx *C, const Adj *A, unsigned char *gone) {
     for (size_t k = 0; k < nends && ok; k++)
       ok = !((ends[2 * k] == p && ends[2 * k + 1] == q) ||
              (ends[2 * k] == q && ends[2 * k + 1] == p));
-    if (ok && joined(A, p, q)) ok = 0;
     if (ok && grow_ints(&ends, &capends, 2 * nends + 2) < 0) ok = 0;
     if (ok) {
       ends[2 * nends] = p;
