@@ -61,6 +61,12 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "(sides decided exactly, ties by a symbolic perturbation; "
             "edges shorter than 2^-46 of the object's size collapsed, the "
             "certified bound grown by the largest move)\n", r->welded);
+  if (r->snapped)
+    fprintf(f, "  planes joined: %ld plane%s within 2^-46 of another (of "
+            "the object's size) made that plane, faces glued face to face or "
+            "flush one plane but for rounding (moved at most %.3g; in the "
+            "certified bound)\n", r->snapped, r->snapped == 1 ? "" : "s",
+            r->snap_moved);
   if (r->pinches)
     fprintf(f, "  pinches: %ld vert%s where two parts of the solid touch "
             "or all but touch (at a point or along a line) parted, each "

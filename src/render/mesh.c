@@ -5861,10 +5861,151 @@ static int mesh_rounds(const Scene *s, int node, const MeshSettings *ms,
   return rc;
 }
 
+/* ---- planes that are one plane but for rounding ------------------------ */
+
+/* Two halfspaces whose planes differ by at most SNAP (of a normal's
+   components, and of the object's size in the offset) either way are one
+   plane but for rounding: the faces of two prisms glued face to face, or
+   two boxes' tops flush, built by different rotations and shifts. Left
+   apart, the doubles overlap them by a sliver or part them by a gap of
+   1e-16, coplanar faces the self-intersection check rightly refuses, and
+   no cell can be split fine enough to settle them. SNAP is a few dozen
+   ulps: a gap of 1e-13 stays a gap. */
+#define SNAP 0x1p-46
+
+typedef struct {
+  double key;
+  int x, sg;
+} SnapEnt;
+
+static int snap_cmp(const void *a, const void *b) {
+  double x = ((const SnapEnt *)a)->key, y = ((const SnapEnt *)b)->key;
+  return x < y ? -1 : x > y;
+}
+
+static int snap_find(int *p, int x) {
+  while (p[x] != x) x = p[x] = p[p[x]];
+  return x;
+}
+
+/* The halfspaces of node's subtree that are one plane but for rounding
+   made one (each takes the coefficients of its class's first node, negated
+   when facing the other way), in a copy of the scene's nodes: *out shares
+   everything else with s. 1 when a copy was made (free out->nodes), 0
+   when there was nothing to join, -1 out of memory. *moved: the most a
+   plane moved within the box of half-side r about the origin (|Delta
+   n|_1 r + |Delta d|), for the certified bound. */
+static int snap_planes(const Scene *s, int node, double r, Scene *out,
+                       double *moved, long *count) {
+  int f = s->nodes[node].first, nh = 0, rc = 0;
+  *moved = 0;
+  *count = 0;
+  for (int x = f; x <= node; x++) nh += s->nodes[x].kind == SC_HALFSPACE;
+  if (nh < 2 || !(r > 0) || !isfinite(r)) return 0;
+  SnapEnt *e = malloc(2 * (size_t)nh * sizeof *e);
+  int *par = malloc((size_t)(node - f + 1) * sizeof *par);
+  if (!e || !par) {
+    free(e);
+    free(par);
+    return -1;
+  }
+  /* each plane both ways, ordered by a key that two planes within SNAP
+     of each other have within KW SNAP of each other */
+  const double c1 = 1.4142135623730951, c2 = 1.7320508075688772, c3 = 0.5;
+  const double kw = (1 + c1 + c2 + c3) * SNAP * 1.0001;
+  size_t ne = 0;
+  for (int x = f; x <= node; x++) {
+    par[x - f] = x - f;
+    const ScNode *nd = &s->nodes[x];
+    if (nd->kind != SC_HALFSPACE) continue;
+    for (int sg = -1; sg <= 1; sg += 2)
+      e[ne++] = (SnapEnt){sg * (nd->n[0] + c1 * nd->n[1] + c2 * nd->n[2] +
+                                c3 * nd->d / r), x, sg};
+  }
+  qsort(e, ne, sizeof *e, snap_cmp);
+  int joined = 0;
+  for (size_t i = 0; i < ne; i++)
+    for (size_t j = i + 1; j < ne && e[j].key - e[i].key <= kw; j++) {
+      if (e[i].x == e[j].x) continue;
+      const ScNode *a = &s->nodes[e[i].x], *b = &s->nodes[e[j].x];
+      double sa = e[i].sg, sb = e[j].sg;
+      int near = fabs(sa * a->d - sb * b->d) <= SNAP * r;
+      for (int q = 0; q < 3 && near; q++)
+        near = fabs(sa * a->n[q] - sb * b->n[q]) <= SNAP;
+      if (!near) continue;
+      int ra = snap_find(par, e[i].x - f), rb = snap_find(par, e[j].x - f);
+      if (ra == rb) continue;
+      par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
+      joined = 1;
+    }
+  /* only planes whose coefficients change need the copy */
+  int change = 0;
+  for (int x = f; x <= node && joined && !change; x++) {
+    int rt = snap_find(par, x - f) + f;
+    if (rt == x) continue;
+    const ScNode *a = &s->nodes[x], *b = &s->nodes[rt];
+    double sg = vec3_dot(a->n, b->n) < 0 ? -1 : 1;
+    for (int q = 0; q < 3; q++) change |= a->n[q] != sg * b->n[q];
+    change |= a->d != sg * b->d;
+  }
+  if (change) {
+    ScNode *nodes = malloc((size_t)s->n * sizeof *nodes);
+    if (!nodes) {
+      rc = -1;
+      goto done;
+    }
+    memcpy(nodes, s->nodes, (size_t)s->n * sizeof *nodes);
+    for (int x = f; x <= node; x++) {
+      int rt = snap_find(par, x - f) + f;
+      if (rt == x) continue;
+      ScNode *a = &nodes[x];
+      const ScNode *b = &s->nodes[rt];
+      double sg = vec3_dot(a->n, b->n) < 0 ? -1 : 1, mv = 0;
+      for (int q = 0; q < 3; q++) {
+        double nq = sg * b->n[q];
+        mv += fabs(nq - a->n[q]) * r;
+        a->n[q] = nq;
+      }
+      mv += fabs(sg * b->d - a->d);
+      a->d = sg * b->d;
+      ray_normal_grad(a->n, 0, a->un[0]);
+      ray_normal_grad(a->n, 1, a->un[1]);
+      if (mv > *moved) *moved = mv;
+      if (mv > 0) (*count)++;
+    }
+    *out = *s;
+    out->nodes = nodes;
+    rc = 1;
+  }
+done:
+  free(e);
+  free(par);
+  return rc;
+}
+
 int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
                MeshReport *rep, int *bad_node, char *err, size_t errlen) {
   hmap force = {0}, plainc = {0};
   memset(rep, 0, sizeof *rep);
+  /* planes that are one plane but for rounding made one (snap_planes),
+     the move in the certified bound */
+  Scene snapped;
+  double blo[3], bhi[3], br = 0, snap_moved = 0;
+  long snap_count = 0;
+  int bounded = render_node_box(s, node, blo, bhi);
+  if (ms->has_bounds)
+    for (int i = 0; i < 3; i++) {
+      blo[i] = bounded ? fmax(blo[i], ms->lo[i]) : ms->lo[i];
+      bhi[i] = bounded ? fmin(bhi[i], ms->hi[i]) : ms->hi[i];
+    }
+  if (bounded || ms->has_bounds)
+    for (int i = 0; i < 3; i++) br = fmax(br, fmax(fabs(blo[i]), fabs(bhi[i])));
+  int snap = snap_planes(s, node, br, &snapped, &snap_moved, &snap_count);
+  if (snap < 0) {
+    snprintf(err, errlen, "out of memory while meshing");
+    return MESH_ENOMEM;
+  }
+  if (snap) s = &snapped;
   /* the resident memory now: max_memory bounds its growth */
   size_t mem0[2] = {ms->max_memory ? resident() : 0,
                     ms->max_memory ? peak_resident() : 0};
@@ -5911,6 +6052,14 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
   }
   hfree(&force);
   hfree(&plainc);
+  if (snap) {
+    free(snapped.nodes);
+    if (rc == MESH_OK) {
+      rep->certified += snap_moved;
+      rep->snapped = snap_count;
+      rep->snap_moved = snap_moved;
+    }
+  }
   if (rc == MESH_ENOMEM) snprintf(err, errlen, "out of memory while meshing");
   return rc;
 }

@@ -119,6 +119,10 @@ typedef struct MeshReport {
                               cell_redundant) */
   long welded;             /* triangles of no area dropped where the
                               sharp cells met a degenerate point */
+  long snapped;            /* planes moved onto another that is the same
+                              plane but for rounding (mesh.c, snap_planes) */
+  double snap_moved;       /* the most one moved in the object's box (in
+                              the certified bound) */
   long pinches;            /* vertices where two parts of the solid touch
                               (at a point or along a line), parted
                               (mesh.c, part_contacts) */
