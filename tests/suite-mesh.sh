@@ -311,3 +311,30 @@ if command -v admesh > /dev/null 2>&1; then
 else
   echo "skip mesh: admesh is not installed (apt-get install admesh)"
 fi
+
+# planes one plane but for rounding joined (two hexagonal prisms glued
+# face to face, rotated: one part, the glued face gone, admesh reads one
+# part); never a part's own two faces (a plate 2e-14 thick beside a cube
+# is refused, as thinner than the finest cell, not deleted); never a
+# Bounds face (a cube on a floor, the box's bottom 1e-16 above the
+# floor's plane: the sharp cell kept, 12 triangles)
+printf '%s\n' 'scene = Rotate "z" 12.5 (Union (Rotate "y" 30.0 (CylinderWith [Sides 6] 0.5 1)) (Shift (0.8660254037844387,0,0) (Rotate "y" 30.0 (CylinderWith [Sides 6] 0.5 1))))' > "$tmp/jglued.qcs"
+printf '%s\n' 'scene = Union UnitCube (Shift (2,0,0) (Scale (1,0.00000000000002,1) UnitCube))' > "$tmp/jplate.qcs"
+printf '%s\n' 'meshWith [Bounds (-0.5,0.0000000000000001,-0.5) (1.5,1.5,1.5)] "jfloor.stl" (Union UnitCube (Halfspace ((0,1,0), 0)))' > "$tmp/jfloor.qcs"
+"$top/$QCS" -o "$tmp/jglued.stl" "$tmp/jglued.qcs" > "$tmp/out" 2> "$tmp/err.jglued"
+"$top/$QCS" -o "$tmp/jplate.stl" "$tmp/jplate.qcs" > "$tmp/out" 2> "$tmp/err.jplate"; plate_rc=$?
+(cd "$tmp" && "$top/$QCS" jfloor.qcs > out 2> err.jfloor)
+if grep -q "^  planes joined: 1 plane within 2^-46" "$tmp/err.jglued" &&
+   grep -q "topology: 1 component, Euler characteristic 2" "$tmp/err.jglued" &&
+   [ $plate_rc -ne 0 ] && [ ! -e "$tmp/jplate.stl" ] && grep -q "thinner than the finest cell" "$tmp/err.jplate" &&
+   grep -q "mesh jfloor.stl: 12 triangles" "$tmp/err.jfloor" && grep -q "1 sharp" "$tmp/err.jfloor" &&
+   ! grep -q "planes joined" "$tmp/err.jfloor"; then
+  echo "ok mesh: glued prisms' faces joined (one part); a 2e-14 plate refused, not deleted; a Bounds face 1e-16 off kept (12 triangles)"
+else echo "FAIL mesh: joined planes: $(cat "$tmp/err.jglued" "$tmp/err.jplate" "$tmp/err.jfloor" | grep -E 'qcs: mesh|planes joined|topology|error' | tr '\n' ' ' | head -c 600)"; fi
+if command -v admesh > /dev/null 2>&1 && [ -s "$tmp/jglued.stl" ]; then
+  admesh "$tmp/jglued.stl" > "$tmp/adm" 2>&1
+  if grep -q "Number of parts *: *1" "$tmp/adm" && grep -q "Facets reversed *: *0" "$tmp/adm" &&
+     grep -q "Backwards edges *: *0" "$tmp/adm"; then
+    echo "ok mesh: admesh reads the glued prisms as one part, none reversed"
+  else echo "FAIL mesh: admesh on the glued prisms: $(grep -E 'parts|reversed|Backwards' "$tmp/adm" | tr '\n' ' ')"; fi
+fi

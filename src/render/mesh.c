@@ -17,6 +17,7 @@
 
 #include "core/bounds.h"
 #include "core/interval.h"
+#include "core/mix.h"
 #include "core/vec.h"
 #include "render/image.h"
 #include "render/mesh_check.h"
@@ -70,14 +71,9 @@ typedef struct {
 } hmap;
 
 static size_t hslot(const hmap *h, uint64_t key) {
-  /* murmur3's finalizer: every key bit reaches the low bits (point keys
-     have their low bits 0 when cells stop above the deepest level) */
-  uint64_t x = key ^ key >> 33;
-  x *= 0xff51afd7ed558ccdull;
-  x ^= x >> 33;
-  x *= 0xc4ceb9fe1a85ec53ull;
-  x ^= x >> 33;
-  size_t i = (size_t)x & (h->cap - 1);
+  /* every key bit reaches the low bits (point keys have their low bits
+     0 when cells stop above the deepest level) */
+  size_t i = (size_t)mix64(key) & (h->cap - 1);
   while (h->k[i] && h->k[i] != key + 1) i = (i + 1) & (h->cap - 1);
   return i;
 }
@@ -5912,54 +5908,145 @@ static int snap_find(int *p, int x) {
   return x;
 }
 
+/* Plane y, turned by sg (1 or -1), within SNAP of plane x. */
+static int snap_near(const ScNode *x, const ScNode *y, double sg, double r) {
+  if (!(fabs(x->d - sg * y->d) <= SNAP * r)) return 0;
+  for (int q = 0; q < 3; q++)
+    if (!(fabs(x->n[q] - sg * y->n[q]) <= SNAP)) return 0;
+  return 1;
+}
+
+/* Whether halfspaces x and y, facing apart (n_x . n_y < 0), meet in the
+   tree at an intersection (a difference is one: a and not b) with both
+   entering alike, or at a union with one of them complemented: between
+   two such planes lies a part (or a gap) of their own, a plate or a slot,
+   which joining the planes would delete, however thin. Two facing apart
+   that meet at a union with both alike (or at an intersection, one
+   complemented) are two operands glued face to face: joined, the face
+   between them goes. pol: each node's complement parity from the
+   root (a difference's right side), up: each node's parent. */
+static int snap_thin(const Scene *s, int f, const int *up,
+                     const unsigned char *pol, int x, int y) {
+  int a = x, b = y;
+  /* the lowest common ancestor: children have lower indices */
+  while (a != b) {
+    if (a < b) a = up[a - f];
+    else b = up[b - f];
+    if (a < 0 || b < 0) return 1;
+  }
+  ScKind k = s->nodes[a].kind;
+  int alike = pol[x - f] == pol[y - f];
+  return (k == SC_UNION) != alike;
+}
+
 /* The halfspaces of node's subtree that are one plane but for rounding
    made one (each takes the coefficients of its class's first node, negated
    when facing the other way), in a copy of the scene's nodes: *out shares
-   everything else with s. 1 when a copy was made (free out->nodes), 0
-   when there was nothing to join, -1 out of memory. *moved: the most a
-   plane moved within the box of half-side r about the origin (|Delta
-   n|_1 r + |Delta d|), for the certified bound. */
-static int snap_planes(const Scene *s, int node, double r, Scene *out,
-                       double *moved, long *count) {
-  int f = s->nodes[node].first, nh = 0, rc = 0;
+   everything else with s. A plane joins a class only within SNAP of the
+   class's first (so no chain of near planes reaches further), never when
+   it and a member would bound a part between them (snap_thin: a plate or
+   a slot 1e-14 thick stays, thinner than the finest cell or not), and a
+   face of the Bounds box (lo, hi; NULL without) is never moved: the clip
+   box keeps it. 1 when a copy was made (free out->nodes), 0 when there
+   was nothing to join, -1 out of memory. *moved: the most a plane moved
+   within the box of half-side r about the origin (|Delta n|_1 r + |Delta
+   d|), for the certified bound; *count: the planes moved. */
+static int snap_planes(const Scene *s, int node, double r, const double *lo,
+                       const double *hi, Scene *out, double *moved,
+                       long *count) {
+  int f = s->nodes[node].first, nh = 0, rc = 0, nsub = node - f + 1;
   *moved = 0;
   *count = 0;
   for (int x = f; x <= node; x++) nh += s->nodes[x].kind == SC_HALFSPACE;
   if (nh < 2 || !(r > 0) || !isfinite(r)) return 0;
   SnapEnt *e = malloc(2 * (size_t)nh * sizeof *e);
-  int *par = malloc((size_t)(node - f + 1) * sizeof *par);
-  if (!e || !par) {
-    free(e);
-    free(par);
-    return -1;
+  int *par = malloc((size_t)nsub * sizeof *par), *up = malloc((size_t)nsub * sizeof *up),
+      *nxt = malloc((size_t)nsub * sizeof *nxt); /* each class's members, a ring */
+  unsigned char *pol = malloc((size_t)nsub), *fixed = calloc((size_t)nsub, 1);
+  if (!e || !par || !up || !pol || !fixed || !nxt) {
+    rc = -1;
+    goto done;
+  }
+  for (int x = 0; x < nsub; x++) par[x] = nxt[x] = x, up[x] = -1;
+  pol[node - f] = 0;
+  for (int x = node; x >= f; x--) { /* parents before children */
+    const ScNode *nd = &s->nodes[x];
+    if (nd->kind != SC_UNION && nd->kind != SC_INTER && nd->kind != SC_DIFF) continue;
+    up[nd->a - f] = up[nd->b - f] = x;
+    pol[nd->a - f] = pol[x - f];
+    pol[nd->b - f] = (unsigned char)(pol[x - f] ^ (nd->kind == SC_DIFF));
   }
   /* each plane both ways, ordered by a key that two planes within SNAP
-     of each other have within KW SNAP of each other */
+     of each other have within (1 + c1 + c2 + c3) SNAP of each other; the
+     window is twice that, for the keys' own rounding */
   const double c1 = 1.4142135623730951, c2 = 1.7320508075688772, c3 = 0.5;
-  const double kw = (1 + c1 + c2 + c3) * SNAP * 1.0001;
+  const double kw = 2 * (1 + c1 + c2 + c3) * SNAP;
   size_t ne = 0;
   for (int x = f; x <= node; x++) {
-    par[x - f] = x - f;
     const ScNode *nd = &s->nodes[x];
     if (nd->kind != SC_HALFSPACE) continue;
+    for (int q = 0; q < 3 && lo; q++) /* a Bounds face: n = -e_q, d = -lo, or e_q, hi */
+      if (nd->n[q] == -1 && nd->d == -lo[q]) fixed[x - f] = 1;
+      else if (nd->n[q] == 1 && nd->d == hi[q]) fixed[x - f] = 1;
     for (int sg = -1; sg <= 1; sg += 2)
       e[ne++] = (SnapEnt){sg * (nd->n[0] + c1 * nd->n[1] + c2 * nd->n[2] +
                                 c3 * nd->d / r), x, sg};
   }
   qsort(e, ne, sizeof *e, snap_cmp);
+  /* copies of one plane (a grid of boxes) joined in one pass, so that the
+     windows below hold distinct planes */
+  size_t nk = 0;
+  for (size_t i = 0; i < ne; i++) {
+    const ScNode *b = &s->nodes[e[i].x];
+    if (nk) {
+      const ScNode *a = &s->nodes[e[nk - 1].x];
+      double sa = e[nk - 1].sg, sb = e[i].sg;
+      if (a->d * sa == b->d * sb && a->n[0] * sa == b->n[0] * sb &&
+          a->n[1] * sa == b->n[1] * sb && a->n[2] * sa == b->n[2] * sb &&
+          sa == sb) {
+        int ra = snap_find(par, e[nk - 1].x - f), rb = snap_find(par, e[i].x - f);
+        if (ra != rb) {
+          par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
+          int t = nxt[ra];
+          nxt[ra] = nxt[rb];
+          nxt[rb] = t;
+        }
+        continue;
+      }
+    }
+    e[nk++] = e[i];
+  }
   int joined = 0;
-  for (size_t i = 0; i < ne; i++)
-    for (size_t j = i + 1; j < ne && e[j].key - e[i].key <= kw; j++) {
-      if (e[i].x == e[j].x) continue;
-      const ScNode *a = &s->nodes[e[i].x], *b = &s->nodes[e[j].x];
-      double sa = e[i].sg, sb = e[j].sg;
-      int near = fabs(sa * a->d - sb * b->d) <= SNAP * r;
-      for (int q = 0; q < 3 && near; q++)
-        near = fabs(sa * a->n[q] - sb * b->n[q]) <= SNAP;
-      if (!near) continue;
-      int ra = snap_find(par, e[i].x - f), rb = snap_find(par, e[j].x - f);
+  for (size_t i = 0; i < nk; i++)
+    for (size_t j = i + 1; j < nk && e[j].key - e[i].key <= kw; j++) {
+      int x = e[i].x, y = e[j].x;
+      if (x == y || fixed[x - f] || fixed[y - f]) continue;
+      const ScNode *a = &s->nodes[x], *b = &s->nodes[y];
+      double sg = e[i].sg * e[j].sg;
+      if (!snap_near(a, b, sg, r)) continue;
+      int ra = snap_find(par, x - f), rb = snap_find(par, y - f);
       if (ra == rb) continue;
+      /* the merged class within SNAP of its first, and no two of its
+         members bounding a part between them */
+      const ScNode *pa = &s->nodes[ra + f], *pb = &s->nodes[rb + f];
+      if (!snap_near(pa, pb, vec3_dot(pa->n, pb->n) < 0 ? -1 : 1, r)) continue;
+      int ok = 1, u = ra;
+      do { /* exact complements are one surface already: only the others */
+        int w = rb;
+        const ScNode *nu = &s->nodes[u + f];
+        do {
+          const ScNode *nw = &s->nodes[w + f];
+          if (vec3_dot(nu->n, nw->n) < 0 && !same_surface(s, u + f, w + f))
+            ok = !snap_thin(s, f, up, pol, u + f, w + f);
+          w = nxt[w];
+        } while (w != rb && ok);
+        u = nxt[u];
+      } while (u != ra && ok);
+      if (!ok) continue;
       par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
+      int t = nxt[ra]; /* the two member rings spliced */
+      nxt[ra] = nxt[rb];
+      nxt[rb] = t;
       joined = 1;
     }
   /* only planes whose coefficients change need the copy */
@@ -6004,6 +6091,10 @@ static int snap_planes(const Scene *s, int node, double r, Scene *out,
 done:
   free(e);
   free(par);
+  free(up);
+  free(nxt);
+  free(pol);
+  free(fixed);
   return rc;
 }
 
@@ -6024,7 +6115,9 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
     }
   if (bounded || ms->has_bounds)
     for (int i = 0; i < 3; i++) br = fmax(br, fmax(fabs(blo[i]), fabs(bhi[i])));
-  int snap = snap_planes(s, node, br, &snapped, &snap_moved, &snap_count);
+  int snap = snap_planes(s, node, br, ms->has_bounds ? ms->lo : NULL,
+                         ms->has_bounds ? ms->hi : NULL, &snapped, &snap_moved,
+                         &snap_count);
   if (snap < 0) {
     snprintf(err, errlen, "out of memory while meshing");
     return MESH_ENOMEM;
@@ -6072,7 +6165,7 @@ int mesh_scene(const Scene *s, int node, const MeshSettings *ms, Mesh **out,
        of a crease path reaching past its tetrahedron: the marching cells
        alone are closed by construction, each triangle in its own
        tetrahedron */
-    double t = rep->seconds + t0;
+    double t = rep->seconds; /* the failed tries' already in it */
     int why = rc == MESH_ESELF ? 2 : 1;
     rc = mesh_rounds(s, node, ms, out, rep, bad_node, err, errlen, 0, &force,
                      &plainc, mem0);

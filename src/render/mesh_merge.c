@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/mix.h"
 #include "render/mesh.h"
 #include "render/mesh_check.h"
 
@@ -310,7 +311,10 @@ static int region_normal_ok(const Ctx *C, int j, const double n[3], double d) {
   return 1;
 }
 
-static int grow_ints(int **p, size_t *cap, size_t need);
+/* A slot for key in a table of cap (a power of two) entries. */
+static size_t ends_slot(uint64_t key, size_t cap) {
+  return (size_t)mix64(key) & (cap - 1);
+}
 
 /* Straight vertices: on the common boundary of exactly two merged regions
    and nothing else, between the same two neighbours on both; removed in
@@ -326,7 +330,9 @@ static void straight(Ctx *C, const Adj *A, unsigned char *gone) {
   int *na = malloc(nv * sizeof *na), *nb = malloc(nv * sizeof *nb);
   unsigned char *seen = calloc(nv, 1);
   int *chain = malloc(nv * sizeof *chain);
-  int *ends = NULL; /* the chains removed: their ends, pair by pair */
+  /* the chains removed: their ends (lower << 32 | higher + 1), a set by
+     open addressing, at most half full */
+  uint64_t *ends = NULL;
   size_t nends = 0, capends = 0;
   if (!ra || !rb || !na || !nb || !seen || !chain) goto out;
   for (size_t v = 0; v < nv; v++) {
@@ -384,14 +390,32 @@ static void straight(Ctx *C, const Adj *A, unsigned char *gone) {
       ok = s1 > 0 && s1 < 1 &&
            sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) <= C->delta;
     }
-    for (size_t k = 0; k < nends && ok; k++)
-      ok = !((ends[2 * k] == p && ends[2 * k + 1] == q) ||
-             (ends[2 * k] == q && ends[2 * k + 1] == p));
-    if (ok && grow_ints(&ends, &capends, 2 * nends + 2) < 0) ok = 0;
+    uint64_t key = ((uint64_t)(uint32_t)(p < q ? p : q) << 32 | (uint32_t)(p < q ? q : p)) + 1;
+    if (ok && 2 * (nends + 1) > capends) { /* grown: every key placed again */
+      size_t cap = capends ? 2 * capends : 64;
+      uint64_t *n2 = calloc(cap, sizeof *n2);
+      if (!n2) ok = 0;
+      for (size_t k = 0; k < capends && n2; k++) {
+        if (!ends[k]) continue;
+        size_t h = ends_slot(ends[k], cap);
+        while (n2[h]) h = (h + 1) & (cap - 1);
+        n2[h] = ends[k];
+      }
+      if (n2) {
+        free(ends);
+        ends = n2;
+        capends = cap;
+      }
+    }
     if (ok) {
-      ends[2 * nends] = p;
-      ends[2 * nends++ + 1] = q;
-      for (int i = 0; i < len; i++) gone[chain[i]] = 1;
+      size_t h = ends_slot(key, capends);
+      while (ends[h] && ends[h] != key) h = (h + 1) & (capends - 1);
+      ok = !ends[h];
+      if (ok) {
+        ends[h] = key;
+        nends++;
+        for (int i = 0; i < len; i++) gone[chain[i]] = 1;
+      }
     }
   }
 out:
