@@ -2823,6 +2823,27 @@ static long double mesh_area(const Mesh *m) {
   return area;
 }
 
+/* The mesh's volume within its area times the certified bound of vol
+   (a surface within c of the true one holds a volume within its area
+   times c of the true one's), and 3000 of its triangles' points within
+   tol of the surface; the checks named "what: name: ...". */
+static void volume_and_surface(const char *what, const char *name,
+                               const Scene *s, const Mesh *m,
+                               const MeshReport *rep, long double vol,
+                               double tol) {
+  char buf[600];
+  long double area = mesh_area(m);
+  double v = volume(m);
+  snprintf(buf, sizeof buf, "%s: %s: volume %.15g, independently %.15Lg "
+           "(within the area %.4Lg times the certified %.3g)", what, name, v,
+           vol, area, rep->certified);
+  CHECK(buf, fabsl((long double)v - vol) <= area * rep->certified + 1e-12L);
+  long far = mesh_to_surface(s, m, tol, 3000);
+  snprintf(buf, sizeof buf, "%s: %s: 3000 triangle points within the "
+           "tolerance of the surface (%ld not)", what, name, far);
+  CHECK(buf, far == 0);
+}
+
 /* Prisms side by side whose edges meet, one's corner on the other's: the
    faces beside the line of contact lie in one plane but for rounding
    (two 8-sided prisms), or the doubles overlap them by 1e-16 (a neck of
@@ -2891,19 +2912,8 @@ static void touching_prisms(void) {
                    eu == 2 * ck.components && rep.sharp_apart == 0 &&
                    rep.sharp_off == 0 && rep.flat_undone == 0 &&
                    m->nt <= (size_t)want + 16);
-    /* a surface within c of the true one holds a volume within its area
-       times c of the true one's (parted vertices move by 2^-18 of the
-       size, in the certified bound) */
-    long double area = mesh_area(m);
-    double v = volume(m);
-    snprintf(buf, sizeof buf, "touching prisms: %s: volume %.15g, the prisms' "
-             "%.15Lg (within the area %.4Lg times the certified %.3g)",
-             objs[k].name, v, vol, area, rep.certified);
-    CHECK(buf, fabsl((long double)v - vol) <= area * rep.certified + 1e-12L);
-    long far = mesh_to_surface(s, m, tol, 3000);
-    snprintf(buf, sizeof buf, "touching prisms: %s: 3000 triangle points within "
-             "the tolerance of the surface (%ld not)", objs[k].name, far);
-    CHECK(buf, far == 0);
+    /* parted vertices move by 2^-18 of the size, in the certified bound */
+    volume_and_surface("touching prisms", objs[k].name, s, m, &rep, vol, tol);
     mesh_free(m);
     scene_free(s);
   }
@@ -2959,16 +2969,7 @@ static void glued_faces(void) {
                    eu == 2 * objs[k].parts &&
                    (objs[k].parts == 1 ? rep.snapped > 0 : rep.snapped == 0) &&
                    rep.sharp_apart == 0 && rep.sharp_off == 0 && m->nt < 200);
-    long double area = mesh_area(m);
-    double v = volume(m);
-    snprintf(buf, sizeof buf, "glued faces: %s: volume %.15g, the prisms' "
-             "%.15Lg (within the area %.4Lg times the certified %.3g)",
-             objs[k].name, v, vol, area, rep.certified);
-    CHECK(buf, fabsl((long double)v - vol) <= area * rep.certified + 1e-12L);
-    long far = mesh_to_surface(s, m, tol, 3000);
-    snprintf(buf, sizeof buf, "glued faces: %s: 3000 triangle points within "
-             "the tolerance of the surface (%ld not)", objs[k].name, far);
-    CHECK(buf, far == 0);
+    volume_and_surface("glued faces", objs[k].name, s, m, &rep, vol, tol);
     mesh_free(m);
     scene_free(s);
   }
@@ -3005,16 +3006,7 @@ static void bored_half_width(void) {
                  eu == 2 * ck.components && rep.sharp_apart == 0 &&
                  rep.sharp_off == 0 && m->nt < 400);
   long double vol = 1.4L * 2 * 1.4L - 24 * 0.49L * sinl(2 * acosl(-1) / 24) / 2 * 1.4L;
-  long double area = mesh_area(m);
-  double v = volume(m);
-  snprintf(buf, sizeof buf, "bored: %s: volume %.15g, the box less the prism "
-           "%.15Lg (within the area %.4Lg times the certified %.3g)", name, v,
-           vol, area, rep.certified);
-  CHECK(buf, fabsl((long double)v - vol) <= area * rep.certified + 1e-12L);
-  long far = mesh_to_surface(s, m, tol, 3000);
-  snprintf(buf, sizeof buf, "bored: %s: 3000 triangle points within the "
-           "tolerance of the surface (%ld not)", name, far);
-  CHECK(buf, far == 0);
+  volume_and_surface("bored", name, s, m, &rep, vol, tol);
   mesh_free(m);
   scene_free(s);
 }
