@@ -1884,9 +1884,14 @@ static const Scene *prune_cell(Mesher *m, int level, const double lo[3],
 
 /* ---- planes that do not reach the solid in a sharp cell --------------- */
 
-/* The most planes of one intersection cell_redundant takes (the triples
-   of its planes and the box's are tried: C(30, 3) = 4060). */
-#define RED_MAX 24
+/* The most planes of one intersection cell_redundant takes (each pair of
+   its planes and the box's, clipped by every other: 134^3 / 2, some 1.2
+   million steps at most). 24 before: near the side of a prism of n sides
+   the infinite planes of about n sqrt(1.7 s) / pi of them cross a cell of
+   side s, so a 400-sided prism's cells had to shrink to 0.02 before they
+   were pruned (111,025 cells, 11 s; a 1000-sided one 108 s); with 128,
+   777 cells and 0.7 s, and 6,185 cells and 5.5 s (bench/NOTES.md). */
+#define RED_MAX 128
 
 /* Whether some pair of the np planes n . p = d + off (the first six the
    box's faces, no pair of two of them) meets on a segment inside every
