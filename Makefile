@@ -22,8 +22,8 @@ OPT     ?= -O2
 DEB_PKGS := pkg-config libreadline-dev libgc-dev libpng-dev libopenexr-dev \
             libmpfr-dev libgmp-dev tmux clang hugs libchafa-dev libglib2.0-dev \
             libmicrohttpd-dev parallel openexr python3-yaml libzip-dev \
-            libisal-dev zlib1g-dev
-PC_PKGS  := readline bdw-gc libpng OpenEXR libzip libisal zlib gmp
+            zlib1g-dev
+PC_PKGS  := readline bdw-gc libpng OpenEXR libzip zlib gmp
 
 WARN   := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
           -Wmissing-prototypes -Wno-unused-parameter

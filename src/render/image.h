@@ -2,7 +2,7 @@
  * linear floating-point RGBA (premultiplied by alpha, as OpenEXR expects)
  * and optional AOV planes (distance Z, normal N, root-finder cost); the
  * writers turn it into OpenEXR (OpenEXR C library), PNG (libpng's chunks,
- * the pixels compressed by ISA-L's igzip on threads) or PPM, chosen by the
+ * the pixels compressed by zlib in pieces on threads) or PPM, chosen by the
  * file name's extension, and the readers bring EXR and PNG back for tests
  * and reference-image comparison.
  *

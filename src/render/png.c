@@ -7,7 +7,6 @@
 #include "render/image.h"
 
 #include <errno.h>
-#include <isa-l/igzip_lib.h>
 #include <png.h>
 #include <pthread.h>
 #include <setjmp.h>
@@ -55,15 +54,23 @@ static void png_flush_data(png_structp png) {
  *
  * The rows are cut into pieces of about PNG_PIECE_BYTES of filtered data,
  * a cut that depends on the image alone. Each piece is filtered and
- * compressed on its own (ISA-L's igzip, level 1: several times faster
- * than zlib's fastest level, at about zlib level 3's size on rendered
- * pictures) into raw deflate blocks ending on a byte boundary, the last
+ * compressed on its own (zlib, level 1) into raw deflate blocks ending on
+ * a byte boundary (a full flush), the last
  * piece's block final: one after another they are one deflate stream, as
  * pigz joins its pieces. The Adler-32s of the pieces are joined with
  * zlib's adler32_combine. Threads take the pieces from a counter, and a
  * piece's bytes depend on the piece alone, so the file is the same bytes
  * on any number of threads. Each piece is one IDAT
- * chunk (the first with the zlib header, the last with the Adler-32). */
+ * chunk (the first with the zlib header, the last with the Adler-32).
+ *
+ * Until 2026-11-29 the pieces were compressed by ISA-L's igzip (level 1,
+ * about 4 times faster), but igzip 2.30's stateless call gives other
+ * (valid) bytes for the same piece depending on where its stream struct
+ * lies in memory (one 64 KiB block of addresses in a few megabytes, in
+ * about 1 process in 50; besides fields its init leaves unset), so a
+ * helper thread now and then wrote other bytes than the caller would:
+ * files differed with the thread count, and merged parts from the single
+ * render. zlib's deflate is a function of its input and settings alone. */
 
 #ifndef PNG_PIECE_BYTES
 #define PNG_PIECE_BYTES (128 * 1024)
@@ -103,7 +110,8 @@ typedef struct {
 static Piece taken; /* the mark of a piece the caller has taken over */
 
 typedef struct {
-  unsigned char *in, *prev, *cur, *level_buf;
+  unsigned char *in, *prev, *cur;
+  z_stream *z; /* raw deflate, level 1; reset for each piece */
 } Scratch;
 
 /* The Up filter on every row: each byte less the one above it (0 above
@@ -165,33 +173,33 @@ static int compress_piece(Idat *d, int k, int helper, Scratch *s) {
   size_t in_len = rb * (size_t)(y1 - y0);
   int first = k == 0, last = k == d->npieces - 1;
   size_t head = first ? 2 : 0, tail = last ? 4 : 0;
-  /* room for the input in stored blocks, igzip's worst case */
-  size_t cap = in_len + 5 * (in_len / 65535 + 1) + 64 + head + tail;
+  /* zlib's bound for the input, and a full flush's empty stored block */
+  size_t cap = deflateBound(s->z, (uLong)in_len) + 16 + head + tail;
   Piece *p = malloc(sizeof *p);
   unsigned char *out = p ? malloc(cap) : NULL;
   if (!out) {
     free(p);
     return -1;
   }
-  struct isal_zstream z;
-  isal_deflate_stateless_init(&z);
-  z.level = 1;
-  z.level_buf = s->level_buf;
-  z.level_buf_size = ISAL_DEF_LVL1_DEFAULT;
-  z.gzip_flag = IGZIP_DEFLATE;
-  z.end_of_stream = (uint16_t)last;
-  z.flush = last ? NO_FLUSH : FULL_FLUSH; /* to a byte boundary */
-  z.next_in = s->in;
-  z.avail_in = (uint32_t)in_len;
-  z.next_out = out + head;
-  z.avail_out = (uint32_t)(cap - head - tail);
-  if (isal_deflate_stateless(&z) != COMP_OK) {
+  z_stream *z = s->z;
+  if (deflateReset(z) != Z_OK) {
     free(out);
     free(p);
     return -1;
   }
-  *p = (Piece){.out = out, .len = head + z.total_out + tail,
-               .in_len = in_len, .adler = isal_adler32(1, s->in, in_len)};
+  z->next_in = s->in;
+  z->avail_in = (uInt)in_len;
+  z->next_out = out + head;
+  z->avail_out = (uInt)(cap - head - tail);
+  int rc = deflate(z, last ? Z_FINISH : Z_FULL_FLUSH); /* to a byte boundary */
+  if (rc != (last ? Z_STREAM_END : Z_OK) || z->avail_in != 0) {
+    free(out);
+    free(p);
+    return -1;
+  }
+  *p = (Piece){.out = out, .len = head + (size_t)z->total_out + tail,
+               .in_len = in_len,
+               .adler = (uint32_t)adler32(1, s->in, (uInt)in_len)};
   Piece *none = NULL;
   if (!atomic_compare_exchange_strong(&d->done[k], &none, p)) {
     free(out); /* another thread's copy came first: the same bytes */
@@ -214,19 +222,28 @@ static void idat_release(Idat *d) {
   free(d);
 }
 
-static int scratch_new(Scratch *s, const Idat *d) {
-  *s = (Scratch){.in = malloc((d->pix_bytes + 1) * (size_t)d->piece_rows),
-                 .prev = malloc(d->pix_bytes),
-                 .cur = malloc(d->pix_bytes),
-                 .level_buf = malloc(ISAL_DEF_LVL1_DEFAULT)};
-  return s->in && s->prev && s->cur && s->level_buf ? 0 : -1;
-}
-
 static void scratch_free(Scratch *s) {
   free(s->in);
   free(s->prev);
   free(s->cur);
-  free(s->level_buf);
+  if (s->z) deflateEnd(s->z);
+  free(s->z);
+  *s = (Scratch){0};
+}
+
+static int scratch_new(Scratch *s, const Idat *d) {
+  *s = (Scratch){.in = malloc((d->pix_bytes + 1) * (size_t)d->piece_rows),
+                 .prev = malloc(d->pix_bytes),
+                 .cur = malloc(d->pix_bytes),
+                 .z = calloc(1, sizeof(z_stream))};
+  if (s->z && deflateInit2(s->z, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) !=
+                  Z_OK) {
+    free(s->z);
+    s->z = NULL;
+  }
+  if (s->in && s->prev && s->cur && s->z) return 0;
+  scratch_free(s);
+  return -1;
 }
 
 static void *idat_helper(void *arg) {

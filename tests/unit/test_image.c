@@ -720,7 +720,7 @@ static void test_exr_zip_no_gain(void) {
 
 /* ---- the PNG writer against libpng's own --------------------------------
  *
- * img_write_png compresses the rows itself (igzip, in pieces on threads)
+ * img_write_png compresses the rows itself (zlib, in pieces on threads)
  * and has libpng write only the chunks before them. The reference here is
  * the writer it replaced: libpng writing every row (its own filters and
  * zlib), the codes from img_srgb8_exact (the formula, not the table). The
@@ -883,6 +883,33 @@ static Image *writer_picture(int w, int h) {
   return im;
 }
 
+/* Fills the stack below the caller with 16-bit tens, then returns. A
+ * compressor that reads a field its init left unset (ISA-L igzip 2.30's
+ * hist_bits, which qcs used until 2026-11-29: a window of 2^10 instead of
+ * 32 KB, so other matches and other bytes) sees the tens where its frame
+ * lands next. */
+static __attribute__((noinline)) void dirty_stack(void) {
+  uint16_t junk[256 * 1024];
+  for (size_t i = 0; i < sizeof junk / sizeof *junk; i++) junk[i] = 10;
+  __asm__ volatile("" : : "r"(junk) : "memory");
+}
+
+/* The PNG's bytes depend on the picture alone: the same after the stack
+ * was filled with junk (with igzip they differed: on 1 test run in about
+ * 100 a helper thread's stack gave another window). */
+static void test_png_stack_independent(void) {
+  Image *im = writer_picture(1021, 129);
+  Buf clean = png_in_memory(im, 1, 1);
+  dirty_stack();
+  Buf dirty = png_in_memory(im, 1, 1);
+  CHECK("PNG bytes the same after the stack was filled with junk",
+        clean.p && dirty.p && clean.n == dirty.n &&
+            !memcmp(clean.p, dirty.p, clean.n));
+  free(clean.p);
+  free(dirty.p);
+  img_free(im);
+}
+
 static void test_png_writer(void) {
   static const int sizes[][2] = {{1, 1},    {2, 1},    {1, 2},   {3, 7},
                                  {31, 17},  {257, 300}, {600, 380},
@@ -1007,6 +1034,7 @@ int main(void) {
   check_prefix = "image";
   test_srgb8_table();
   test_png_writer();
+  test_png_stack_independent();
   snprintf(dir, sizeof dir, "/tmp/qcs-image-XXXXXX");
   if (!mkdtemp(dir)) {
     printf("FAIL image: mkdtemp: %s\n", strerror(errno));
