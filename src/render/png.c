@@ -66,8 +66,8 @@ static void png_flush_data(png_structp png) {
  * Until 2026-11-29 the pieces were compressed by ISA-L's igzip (level 1,
  * about 4 times faster), but igzip 2.30's stateless call gives other
  * (valid) bytes for the same piece depending on where its stream struct
- * lies in memory (one 64 KiB block of addresses in a few megabytes, in
- * about 1 process in 50; besides fields its init leaves unset), so a
+ * lies in memory (one 64 KiB block of addresses in 16 MiB scanned, in 1
+ * process in 50 to 150; besides a field its init leaves unset), so a
  * helper thread now and then wrote other bytes than the caller would:
  * files differed with the thread count, and merged parts from the single
  * render. zlib's deflate is a function of its input and settings alone. */
