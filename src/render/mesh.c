@@ -3972,6 +3972,316 @@ static int snap_cmp(const void *a, const void *b) {
   return x < y ? -1 : x > y;
 }
 
+/* What a sliver of the solid 1e-16 wide leaves once the second try's
+   near weld has joined its vertices (two prisms edge to edge, turned by
+   angles whose sines round: their edges all but on one line, the exact
+   pieces between them 1e-16 wide). Two triangles on the same three
+   vertices facing apart bound nothing: both dropped. A triangle whose
+   vertex b lies within g of its longest side c -> a (a cap: its three
+   vertices all but on one line) is flipped with the one triangle across
+   that side, (a, c, d) -> (a, b, d) and (b, c, d), which cover the same
+   ground but for the cap's height (in the certified bound). What is left
+   the closure and self-intersection checks judge. 0, or -1 out of
+   memory. */
+typedef struct {
+  int v[3], sg;
+  size_t t;
+} SlTri;
+
+static int sltri_cmp(const void *a, const void *b) {
+  const SlTri *x = a, *y = b;
+  for (int k = 0; k < 3; k++)
+    if (x->v[k] != y->v[k]) return x->v[k] < y->v[k] ? -1 : 1;
+  return x->sg - y->sg;
+}
+
+/* the distance of m's vertex d from the line through a and c (infinity
+   if they are one point) */
+static double line_dist(const Mesher *m, int a, int c, int d) {
+  const double *pa = m->v + 3 * (size_t)a, *pc = m->v + 3 * (size_t)c,
+               *pd = m->v + 3 * (size_t)d;
+  double u[3], w[3];
+  for (int k = 0; k < 3; k++) {
+    u[k] = pc[k] - pa[k];
+    w[k] = pd[k] - pa[k];
+  }
+  double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+  if (!(uu > 0)) return INFINITY;
+  double x[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                 u[0] * w[1] - u[1] * w[0]};
+  return sqrt((x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) / uu);
+}
+
+/* the height of m's vertex b over the line through a and c if its foot
+   lies strictly between them, else infinity */
+static double cap_height(const Mesher *m, int a, int b, int c) {
+  const double *pa = m->v + 3 * (size_t)a, *pb = m->v + 3 * (size_t)b,
+               *pc = m->v + 3 * (size_t)c;
+  double u[3], w[3];
+  for (int k = 0; k < 3; k++) {
+    u[k] = pc[k] - pa[k];
+    w[k] = pb[k] - pa[k];
+  }
+  double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+  double uw = u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
+  if (!(uu > 0) || !(uw > 0) || !(uw < uu)) return INFINITY;
+  double x[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                 u[0] * w[1] - u[1] * w[0]};
+  return sqrt((x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) / uu);
+}
+
+/* [*e0, *e1): the directed edges a -> b in ed (sorted, n of them) */
+static void edge_range(const SlTri *ed, size_t n, int a, int b, size_t *e0,
+                       size_t *e1) {
+  size_t lo = 0, hi = n;
+  SlTri key = {{a, b, 0}, 0, 0};
+  while (lo < hi) {
+    size_t mid = lo + (hi - lo) / 2;
+    if (sltri_cmp(&ed[mid], &key) < 0) lo = mid + 1;
+    else hi = mid;
+  }
+  *e0 = *e1 = lo;
+  while (*e1 < n && ed[*e1].v[0] == a && ed[*e1].v[1] == b) ++*e1;
+}
+
+/* the vertex of m's triangle t after its side a -> b */
+static int tri_third(const Mesher *m, size_t t, int a, int b) {
+  const int *v = m->t + 3 * t;
+  for (int q = 0; q < 3; q++)
+    if (v[q] == a && v[(q + 1) % 3] == b) return v[(q + 2) % 3];
+  return v[0] == a ? v[2] : v[0]; /* not reached: t has the side */
+}
+
+/* the part of vertex d - a across the line a -> c, as a unit vector in
+   w; 0 if d is on the line */
+static int wing(const Mesher *m, int a, int c, int d, double w[3]) {
+  const double *pa = m->v + 3 * (size_t)a, *pc = m->v + 3 * (size_t)c,
+               *pd = m->v + 3 * (size_t)d;
+  double u[3], x[3];
+  for (int k = 0; k < 3; k++) {
+    u[k] = pc[k] - pa[k];
+    x[k] = pd[k] - pa[k];
+  }
+  double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+  double ux = u[0] * x[0] + u[1] * x[1] + u[2] * x[2];
+  if (!(uu > 0)) return 0;
+  for (int k = 0; k < 3; k++) w[k] = x[k] - u[k] * (ux / uu);
+  double n = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  if (!(n > 0)) return 0;
+  for (int k = 0; k < 3; k++) w[k] /= n;
+  return 1;
+}
+
+/* how far d's wing lies turned about a -> c from the unit wing ref (right
+   handed, in (0, 2 pi]); infinity if d is on the line */
+static double wing_angle(const Mesher *m, int a, int c, int d,
+                         const double ref[3]) {
+  double w[3];
+  if (!wing(m, a, c, d, w)) return INFINITY;
+  const double *pa = m->v + 3 * (size_t)a, *pc = m->v + 3 * (size_t)c;
+  double u[3] = {pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]};
+  double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  double e2[3] = {(u[1] * ref[2] - u[2] * ref[1]) / un,
+                  (u[2] * ref[0] - u[0] * ref[2]) / un,
+                  (u[0] * ref[1] - u[1] * ref[0]) / un};
+  double ang = atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2],
+                     w[0] * ref[0] + w[1] * ref[1] + w[2] * ref[2]);
+  return ang > 0 ? ang : ang + 2 * M_PI;
+}
+
+/* a cap's long side at least this many times the near weld's distance */
+#define CAP_SIDE 1024
+/* caps on one vertex set taken out together, at most */
+#define SLIVER_GROUP 8
+
+static int drop_slivers(Mesher *m, double g) {
+  size_t nt = m->nt;
+  if (!nt) return 0;
+  SlTri *o = malloc(nt * sizeof *o);
+  if (!o) return -1;
+  for (size_t t = 0; t < nt; t++) {
+    int a = m->t[3 * t], b = m->t[3 * t + 1], c = m->t[3 * t + 2], sg = 1;
+    /* sorted, each swap turning the orientation over */
+    if (a > b) { int x = a; a = b; b = x; sg = -sg; }
+    if (b > c) { int x = b; b = c; c = x; sg = -sg; }
+    if (a > b) { int x = a; a = b; b = x; sg = -sg; }
+    o[t] = (SlTri){{a, b, c}, sg, t};
+  }
+  qsort(o, nt, sizeof *o, sltri_cmp);
+  unsigned char *gone = calloc(nt, 1);
+  if (!gone) {
+    free(o);
+    return -1;
+  }
+  long dropped = 0;
+  for (size_t i = 0; i < nt;) {
+    size_t j = i;
+    while (j < nt && !memcmp(o[j].v, o[i].v, sizeof o[i].v)) j++;
+    /* [i, j): one vertex set, those facing -1 first */
+    size_t neg = i;
+    while (neg < j && o[neg].sg < 0) neg++;
+    for (size_t x = i, y = neg; x < neg && y < j; x++, y++) {
+      gone[o[x].t] = gone[o[y].t] = 1;
+      dropped += 2;
+    }
+    i = j;
+  }
+  free(o);
+  if (dropped) {
+    size_t w = 0;
+    for (size_t t = 0; t < nt; t++)
+      if (!gone[t]) {
+        memmove(m->t + 3 * w, m->t + 3 * t, 3 * sizeof *m->t);
+        w++;
+      }
+    m->nt = nt = w;
+  }
+  free(gone);
+  /* the caps. Where two parts of the solid meet along the line, each
+     sheet can hold one, on the same three vertices facing the same way,
+     and as many triangles across its side a -> c: so the caps of one
+     (a, b, c) go together, taken out when there are exactly as many
+     triangles with the side a -> c, each of those split at b: (a, c, d)
+     -> (a, b, d) and (b, c, d), the second in a cap's place. Every
+     directed edge keeps its count but a -> c's and c -> a's, both down by
+     as many; the split triangles cover the same ground but for the caps'
+     heights (in the certified bound). A few passes: a split's triangles
+     are caps in their turn only where d is on the line too. */
+  double moved = 0;
+  long flips = 0;
+  int rc = 0;
+  SlTri *cap = NULL, *ed = NULL;
+  for (int pass = 0; pass < 8; pass++) {
+    size_t ncap = 0;
+    for (size_t t = 0; t < nt; t++) {
+      const int *tv = m->t + 3 * t;
+      int k = -1; /* the longest side, tv[k+2] -> tv[k], opposite tv[k+1] */
+      double best = -1;
+      for (int q = 0; q < 3; q++) {
+        double d = dist3(m->v + 3 * (size_t)tv[(q + 2) % 3], m->v + 3 * (size_t)tv[q]);
+        if (d > best) {
+          best = d;
+          k = (q + 1) % 3;
+        }
+      }
+      int b = tv[k], c = tv[(k + 1) % 3], a = tv[(k + 2) % 3];
+      double h = cap_height(m, a, b, c);
+      /* a long side, not a cluster of points a few g apart (the near
+         weld's distance: flips among them would go round) */
+      if (!(h <= g) || !(best > CAP_SIDE * g)) continue;
+      if (!cap && !(cap = malloc(nt * sizeof *cap))) {
+        rc = -1;
+        goto done;
+      }
+      if (h > moved) moved = h;
+      cap[ncap++] = (SlTri){{a, c, b}, 0, t};
+    }
+    if (!ncap) break;
+    /* every directed edge, by its ends, with its triangle */
+    if (!ed && !(ed = malloc(3 * nt * sizeof *ed))) {
+      rc = -1;
+      goto done;
+    }
+    for (size_t t = 0; t < nt; t++)
+      for (int q = 0; q < 3; q++)
+        ed[3 * t + (size_t)q] = (SlTri){{m->t[3 * t + (size_t)q],
+                                         m->t[3 * t + (size_t)(q + 1) % 3], 0},
+                                        0, t};
+    qsort(ed, 3 * nt, sizeof *ed, sltri_cmp);
+    qsort(cap, ncap, sizeof *cap, sltri_cmp);
+    int any = 0;
+    for (size_t i = 0; i < ncap;) {
+      size_t j = i;
+      while (j < ncap && !memcmp(cap[j].v, cap[i].v, sizeof cap[i].v)) j++;
+      int a = cap[i].v[0], c = cap[i].v[1], b = cap[i].v[2];
+      size_t e0, e1; /* the triangles with the side a -> c */
+      edge_range(ed, 3 * nt, a, c, &e0, &e1);
+      int ok = e1 - e0 >= j - i && j - i <= SLIVER_GROUP;
+      for (size_t x = e0; ok && x < e1; x++) {
+        const int *nv = m->t + 3 * ed[x].t;
+        for (int q = 0; q < 3; q++)
+          if (nv[q] == b || nv[q] < 0) ok = 0; /* a cap, or changed */
+      }
+      for (size_t y = i; ok && y < j; y++)
+        if (m->t[3 * cap[y].t] < 0) ok = 0;
+      size_t pick[SLIVER_GROUP];
+      if (ok && e1 - e0 == j - i) {
+        for (size_t y = i; y < j; y++) pick[y - i] = ed[e0 + y - i].t;
+      } else if (ok) {
+        /* more triangles across than caps: parts meeting along the line.
+           Each cap goes with the triangle across that closes its part's
+           wedge: turning about a -> c from the triangle beside the cap
+           (the one on its side b -> a), into the solid, the first
+           triangle along the line met */
+        size_t r0, r1;
+        edge_range(ed, 3 * nt, c, a, &r0, &r1);
+        for (size_t y = i; ok && y < j; y++) {
+          size_t f0, f1;
+          edge_range(ed, 3 * nt, b, a, &f0, &f1);
+          if (f1 - f0 != 1 || m->t[3 * ed[f0].t] < 0) {
+            ok = 0;
+            break;
+          }
+          double ref[3];
+          if (!wing(m, a, c, tri_third(m, ed[f0].t, b, a), ref)) {
+            ok = 0;
+            break;
+          }
+          double best = INFINITY;
+          long who = -1; /* an index in [e0, e1), or -2: one facing back */
+          for (size_t x = e0; x < e1; x++) {
+            double ang = wing_angle(m, a, c, tri_third(m, ed[x].t, a, c), ref);
+            if (ang < best) best = ang, who = (long)x;
+            else if (ang == best) who = -3;
+          }
+          for (size_t x = r0; x < r1; x++) {
+            int iscap = 0;
+            for (size_t z = i; z < j; z++) iscap |= ed[x].t == cap[z].t;
+            if (iscap) continue;
+            double ang = wing_angle(m, a, c, tri_third(m, ed[x].t, c, a), ref);
+            if (ang < best) best = ang, who = -2;
+            else if (ang == best) who = -3;
+          }
+          if (who < 0 || !(best < INFINITY)) {
+            ok = 0;
+            break;
+          }
+          pick[y - i] = ed[who].t;
+          for (size_t z = i; z < y; z++)
+            if (pick[z - i] == pick[y - i]) ok = 0;
+        }
+      }
+      /* a triangle across whose third vertex is on the line too would
+         leave two caps for one: the pieces would be split back and forth
+         (several vertices of a line of contact), left to the checks */
+      for (size_t y = i; ok && y < j; y++)
+        if (!(line_dist(m, a, c, tri_third(m, pick[y - i], a, c)) > g)) ok = 0;
+      if (ok) {
+        for (size_t y = i; y < j; y++) {
+          int *nv = m->t + 3 * pick[y - i], d = tri_third(m, pick[y - i], a, c);
+          int *cv = m->t + 3 * cap[y].t;
+          /* marked until the pass ends (restored below) */
+          nv[0] = -1 - a, nv[1] = b, nv[2] = d;
+          cv[0] = -1 - b, cv[1] = c, cv[2] = d;
+          flips++;
+        }
+        any = 1;
+      }
+      i = j;
+    }
+    for (size_t t = 0; t < 3 * nt; t += 3)
+      if (m->t[t] < 0) m->t[t] = -1 - m->t[t];
+    if (!any) break;
+  }
+done:
+  free(cap);
+  free(ed);
+  m->rep->sliver_pairs += dropped / 2;
+  m->rep->sliver_caps += flips;
+  m->rep->certified += moved;
+  return rc;
+}
+
 static int weld(Mesher *m) {
   if (!m->nv) return 0;
   double g = ldexp(m->h, MAX_DEPTH) * WELD;
@@ -4056,6 +4366,7 @@ static int weld(Mesher *m) {
   m->nv = nv;
   m->nt = w;
   free(par);
+  if (m->near_weld && drop_slivers(m, g) < 0) return -1;
   return contacts(m);
 }
 

@@ -119,6 +119,11 @@ typedef struct MeshReport {
                               cell_redundant) */
   long welded;             /* triangles of no area dropped where the
                               sharp cells met a degenerate point */
+  long sliver_pairs;       /* in the second try, pairs of triangles on
+                              one vertex set facing apart dropped, and */
+  long sliver_caps;        /* caps (three vertices all but on one line)
+                              flipped away: a sliver 1e-16 wide once its
+                              vertices were joined (mesh.c, drop_slivers) */
   long snapped;            /* planes moved onto another that is the same
                               plane but for rounding (mesh.c, snap_planes) */
   double snap_moved;       /* the most one moved in the object's box (in

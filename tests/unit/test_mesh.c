@@ -2884,6 +2884,27 @@ static void touching_prisms(void) {
     {"a row of three 8-sided prisms, corner to corner",
      "Union (Union (CylinderWith [Sides 8] 0.5 1) (Shift (1,0,0) (CylinderWith "
      "[Sides 8] 0.5 1))) (Shift (2,0,0) (CylinderWith [Sides 8] 0.5 1))", {8, 8, 8}, 0.02},
+    /* turned about two axes by angles whose sines round, the edges all but
+       on one line: the second try's near weld left the pieces between them
+       (1e-16 wide) as triangles on one vertex set facing apart and caps
+       with three vertices on the line; the sharp cells were given up
+       (89,690 triangles of genus 24 at 0.02, 183,744 of genus 61 at 0.01) */
+    {"a 16-sided prism beside a turned 9-sided one, corner to corner, rotated twice",
+     "Rotate \"z\" 30 (Rotate \"x\" 15 (Union (CylinderWith [Sides 16] 0.5 1) "
+     "(Shift (1,0,0) (Rotate \"y\" 20.0 (CylinderWith [Sides 9] 0.5 1)))))",
+     {16, 9, 0}, 0.02},
+    {"a 16-sided prism beside a turned 9-sided one, rotated twice, at 0.01",
+     "Rotate \"z\" 30 (Rotate \"x\" 15 (Union (CylinderWith [Sides 16] 0.5 1) "
+     "(Shift (1,0,0) (Rotate \"y\" 20.0 (CylinderWith [Sides 9] 0.5 1)))))",
+     {16, 9, 0}, 0.01},
+    /* a corner on a face: the caps of the two parts along the line, each
+       split with the triangle that closes its own part's wedge (260,452
+       triangles of genus 7 before) */
+    {"a 22-sided prism's corner on a 7-sided one's face, rotated twice",
+     "Rotate \"z\" 15.368652287845068 (Rotate \"x\" 25.357143557067715 (Union "
+     "(CylinderWith [Sides 22] 0.5 1) (Shift (0.9504844339512095,0,0) (Rotate "
+     "\"y\" 51.428571428571416 (CylinderWith [Sides 7] 0.5 1)))))",
+     {22, 7, 0}, 0.02},
   };
   for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
     const double tol = objs[k].tol, r = 0.5;
