@@ -3978,10 +3978,11 @@ static int snap_cmp(const void *a, const void *b) {
    pieces between them 1e-16 wide). Two triangles on the same three
    vertices facing apart bound nothing: both dropped. A triangle whose
    vertex b lies within g of its longest side c -> a (a cap: its three
-   vertices all but on one line) is flipped with the one triangle across
-   that side, (a, c, d) -> (a, b, d) and (b, c, d), which cover the same
-   ground but for the cap's height (in the certified bound). What is left
-   the closure and self-intersection checks judge. 0, or -1 out of
+   vertices all but on one line) is removed and a triangle across that
+   side split at b, (a, c, d) -> (a, b, d) and (b, c, d), which cover
+   the same ground but for the cap's height (in the certified bound; the
+   choice of the triangle where several lie across is below). What is
+   left the closure and self-intersection checks judge. 0, or -1 out of
    memory. */
 typedef struct {
   int v[3], sg;
