@@ -61,15 +61,17 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "(sides decided exactly, ties by a symbolic perturbation; "
             "edges shorter than 2^-46 of the object's size collapsed, the "
             "certified bound grown by the largest move)\n", r->welded);
-  if (r->sliver_pairs || r->sliver_caps)
+  if (r->sliver_pairs || r->sliver_caps || r->sliver_holes)
     fprintf(f, "  slivers: where planes all but meet in a line, once their "
-            "vertices within 2^-46 of the object's size were joined, %ld "
-            "pair%s of triangles on the same vertices facing apart dropped "
-            "and %ld triangle%s with three vertices all but on one line "
-            "taken out, the triangle across each one's long side split at "
-            "its middle vertex (the certified bound grown by the largest "
+            "vertices within 2^-44 of the object's size were joined, %ld "
+            "pair%s of triangles on the same vertices facing apart dropped, "
+            "%ld triangle%s with three vertices all but on one line taken "
+            "out and the edges left along the line zipped (a triangle "
+            "across split at each vertex on its side), %ld hole%s along the "
+            "line closed (the certified bound grown by the largest "
             "height)\n", r->sliver_pairs, r->sliver_pairs == 1 ? "" : "s",
-            r->sliver_caps, r->sliver_caps == 1 ? "" : "s");
+            r->sliver_caps, r->sliver_caps == 1 ? "" : "s", r->sliver_holes,
+            r->sliver_holes == 1 ? "" : "s");
   if (r->snapped)
     fprintf(f, "  planes joined: %ld plane%s within 2^-46 of another (of "
             "the object's size) made that plane, faces glued face to face or "

@@ -30,6 +30,8 @@
 #define MAX_DEPTH 19       /* grid coordinates fit 20 bits */
 /* weld joins edges shorter than this (of the octree's side) */
 #define WELD 0x1p-46
+/* the second try's weld of vertices on no common edge: 2^-44 of the size */
+#define NEAR_WELD 4
 /* Cells where two surfaces, each one sheet, are not proven one sheet
    together split this many levels below the finest at most (walk). */
 #define TWO_LEVELS 2
@@ -4092,8 +4094,87 @@ static double wing_angle(const Mesher *m, int a, int c, int d,
 
 /* a cap's long side at least this many times the near weld's distance */
 #define CAP_SIDE 1024
-/* caps on one vertex set taken out together, at most */
-#define SLIVER_GROUP 8
+/* the zip's passes, and its open edges at most (more are not a
+   sliver's: left to the checks) */
+#define ZIP_PASSES 64
+#define ZIP_OPEN_MAX 4096
+/* triangles on one open edge split at once, at most */
+#define ZIP_FAN 8
+/* holes the zip leaves filled: at most so many vertices, all within
+   HOLE_LINE near weld distances of one line */
+#define HOLE_MAX 8
+#define HOLE_LINE 1024
+
+/* What the zip leaves: a hole whose open edges make a cycle of 3 to
+   HOLE_MAX vertices, each with one open edge leaving it, all within h of
+   the line through the two farthest apart (two caps' vertices 1e-13
+   apart, beyond the near weld's distance), closed by a fan from one end
+   of that line: slivers of the line's own, which the self-intersection
+   check judges. 0, or -1 out of memory. */
+static int fill_slivers(Mesher *m, double h, double *moved) {
+  size_t nt = m->nt, ne = 3 * nt, no = 0;
+  if (!nt) return 0;
+  SlTri *ed = malloc(ne * sizeof *ed);
+  int *next = NULL, rc = -1;
+  if (!ed) return -1;
+  for (size_t t = 0; t < nt; t++)
+    for (int q = 0; q < 3; q++)
+      ed[3 * t + (size_t)q] = (SlTri){{m->t[3 * t + (size_t)q],
+                                       m->t[3 * t + (size_t)(q + 1) % 3], 0},
+                                      0, t};
+  qsort(ed, ne, sizeof *ed, sltri_cmp);
+  if (!(next = malloc(m->nv * sizeof *next))) goto done;
+  for (size_t i = 0; i < m->nv; i++) next[i] = -1;
+  /* next[p]: the end of p's one open edge; -2 if it has several, or an
+     open edge of several triangles */
+  for (size_t x = 0; x < ne;) {
+    size_t y = x, r0, r1;
+    while (y < ne && ed[y].v[0] == ed[x].v[0] && ed[y].v[1] == ed[x].v[1]) y++;
+    edge_range(ed, ne, ed[x].v[1], ed[x].v[0], &r0, &r1);
+    if (y - x > r1 - r0) {
+      int p = ed[x].v[0];
+      next[p] = next[p] == -1 && y - x == 1 && r1 == r0 ? ed[x].v[1] : -2;
+      no++;
+    }
+    x = y;
+  }
+  for (size_t s = 0; no && s < m->nv; s++) {
+    int cyc[HOLE_MAX], k = 0, p = (int)s;
+    while (k < HOLE_MAX && p >= 0 && (k == 0 || p != (int)s)) {
+      cyc[k++] = p;
+      p = next[p];
+    }
+    if (p != (int)s || k < 3) continue;
+    /* the two farthest apart, and every vertex within h of their line */
+    int fa = 0, fb = 1;
+    double far = -1;
+    for (int i = 0; i < k; i++)
+      for (int j = i + 1; j < k; j++) {
+        double d = dist3(m->v + 3 * (size_t)cyc[i], m->v + 3 * (size_t)cyc[j]);
+        if (d > far) far = d, fa = i, fb = j;
+      }
+    double hi = 0;
+    for (int i = 0; i < k; i++)
+      if (i != fa && i != fb) hi = fmax(hi, line_dist(m, cyc[fa], cyc[fb], cyc[i]));
+    if (!(hi <= h)) continue;
+    if (grow((void **)&m->t, &m->capt, 3 * (m->nt + (size_t)k - 2), sizeof *m->t) < 0)
+      goto done;
+    /* the fan from cyc[fa]: (c0, c[i+1], c[i]) holds the reverse of each
+       open edge c[i] -> c[i+1] */
+    for (int i = 1; i + 1 < k; i++) {
+      int *tv = m->t + 3 * m->nt++;
+      tv[0] = cyc[fa], tv[1] = cyc[(fa + i + 1) % k], tv[2] = cyc[(fa + i) % k];
+    }
+    for (int i = 0; i < k; i++) next[cyc[i]] = -2;
+    if (hi > *moved) *moved = hi;
+    m->rep->sliver_holes++;
+  }
+  rc = 0;
+done:
+  free(ed);
+  free(next);
+  return rc;
+}
 
 static int drop_slivers(Mesher *m, double g) {
   size_t nt = m->nt;
@@ -4138,22 +4219,27 @@ static int drop_slivers(Mesher *m, double g) {
     m->nt = nt = w;
   }
   free(gone);
-  /* the caps. Where two parts of the solid meet along the line, each
-     sheet can hold one, on the same three vertices facing the same way,
-     and as many triangles across its side a -> c: so the caps of one
-     (a, b, c) go together, taken out when there are exactly as many
-     triangles with the side a -> c, each of those split at b: (a, c, d)
-     -> (a, b, d) and (b, c, d), the second in a cap's place. Every
-     directed edge keeps its count but a -> c's and c -> a's, both down by
-     as many; the split triangles cover the same ground but for the caps'
-     heights (in the certified bound). A few passes: a split's triangles
-     are caps in their turn only where d is on the line too. */
+  /* the caps, removed. Each leaves the sides across its own as directed
+     edges that outnumber their reverses: open edges along the line, with
+     the caps' middle vertices on them. Then, while an open edge p -> q
+     has an open edge's end v on it (within g of the segment, strictly
+     between), a triangle with the side p -> q is split at v: (p, q, d)
+     -> (p, v, d) and (v, q, d), covering the same ground but for v's
+     distance (in the certified bound); the nearest such v to p first.
+     Where several triangles have the side (two parts meet along the
+     line), the one split is the one that closes the wedge of the part
+     beside v: turning about p -> q from the triangle of an open edge
+     leaving v, into its solid, the first triangle along the line met.
+     No split makes a cap (the triangles left have their third vertex off
+     the line, and v is on it), so the open edges only get shorter. */
   double moved = 0;
-  long flips = 0;
+  long caps = 0;
   int rc = 0;
-  SlTri *cap = NULL, *ed = NULL;
-  for (int pass = 0; pass < 8; pass++) {
-    size_t ncap = 0;
+  SlTri *ed = NULL;
+  size_t *open = NULL;
+  int *ov = NULL;
+  {
+    size_t w = 0;
     for (size_t t = 0; t < nt; t++) {
       const int *tv = m->t + 3 * t;
       int k = -1; /* the longest side, tv[k+2] -> tv[k], opposite tv[k+1] */
@@ -4165,120 +4251,136 @@ static int drop_slivers(Mesher *m, double g) {
           k = (q + 1) % 3;
         }
       }
-      int b = tv[k], c = tv[(k + 1) % 3], a = tv[(k + 2) % 3];
-      double h = cap_height(m, a, b, c);
-      /* a long side, not a cluster of points a few g apart (the near
-         weld's distance: flips among them would go round) */
-      if (!(h <= g) || !(best > CAP_SIDE * g)) continue;
-      if (!cap && !(cap = malloc(nt * sizeof *cap))) {
-        rc = -1;
-        goto done;
+      double h = cap_height(m, tv[(k + 2) % 3], tv[k], tv[(k + 1) % 3]);
+      /* a long side, not a cluster of points a few g apart */
+      if (h <= g && best > CAP_SIDE * g) {
+        if (h > moved) moved = h;
+        caps++;
+        continue;
       }
-      if (h > moved) moved = h;
-      cap[ncap++] = (SlTri){{a, c, b}, 0, t};
+      memmove(m->t + 3 * w, tv, 3 * sizeof *m->t);
+      w++;
     }
-    if (!ncap) break;
-    /* every directed edge, by its ends, with its triangle */
-    if (!ed && !(ed = malloc(3 * nt * sizeof *ed))) {
-      rc = -1;
-      goto done;
-    }
+    m->nt = nt = w;
+  }
+  for (int pass = 0; caps && pass < ZIP_PASSES; pass++) {
+    free(ed);
+    free(open);
+    free(ov);
+    open = NULL;
+    ov = NULL;
+    if (!(ed = malloc(3 * (nt ? nt : 1) * sizeof *ed))) goto oom;
     for (size_t t = 0; t < nt; t++)
       for (int q = 0; q < 3; q++)
         ed[3 * t + (size_t)q] = (SlTri){{m->t[3 * t + (size_t)q],
                                          m->t[3 * t + (size_t)(q + 1) % 3], 0},
                                         0, t};
-    qsort(ed, 3 * nt, sizeof *ed, sltri_cmp);
-    qsort(cap, ncap, sizeof *cap, sltri_cmp);
+    size_t ne = 3 * nt, no = 0, nov = 0;
+    qsort(ed, ne, sizeof *ed, sltri_cmp);
+    /* the open edges (the first of each run of one directed edge) */
+    for (size_t x = 0; x < ne;) {
+      size_t y = x, r0, r1;
+      while (y < ne && ed[y].v[0] == ed[x].v[0] && ed[y].v[1] == ed[x].v[1]) y++;
+      edge_range(ed, ne, ed[x].v[1], ed[x].v[0], &r0, &r1);
+      if (y - x > r1 - r0) {
+        if (no == ZIP_OPEN_MAX) goto done; /* not a sliver's: the checks */
+        if (!open && !(open = malloc(ZIP_OPEN_MAX * sizeof *open))) goto oom;
+        open[no++] = x;
+      }
+      x = y;
+    }
+    if (!no) break;
+    if (!(ov = malloc(2 * no * sizeof *ov))) goto oom;
+    for (size_t oi = 0; oi < no; oi++) {
+      ov[nov++] = ed[open[oi]].v[0];
+      ov[nov++] = ed[open[oi]].v[1];
+    }
+    unsigned char *hit = calloc(nt ? nt : 1, 1); /* split in this pass */
+    if (!hit) goto oom;
     int any = 0;
-    for (size_t i = 0; i < ncap;) {
-      size_t j = i;
-      while (j < ncap && !memcmp(cap[j].v, cap[i].v, sizeof cap[i].v)) j++;
-      int a = cap[i].v[0], c = cap[i].v[1], b = cap[i].v[2];
-      size_t e0, e1; /* the triangles with the side a -> c */
-      edge_range(ed, 3 * nt, a, c, &e0, &e1);
-      int ok = e1 - e0 >= j - i && j - i <= SLIVER_GROUP;
-      for (size_t x = e0; ok && x < e1; x++) {
-        const int *nv = m->t + 3 * ed[x].t;
-        for (int q = 0; q < 3; q++)
-          if (nv[q] == b || nv[q] < 0) ok = 0; /* a cap, or changed */
+    for (size_t oi = 0; oi < no; oi++) {
+      int p = ed[open[oi]].v[0], q = ed[open[oi]].v[1];
+      const double *pp = m->v + 3 * (size_t)p, *pq = m->v + 3 * (size_t)q;
+      double u[3] = {pq[0] - pp[0], pq[1] - pp[1], pq[2] - pp[2]};
+      double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+      int v = -1;
+      double vs = INFINITY;
+      for (size_t z = 0; z < nov; z++) {
+        int x = ov[z];
+        if (x == p || x == q || !(cap_height(m, p, x, q) <= g)) continue;
+        const double *px = m->v + 3 * (size_t)x;
+        double sx = (u[0] * (px[0] - pp[0]) + u[1] * (px[1] - pp[1]) +
+                     u[2] * (px[2] - pp[2])) / uu;
+        if (sx < vs) vs = sx, v = x;
       }
-      for (size_t y = i; ok && y < j; y++)
-        if (m->t[3 * cap[y].t] < 0) ok = 0;
-      size_t pick[SLIVER_GROUP];
-      if (ok && e1 - e0 == j - i) {
-        for (size_t y = i; y < j; y++) pick[y - i] = ed[e0 + y - i].t;
-      } else if (ok) {
-        /* more triangles across than caps: parts meeting along the line.
-           Each cap goes with the triangle across that closes its part's
-           wedge: turning about a -> c from the triangle beside the cap
-           (the one on its side b -> a), into the solid, the first
-           triangle along the line met */
-        size_t r0, r1;
-        edge_range(ed, 3 * nt, c, a, &r0, &r1);
-        for (size_t y = i; ok && y < j; y++) {
-          size_t f0, f1;
-          edge_range(ed, 3 * nt, b, a, &f0, &f1);
-          if (f1 - f0 != 1 || m->t[3 * ed[f0].t] < 0) {
-            ok = 0;
-            break;
+      if (v < 0) continue;
+      size_t e0, e1, r0, r1, np = 0;
+      edge_range(ed, ne, p, q, &e0, &e1);
+      edge_range(ed, ne, q, p, &r0, &r1);
+      size_t picks[ZIP_FAN];
+      if (r1 == r0) {
+        /* no side q -> p left: every triangle with p -> q */
+        for (size_t x = e0; x < e1 && np < ZIP_FAN; x++) picks[np++] = ed[x].t;
+      } else {
+        /* each triangle of an open edge leaving v along the line picks
+           the one that closes its part's wedge */
+        for (size_t o2 = 0; o2 < no; o2++) {
+          size_t x = open[o2];
+          if (ed[x].v[0] != v || !(line_dist(m, p, q, ed[x].v[1]) <= g)) continue;
+          int fy = ed[x].v[1];
+          for (size_t x1 = x; x1 < ne && ed[x1].v[0] == v && ed[x1].v[1] == fy; x1++) {
+            double ref[3];
+            if (!wing(m, p, q, tri_third(m, ed[x1].t, v, fy), ref)) continue;
+            double bestang = INFINITY;
+            long pick = -1;
+            for (size_t y = e0; y < e1; y++) {
+              double ang = wing_angle(m, p, q, tri_third(m, ed[y].t, p, q), ref);
+              if (ang < bestang) bestang = ang, pick = (long)ed[y].t;
+              else if (ang == bestang) pick = -1;
+            }
+            for (size_t y = r0; y < r1; y++) {
+              double ang = wing_angle(m, p, q, tri_third(m, ed[y].t, q, p), ref);
+              if (ang <= bestang) bestang = ang, pick = -1;
+            }
+            int seen = pick < 0;
+            for (size_t z = 0; z < np; z++) seen |= picks[z] == (size_t)pick;
+            if (!seen && np < ZIP_FAN) picks[np++] = (size_t)pick;
           }
-          double ref[3];
-          if (!wing(m, a, c, tri_third(m, ed[f0].t, b, a), ref)) {
-            ok = 0;
-            break;
-          }
-          double best = INFINITY;
-          long who = -1; /* an index in [e0, e1), or -2: one facing back */
-          for (size_t x = e0; x < e1; x++) {
-            double ang = wing_angle(m, a, c, tri_third(m, ed[x].t, a, c), ref);
-            if (ang < best) best = ang, who = (long)x;
-            else if (ang == best) who = -3;
-          }
-          for (size_t x = r0; x < r1; x++) {
-            int iscap = 0;
-            for (size_t z = i; z < j; z++) iscap |= ed[x].t == cap[z].t;
-            if (iscap) continue;
-            double ang = wing_angle(m, a, c, tri_third(m, ed[x].t, c, a), ref);
-            if (ang < best) best = ang, who = -2;
-            else if (ang == best) who = -3;
-          }
-          if (who < 0 || !(best < INFINITY)) {
-            ok = 0;
-            break;
-          }
-          pick[y - i] = ed[who].t;
-          for (size_t z = i; z < y; z++)
-            if (pick[z - i] == pick[y - i]) ok = 0;
         }
       }
-      /* a triangle across whose third vertex is on the line too would
-         leave two caps for one: the pieces would be split back and forth
-         (several vertices of a line of contact), left to the checks */
-      for (size_t y = i; ok && y < j; y++)
-        if (!(line_dist(m, a, c, tri_third(m, pick[y - i], a, c)) > g)) ok = 0;
-      if (ok) {
-        for (size_t y = i; y < j; y++) {
-          int *nv = m->t + 3 * pick[y - i], d = tri_third(m, pick[y - i], a, c);
-          int *cv = m->t + 3 * cap[y].t;
-          /* marked until the pass ends (restored below) */
-          nv[0] = -1 - a, nv[1] = b, nv[2] = d;
-          cv[0] = -1 - b, cv[1] = c, cv[2] = d;
-          flips++;
+      for (size_t z = 0; z < np; z++) {
+        size_t pick = picks[z];
+        if (hit[pick]) continue;
+        int d = tri_third(m, pick, p, q);
+        if (!(line_dist(m, p, q, d) > g)) continue;
+        if (grow((void **)&m->t, &m->capt, 3 * (nt + 1), sizeof *m->t) < 0) {
+          free(hit);
+          goto oom;
         }
+        int *tv = m->t + 3 * pick;
+        tv[0] = p, tv[1] = v, tv[2] = d;
+        m->t[3 * nt] = v, m->t[3 * nt + 1] = q, m->t[3 * nt + 2] = d;
+        nt++;
+        hit[pick] = 1;
+        double dv = line_dist(m, p, q, v);
+        if (dv > moved) moved = dv;
         any = 1;
       }
-      i = j;
     }
-    for (size_t t = 0; t < 3 * nt; t += 3)
-      if (m->t[t] < 0) m->t[t] = -1 - m->t[t];
+    free(hit);
+    m->nt = nt;
     if (!any) break;
   }
+  if (caps && fill_slivers(m, g * HOLE_LINE, &moved) < 0) goto oom;
+  goto done;
+oom:
+  rc = -1;
 done:
-  free(cap);
   free(ed);
+  free(open);
+  free(ov);
   m->rep->sliver_pairs += dropped / 2;
-  m->rep->sliver_caps += flips;
+  m->rep->sliver_caps += caps;
   m->rep->certified += moved;
   return rc;
 }
@@ -4303,6 +4405,9 @@ static int weld(Mesher *m) {
       moved = 1;
     }
   if (m->near_weld) {
+    /* wider than an edge's: where the turned planes of a line of contact
+       meet, the exact points cluster within 1e-13 (NEAR_WELD) */
+    double gn = g * NEAR_WELD;
     SnapEnt *o = malloc(m->nv * sizeof *o);
     if (!o) {
       free(par);
@@ -4311,9 +4416,9 @@ static int weld(Mesher *m) {
     for (size_t i = 0; i < m->nv; i++) o[i] = (SnapEnt){m->v[3 * i], (int)i, 0};
     qsort(o, m->nv, sizeof *o, snap_cmp);
     for (size_t i = 0; i < m->nv; i++)
-      for (size_t j = i + 1; j < m->nv && o[j].key - o[i].key <= g; j++) {
+      for (size_t j = i + 1; j < m->nv && o[j].key - o[i].key <= gn; j++) {
         const double *x = m->v + 3 * (size_t)o[i].x, *y = m->v + 3 * (size_t)o[j].x;
-        if (!(fabs(x[1] - y[1]) <= g && fabs(x[2] - y[2]) <= g)) continue;
+        if (!(fabs(x[1] - y[1]) <= gn && fabs(x[2] - y[2]) <= gn)) continue;
         int ra = find(par, o[i].x), rb = find(par, o[j].x);
         if (ra == rb) continue;
         par[ra > rb ? ra : rb] = ra < rb ? ra : rb;

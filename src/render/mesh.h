@@ -124,6 +124,8 @@ typedef struct MeshReport {
   long sliver_caps;        /* caps (three vertices all but on one line)
                               flipped away: a sliver 1e-16 wide once its
                               vertices were joined (mesh.c, drop_slivers) */
+  long sliver_holes;       /* holes all but on one line the zip left,
+                              closed by a fan (mesh.c, fill_slivers) */
   long snapped;            /* planes moved onto another that is the same
                               plane but for rounding (mesh.c, snap_planes) */
   double snap_moved;       /* the most one moved in the object's box (in

@@ -2905,6 +2905,15 @@ static void touching_prisms(void) {
      "(CylinderWith [Sides 22] 0.5 1) (Shift (0.9504844339512095,0,0) (Rotate "
      "\"y\" 51.428571428571416 (CylinderWith [Sides 7] 0.5 1)))))",
      {22, 7, 0}, 0.02},
+    /* turned about three axes: the exact points where the four planes
+       meet cluster within 1e-13, beyond the edge weld's 2^-46; the caps
+       then form holes along the line (87,448 triangles of genus 18, 12
+       sharp cells given up, before the zip and the near weld at 2^-44) */
+    {"a 22-sided prism beside a turned 23-sided one, corner to corner, rotated thrice",
+     "Rotate \"y\" 45 (Rotate \"x\" 37.95912375652199 (Rotate \"z\" 7 (Union "
+     "(CylinderWith [Sides 22] 0.5 1) (Shift (1,0,0) (Rotate \"y\" "
+     "7.826086956521737 (CylinderWith [Sides 23] 0.5 1))))))",
+     {22, 23, 0}, 0.02},
   };
   for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
     const double tol = objs[k].tol, r = 0.5;
