@@ -2715,9 +2715,14 @@ static int face(Mesher *m, int l, const int64_t q[3], int a, int s,
    for closure at the end; should two neighbours still leave a crack, the
    sharp cells there are meshed by their tetrahedra (sharp_apart) or, at
    last, the mesh is made again without sharp cells (mesh_scene). */
-#define PV_MAX 32
-#define PC_MAX 160
-#define LV_MAX 1024
+/* a piece's vertices (a tetrahedron's section, at most 4, cut by the
+   other 31 planes at most), the pieces of one plane's polygon (1 + 31 +
+   31 * 30 / 2 at most), a tetrahedron's vertices (4 corners, 6 edges
+   times 32 planes, 4 faces times 496 pairs, 4960 triples: 7140 at
+   most): for up to 32 planes (PL_MAX) */
+#define PV_MAX 40
+#define PC_MAX 700
+#define LV_MAX 8192
 
 typedef struct {
   int n;

@@ -75,7 +75,7 @@
 #include "scene/scene.h"
 
 /* The most distinct planes a sharp cell holds (meshed exactly). */
-#define MESH_PLANES_MAX 16
+#define MESH_PLANES_MAX 32
 
 typedef struct MeshSettings {
   double tol;              /* the requested error, scene units (> 0) */
@@ -122,8 +122,9 @@ typedef struct MeshReport {
   long sliver_pairs;       /* in the second try, pairs of triangles on
                               one vertex set facing apart dropped, and */
   long sliver_caps;        /* caps (three vertices all but on one line)
-                              flipped away: a sliver 1e-16 wide once its
-                              vertices were joined (mesh.c, drop_slivers) */
+                              taken out and the line zipped: a sliver
+                              1e-16 wide once its vertices were joined
+                              (mesh.c, drop_slivers) */
   long sliver_holes;       /* holes all but on one line the zip left,
                               closed by a fan (mesh.c, fill_slivers) */
   long snapped;            /* planes moved onto another that is the same

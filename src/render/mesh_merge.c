@@ -446,6 +446,71 @@ typedef struct {
   size_t cap, scap;
 } Loops;
 
+/* A directed edge and the region of its new triangle (-1: a triangle
+   kept as it was). */
+typedef struct {
+  uint64_t k;
+  int r;
+} DEdge;
+
+static int dedge_cmp(const void *x, const void *y) {
+  uint64_t a = ((const DEdge *)x)->k, b = ((const DEdge *)y)->k;
+  return a < b ? -1 : a > b;
+}
+
+/* After a pass: a directed edge used twice in the mesh it would make (the
+   triangles of the regions not merged and the new ones) is two sheets
+   along one line made one edge of four triangles: a region's diagonal
+   along a line of contact where another part's crease, its straight run
+   dropped, has the same ends (a prism's corner touching a box's top from
+   below: the top's diagonal and the bore's crease). The regions with a
+   new triangle there that lost straight vertices get them back (their
+   neighbours' sides too); if none did, those regions are not merged
+   (rbad). 1 when a region changed (another pass), 0 if none, -1 out of
+   memory. */
+static int dup_edges(Ctx *C, const unsigned char *merged, const int *newt,
+                     const int *newr, size_t nnew, unsigned char *gone) {
+  const Mesh *m = C->m;
+  size_t n = 3 * nnew;
+  for (size_t i = 0; i < m->nt; i++) n += merged[C->reg[i]] ? 0 : 3;
+  DEdge *e = malloc((n ? n : 1) * sizeof *e);
+  if (!e) return -1;
+  size_t w = 0;
+  for (size_t i = 0; i < m->nt; i++)
+    if (!merged[C->reg[i]])
+      for (int q = 0; q < 3; q++)
+        e[w++] = (DEdge){(uint64_t)(uint32_t)m->t[3 * i + (size_t)q] << 32 |
+                             (uint32_t)m->t[3 * i + (size_t)(q + 1) % 3], -1};
+  for (size_t i = 0; i < nnew; i++)
+    for (int q = 0; q < 3; q++)
+      e[w++] = (DEdge){(uint64_t)(uint32_t)newt[3 * i + (size_t)q] << 32 |
+                           (uint32_t)newt[3 * i + (size_t)(q + 1) % 3], newr[i]};
+  qsort(e, n, sizeof *e, dedge_cmp);
+  int changed = 0;
+  for (size_t i = 0; i < n;) {
+    size_t j = i;
+    while (j < n && e[j].k == e[i].k) j++;
+    if (j - i > 1) {
+      int had = 0;
+      for (size_t x = i; x < j; x++) {
+        int r = e[x].r;
+        if (r < 0) continue;
+        for (size_t b = C->B.rs[r]; b < C->B.rs[r + 1]; b++)
+          if (gone[C->edges[b].a]) {
+            gone[C->edges[b].a] = 0;
+            had = 1;
+          }
+      }
+      for (size_t x = i; x < j && !had; x++)
+        if (e[x].r >= 0) C->rbad[e[x].r] = 1;
+      for (size_t x = i; x < j; x++) changed |= e[x].r >= 0;
+    }
+    i = j;
+  }
+  free(e);
+  return changed;
+}
+
 /* Region r's boundary as loops of the vertices not gone. 0, -1 when a
    loop is too short or the boundary does not close, -2 out of memory. */
 static int region_loops(const Ctx *C, int r, const unsigned char *gone,
@@ -735,8 +800,8 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
   int *stack = malloc(nt * sizeof *stack);
   unsigned char *gone = calloc(nv ? nv : 1, 1), *merged = NULL, *used = NULL,
                 *joined = NULL, *vused = NULL;
-  int *newt = NULL, *seq = NULL, *outt = NULL, *remap = NULL;
-  size_t newcap = 0, nnew = 0;
+  int *newt = NULL, *seq = NULL, *outt = NULL, *remap = NULL, *newr = NULL;
+  size_t newcap = 0, nnew = 0, newrcap = 0;
   Loops L = {0};
   Poly P = {0};
   C.B.rs = NULL;
@@ -940,8 +1005,11 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
          vertex gone from its boundary) */
       if (clip(&P, outt) == 0 && (had_gone || np - 2 < C.rcount[r])) {
         flip_region(&P, outt, np - 2);
-        if (grow_ints(&newt, &newcap, 3 * (nnew + (size_t)np - 2)) < 0) goto out;
+        if (grow_ints(&newt, &newcap, 3 * (nnew + (size_t)np - 2)) < 0 ||
+            grow_ints(&newr, &newrcap, nnew + (size_t)np - 2) < 0)
+          goto out;
         memcpy(newt + 3 * nnew, outt, 3 * (size_t)(np - 2) * sizeof *outt);
+        for (int q = 0; q < np - 2; q++) newr[nnew + (size_t)q] = r;
         nnew += (size_t)np - 2;
         merged[r] = 1;
         st->regions++;
@@ -954,6 +1022,11 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
       continue;
     }
     st->kept += np < 3 || np - 2 < C.rcount[r]; /* else: no gain, not a failure */
+  }
+  if (!again) {
+    int de = dup_edges(&C, merged, newt, newr, nnew, gone);
+    if (de < 0) goto out;
+    again = de;
   }
   if (!again) break;
   if (pass == 7) memset(gone, 0, nv); /* 8 passes with removals, then none */
@@ -1019,6 +1092,7 @@ out:
   free(used);
   free(joined);
   free(newt);
+  free(newr);
   free(seq);
   free(outt);
   free(remap);
