@@ -4025,17 +4025,13 @@ static double line_dist(const Mesher *m, int a, int c, int d) {
 static double cap_height(const Mesher *m, int a, int b, int c) {
   const double *pa = m->v + 3 * (size_t)a, *pb = m->v + 3 * (size_t)b,
                *pc = m->v + 3 * (size_t)c;
-  double u[3], w[3];
+  double uu = 0, uw = 0;
   for (int k = 0; k < 3; k++) {
-    u[k] = pc[k] - pa[k];
-    w[k] = pb[k] - pa[k];
+    uu += (pc[k] - pa[k]) * (pc[k] - pa[k]);
+    uw += (pc[k] - pa[k]) * (pb[k] - pa[k]);
   }
-  double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-  double uw = u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
   if (!(uu > 0) || !(uw > 0) || !(uw < uu)) return INFINITY;
-  double x[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                 u[0] * w[1] - u[1] * w[0]};
-  return sqrt((x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) / uu);
+  return line_dist(m, a, c, b);
 }
 
 /* [*e0, *e1): the directed edges a -> b in ed (sorted, n of them) */
