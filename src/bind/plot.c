@@ -276,7 +276,7 @@ static const char *const seg_colour[] = {
     [LG_SEG_EXCLUDED] = "#9e9e9e", [LG_SEG_FLAT] = "#bdbdbd",
     [LG_SEG_NO_ROOT] = "#1f77b4",  [LG_SEG_ROOT] = "#2ca02c",
     [LG_SEG_SPLIT] = "#ff7f0e",    [LG_SEG_TINY] = "#9467bd",
-    [LG_SEG_PLANE] = "#17becf",
+    [LG_SEG_PLANE] = "#17becf",    [LG_SEG_CONCAVE] = "#8c564b",
 };
 
 /* The spans of a sharp bound along the ray, as bars in a row at y. */
@@ -306,7 +306,7 @@ static void bound_row(Svg *s, const csg_tape *b, const double o[3],
 static void lg_cone(Svg *s, const lg_trace_event *e) {
   if (!isfinite(e->L)) return;
   double r0 = e->f0 + 0.5, r1 = e->f1 + 0.5, L = e->L;
-  const char *col = e->decision >= 0 && e->decision <= LG_SEG_PLANE
+  const char *col = e->decision >= 0 && e->decision <= LG_SEG_CONCAVE
                         ? seg_colour[e->decision] : "black";
   int leaf = e->decision != LG_SEG_SPLIT;
   enum { K = 24 };
@@ -473,7 +473,7 @@ static Value *pl_ray(Interp *I, Value **args, Pos pos) {
       const lg_trace_event *e = &log.lg[i];
       if (e->depth > maxdepth) continue;
       double yy = y + 14.0 * e->depth;
-      const char *col = e->decision >= 0 && e->decision <= LG_SEG_PLANE
+      const char *col = e->decision >= 0 && e->decision <= LG_SEG_CONCAVE
                             ? seg_colour[e->decision] : "black";
       fprintf(f, "<rect class=\"segment\" x=\"%.2f\" y=\"%.1f\" "
               "width=\"%.2f\" height=\"10\" fill=\"%s\" stroke=\"white\" "
@@ -498,6 +498,7 @@ static Value *pl_ray(Interp *I, Value **args, Pos pos) {
         {"fill=\"#9e9e9e\"", 1, "discarded: range misses 0.5"},
         {"fill=\"#9467bd\"", 1, "shorter than the tolerance"},
         {"fill=\"#17becf\"", 1, "one leaf live: its plane"},
+        {"fill=\"#8c564b\"", 1, "a product: log-concave, decided whole"},
         {"fill=\"none\" stroke=\"#ff7f0e\" stroke-dasharray=\"4 3\"", 1,
          "LG cone: |rho(t) - rho(end)| <= L |t - end|"},
     };

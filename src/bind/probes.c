@@ -364,7 +364,7 @@ static const char *const lg_decisions[] = {
     [LG_SEG_EXCLUDED] = "miss",  [LG_SEG_FLAT] = "flat",
     [LG_SEG_NO_ROOT] = "none",   [LG_SEG_ROOT] = "root",
     [LG_SEG_SPLIT] = "split",    [LG_SEG_TINY] = "tiny",
-    [LG_SEG_PLANE] = "plane",
+    [LG_SEG_PLANE] = "plane",    [LG_SEG_CONCAVE] = "concave",
 };
 
 static void print_lg_trace(FILE *out, const TraceLog *t, int digits) {
@@ -381,7 +381,9 @@ static void print_lg_trace(FILE *out, const TraceLog *t, int digits) {
           " miss: range misses 0.5  flat: L = 0  tiny: below the "
           "tolerance\n"
           " plane: one leaf live, its plane is the 0.5 level: a root "
-          "by one division\n");
+          "by one division\n"
+          " concave: a product, log-concave: one stretch inside or none, "
+          "decided whole\n");
   static const char *const head[] = {"d", "t0", "t1", "f0", "f1", "L",
                                      "G", "A+B", "ops", "decision"};
   char (*cells)[CELL] = calloc(t->nlg * 10 + 1, CELL);
@@ -400,7 +402,7 @@ static void print_lg_trace(FILE *out, const TraceLog *t, int digits) {
     cell(c[7], e->lhs, digits, 0);
     snprintf(c[8], CELL, "%d", e->ncode);
     snprintf(c[9], CELL, "%s%s",
-             e->decision >= 0 && e->decision <= LG_SEG_PLANE
+             e->decision >= 0 && e->decision <= LG_SEG_CONCAVE
                  ? lg_decisions[e->decision] : "?",
              e->nroots && e->decision == LG_SEG_TINY ? " -> root" : "");
   }

@@ -209,8 +209,14 @@ double lg_multiroot_length(double f0, double df0, double f1, double df1,
    split's) */
 typedef struct {
   double a, b, fa, dfa, fb, dfb;
-  long depth;
+  long depth;   /* the subdivision depth, and SEG_LG when the concave
+                   path left the segment to the LG search */
 } segment;
+
+/* A segment (and its descendants) the concave path could not decide:
+   searched by Figure 9 alone. */
+#define SEG_LG (1L << 32)
+#define SEG_DEPTH(sg) ((int)((sg).depth & 0xffffffffL))
 
 /* Everything one search needs, so helpers stay short. */
 typedef struct {
@@ -380,7 +386,7 @@ static void trace(search *s, const segment *sg, const lg_bounds *lb,
   if (!s->hook || !s->hook->fn) return;
   lg_trace_event ev = {sg->a, sg->b, sg->fa, sg->fb, sg->dfa, sg->dfb,
                        lb->L, lb->G, lb->lo, lb->hi, lhs, decision,
-                       (int)sg->depth, ncode, nroots};
+                       SEG_DEPTH(*sg), ncode, nroots};
   s->hook->fn(s->hook->ctx, &ev);
 }
 
@@ -445,6 +451,275 @@ static int plane_segment(search *s, const dt_tape *t, const segment *sg) {
   return nroots ? emit(s, t, x, pa ? LG_EXIT : LG_ENTER) : 1;
 }
 
+/* The concave path (beyond the paper). A smoothed halfspace is
+ * log-concave in x (eq. (2)'s kernel integrates the log-concave
+ * 3/4 (1 - a^2): Prekopa), and so is a product of them, so along a ray
+ * g = log rho is concave wherever rho > 0: the solid (rho > 0.5) meets
+ * a segment whose view is such a product in one interval or not at all.
+ * Then the ends' signs say almost everything, with no LG bounds and no
+ * splitting:
+ *   - unlike signs: exactly one crossing, polished in [a, b];
+ *   - both inside: none (rho's lower bounds above 0.5 at both ends,
+ *     with their rounding, prove it);
+ *   - both outside: none if the tangents of g at the ends of a bracket
+ *     of g's peak keep g below log 0.5 (concave: g lies under every
+ *     tangent), else the bracket shrinks by the sign of g' at the
+ *     tangents' meeting point, or a point found inside splits the
+ *     segment into one crossing on each side.
+ * Every bound at a point takes the rounding of the leaves' distances
+ * along the ray (from o and d), of alpha, the kernel, its log-slope
+ * -3 (1 + a) / ((1 - a)(2 + a)) (increasing in a) and the sums, so an
+ * answer of none is a proof; what the bounds cannot settle (a graze
+ * within rounding of 0.5, a factor that may be 0, too many leaves, no
+ * progress) goes to Figure 9 (SEG_LG), which decides it as before. */
+
+#define LC_MAX 64      /* leaves of a view the concave path takes */
+#define LC_ITERS 32    /* bracket steps before it gives the segment up */
+
+/* Whether a view is a product of smoothed halfspaces of positive radius
+ * (and positive constants). */
+static int product_view(const dt_tape *t) {
+  /* from the root down: a Difference or Sum at the root shows at once */
+  for (int i = t->ncode - 1; i >= 0; i--) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_LEAF) {
+      if (!(t->leaves[in->arg].r > 0)) return 0;
+    } else if (in->op == DT_CONST) {
+      if (!(in->c > 0)) return 0;
+    } else if (in->op != DT_PRODUCT) {
+      return 0;
+    }
+  }
+  return 1;
+}
+
+/* One leaf of the view along the ray: base = n.o - d and nd = n.d as the
+ * ray's table has them, k = 1/r; alpha = (base + x nd) k is known within
+ * e0 + |x| e1 + 2u |alpha| (the rounding of base and nd from o and d, of
+ * the sum and the product); b = nd k, alpha's rate, within eb. */
+typedef struct {
+  double base, nd, k, e0, e1, b, eb;
+} lc_leaf;
+
+/* The view's leaves and the product c of its constants; 0 if more than
+ * LC_MAX leaves or a distance is not finite. */
+static int lc_leaves(const search *s, const dt_tape *t, lc_leaf *lv, int *n,
+                     double *c) {
+  const double u = DBL_EPSILON;   /* twice the unit roundoff: generous */
+  const double *o = s->o, *d = s->d;
+  int m = 0;
+  double cc = 1;
+  for (int i = 0; i < t->ncode; i++) {
+    const dt_instr *in = &t->code[i];
+    if (in->op == DT_CONST) cc *= in->c;
+    if (in->op != DT_LEAF) continue;
+    if (m == LC_MAX) return 0;
+    const dt_leaf *lf = &t->leaves[in->arg];
+    lc_leaf *l = &lv[m++];
+    l->base = s->rl[in->arg].base;
+    l->nd = s->rl[in->arg].nd;
+    l->k = lf->inv_r;
+    if (!(isfinite(l->base) && isfinite(l->nd) && isfinite(l->k))) return 0;
+    /* n.o - d: 3 products and 2 sums (one more for -d); n.d likewise; then
+       base + x nd (2u of each part) and the product by k */
+    double eb = 4 * u * (fabs(lf->n[0] * o[0]) + fabs(lf->n[1] * o[1]) +
+                         fabs(lf->n[2] * o[2]) + fabs(lf->d));
+    double en = 4 * u * (fabs(lf->n[0] * d[0]) + fabs(lf->n[1] * d[1]) +
+                         fabs(lf->n[2] * d[2]));
+    l->e0 = (eb + 2 * u * fabs(l->base)) * l->k * (1 + 2 * u) + DBL_MIN;
+    l->e1 = (en + 2 * u * fabs(l->nd)) * l->k * (1 + 2 * u);
+    l->b = l->nd * l->k;
+    l->eb = en * l->k * (1 + 2 * u) + 2 * u * fabs(l->b) + DBL_MIN;
+  }
+  *n = m;
+  *c = cc;
+  return m > 0 && cc > 0 && isfinite(cc);
+}
+
+/* At o + x d: an upper bound gup of g = log rho, an interval [slo, shi]
+ * holding g' (per unit of the ray parameter) and a lower bound flo of rho.
+ * Per leaf, with alpha known within ea and q = 1 - alpha > 4 ea: the
+ * kernel f falls as alpha rises and c = -(log f)' in alpha,
+ * 3 (1 + a) / ((1 - a)(2 + a)), rises with c' = 3 (a^2 + 2a + 3) / D^2
+ * <= 18 / (1 - a)^2 <= 32 / q^2 over alpha's interval; so log f there is
+ * at most log f(alpha) + ea c(alpha) and c is within ea 32 / q^2 of
+ * c(alpha). Returns 0 when a factor may be 0 or near it (no tangent). */
+static int lc_at(const lc_leaf *lv, int n, double c, double x, double *gup,
+                 double *slo, double *shi, double *flo) {
+  const double u = DBL_EPSILON;
+  double p = c, gx = 0, S = 0, E = 0, mag = 0, ax = fabs(x);
+  for (int i = 0; i < n; i++) {
+    const lc_leaf *l = &lv[i];
+    double a = (l->base + x * l->nd) * l->k;
+    double ea = l->e0 + ax * l->e1 + 2 * u * fabs(a);
+    if (a <= -1 - ea) continue;   /* 1 here, slope 0 */
+    double q = 1 - a;
+    if (!(ea <= 0.25 * q)) return 0;
+    double a2 = 2 + a, inv = 1 / (q * a2), iq = a2 * inv;
+    double cc = a <= -1 ? 0 : 3 * (1 + a) * inv;
+    double f = a <= -1 ? 1 : q * q * a2 * 0.25;
+    double dc = ea * 32 * iq * iq * (1 + 8 * u) + 8 * u * cc;
+    p *= f;
+    gx += ea * (cc + dc);
+    double term = -cc * l->b;
+    S += term;
+    E += dc * fabs(l->b) + (cc + dc) * l->eb;
+    mag += fabs(term);
+  }
+  if (!(p > 0 && isfinite(S) && isfinite(E))) return 0;
+  double er = 8 * (n + 2) * u;   /* the kernels' and the product's rounding */
+  double g = log(p * (1 + er)) + gx * (1 + 4 * u);
+  *gup = g + 4 * u * fabs(g) + DBL_MIN;
+  E = E * (1 + 4 * u) + 2 * (n + 1) * u * mag;
+  *slo = S - E;
+  *shi = S + E;
+  *flo = p * (1 - er) * (1 - gx * (1 + 4 * u));
+  return isfinite(*gup);
+}
+
+/* Cut [*l, *r] to where every factor's alpha is below 1/2: a leaf whose
+ * alpha is at least 1/4 (after its rounding) at a point, and rising away
+ * from it, keeps its kernel below 0.32 beyond, and so rho below 0.5, so
+ * the cut parts hold no crossing. Returns 0 when nothing is left. */
+static int lc_clip(const lc_leaf *lv, int n, double *l, double *r) {
+  const double u = DBL_EPSILON;
+  double lo = *l, hi = *r;
+  for (int i = 0; i < n; i++) {
+    const lc_leaf *f = &lv[i];
+    if (f->nd == 0) continue;
+    double x = (0.5 / f->k - f->base) / f->nd;   /* alpha = 1/2 about here */
+    if (!(x > lo && x < hi)) continue;
+    double a = (f->base + x * f->nd) * f->k;
+    double ea = f->e0 + fabs(x) * f->e1 + 2 * u * fabs(a);
+    if (!(a - ea >= 0.25)) continue;   /* not shown: keep it */
+    if (f->nd > 0) hi = x;   /* alpha rises with x: nothing beyond x */
+    else lo = x;
+  }
+  *l = lo;
+  *r = hi;
+  return lo < hi;
+}
+
+/* A concave segment's trace row (its LG bounds for the table). */
+static void concave_trace(search *s, const dt_tape *t, const segment *sg,
+                          int nroots) {
+  if (!s->hook || !s->hook->fn) return;
+  lg_bounds lb;
+  eval_bounds(t, s->rl, s->o, s->d, sg->a, sg->b, &lb);
+  trace(s, sg, &lb,
+        lg_multiroot_length(sg->fa, sg->dfa, sg->fb, sg->dfb, lb.L, lb.G),
+        LG_SEG_CONCAVE, t->ncode, nroots);
+}
+
+/* Both ends outside and m inside: one crossing on each side of m. */
+static int concave_two(search *s, const dt_tape *t, const segment *sg,
+                       double m, double fm, double dfm) {
+  concave_trace(s, t, sg, 2);
+  if (!emit(s, t, polish(s, t, sg->a, m, sg->fa, fm, sg->dfa, dfm), LG_ENTER))
+    return 0;
+  return emit(s, t, polish(s, t, m, sg->b, fm, sg->fb, dfm, sg->dfb), LG_EXIT);
+}
+
+/* The concave path over segment sg of the product view t: 1 decided
+ * (its crossings emitted), 0 when emit says stop, 2 not decided. */
+static int concave_segment(search *s, const dt_tape *t, const segment *sg) {
+  int pa = pos(sg->fa), pb = pos(sg->fb);
+  if (pa != pb) {
+    double x = polish(s, t, sg->a, sg->b, sg->fa, sg->fb, sg->dfa, sg->dfb);
+    concave_trace(s, t, sg, 1);
+    return emit(s, t, x, pa ? LG_EXIT : LG_ENTER);
+  }
+  if (!pa) {
+    /* both outside: first a guess at g's peak, where g' = rho'/rho,
+       taken as linear between the ends, is 0; a point found inside there
+       needs no proof, and is one when the ray meets the solid */
+    double Fa = sg->fa + 0.5, Fb = sg->fb + 0.5;
+    if (Fa > 0 && Fb > 0) {
+      double Sa = sg->dfa / Fa, Sb = sg->dfb / Fb;
+      if (Sa > 0 && Sb < 0) {
+        double m = sg->a + (sg->b - sg->a) * (Sa / (Sa - Sb));
+        if (m > sg->a && m < sg->b) {
+          double dfm, fm = feval(s, t, m, &dfm);
+          if (pos(fm)) return concave_two(s, t, sg, m, fm, dfm);
+        }
+      }
+    }
+  }
+  lc_leaf lv[LC_MAX];
+  int n;
+  double c;
+  if (!lc_leaves(s, t, lv, &n, &c)) return 2;
+  double Gl, Sl0, Sl1, Fl, Gr, Sr0, Sr1, Fr;
+  double l = sg->a, r = sg->b;
+  if (!pa && !lc_clip(lv, n, &l, &r)) {   /* rho < 0.5 all along */
+    concave_trace(s, t, sg, 0);
+    return 1;
+  }
+  int okl = lc_at(lv, n, c, l, &Gl, &Sl0, &Sl1, &Fl);
+  int okr = lc_at(lv, n, c, r, &Gr, &Sr0, &Sr1, &Fr);
+  if (s->st) s->st->evals += 2;
+  if (pa) {   /* both inside: rho > 0.5 at both ends, so all along */
+    if (!(okl && okr && Fl > 0.5 && Fr > 0.5)) return 2;
+    concave_trace(s, t, sg, 0);
+    return 1;
+  }
+  const double lh = -M_LN2;   /* log 0.5 */
+  double minlen = max2(s->tol, 16 * DBL_EPSILON * max2(fabs(l), fabs(r)));
+  for (int it = 0; it < LC_ITERS; it++) {
+    /* g's least upper bound on [l, r] from the tangents at its ends */
+    double w = r - l, B = INFINITY, x = 0.5 * w;
+    double P = Sl1, Q = -Sr0;   /* g(t) <= Gl + P (t - l), Gr + Q (r - t) */
+    if (okl && okr) {
+      if (P <= 0) B = Gl;
+      else if (Q <= 0) B = Gr;
+      else {
+        x = (Gr - Gl + Q * w) / (P + Q);
+        if (x < 0) x = 0;
+        if (x > w) x = w;
+        B = Gl + P * x;
+      }
+    } else if (okl) {
+      B = Gl + max2(P, 0) * w;
+    } else if (okr) {
+      B = Gr + max2(Q, 0) * w;
+    }
+    double mu = 1e-12 * (1 + fabs(Gl) + fabs(Gr) + (fabs(P) + fabs(Q)) * w);
+    if (B < lh - mu) {
+      concave_trace(s, t, sg, 0);
+      return 1;
+    }
+    if (!(w > minlen)) return 2;
+    if (x < w / 16) x = w / 16;
+    if (x > w - w / 16) x = w - w / 16;
+    double m = l + x, Gm, Sm0, Sm1, Fm;
+    if (!(m > l && m < r)) return 2;
+    int okm = lc_at(lv, n, c, m, &Gm, &Sm0, &Sm1, &Fm);
+    if (s->st) s->st->evals++;
+    if (!okm) return 2;
+    if (!(Gm < lh - 1e-12 * (1 + fabs(Gm)))) {
+      /* rho may exceed 0.5 at m: inside by the tape's own value (the
+         predicate the crossings are polished on) gives one crossing on
+         each side; else too close to tell */
+      double dfm, fm = feval(s, t, m, &dfm);
+      if (!pos(fm)) return 2;
+      return concave_two(s, t, sg, m, fm, dfm);
+    }
+    /* rho < 0.5 at m: the peak is on the side g rises to */
+    if (Sm0 > 0) {
+      l = m, Gl = Gm, Sl0 = Sm0, Sl1 = Sm1, okl = 1;
+    } else if (Sm1 < 0) {
+      r = m, Gr = Gm, Sr0 = Sm0, Sr1 = Sm1, okr = 1;
+    } else {   /* g' straddles 0 at m: the tangents at m both ways */
+      double Bm = Gm + max2(max2(Sm1 * (r - m), -Sm0 * (m - l)), 0);
+      double mum = 1e-12 * (1 + fabs(Gm) + (fabs(Sm0) + fabs(Sm1)) * w);
+      if (!(Bm < lh - mum)) return 2;
+      concave_trace(s, t, sg, 0);
+      return 1;
+    }
+  }
+  return 2;
+}
+
 /* Figure 9 over [a, b] of the (span-pruned) tape t.  Returns 0 when the
  * output is full.  A segment's tape is pruned from its parent's, not from
  * t: the search is depth first, so when a segment of depth k is popped
@@ -464,8 +739,8 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     segment sg = stack[--sp];
     if (s->st) s->st->segments++;
     const dt_tape *vp = t;   /* this segment's view; level 0 is t */
-    if (sg.depth > 0) {
-      int dep = (int)sg.depth;
+    if (SEG_DEPTH(sg) > 0) {
+      int dep = SEG_DEPTH(sg);
       int from = dep - 1 < s->nlv - 1 ? dep - 1 : s->nlv - 1;
       int to = dep < s->nlv ? dep : s->nlv;
       view_of(from ? &lv[from] : t, s->rl, sg.a, sg.b,
@@ -476,6 +751,12 @@ static int search_interval(search *s, const dt_tape *t, double a, double b) {
     if (nc == 1 && vp->code[0].op == DT_LEAF && s->rl[vp->code[0].arg].nd != 0) {
       if (!plane_segment(s, vp, &sg)) return 0;
       continue;
+    }
+    if (nc > 1 && !(sg.depth & SEG_LG) && product_view(vp)) {
+      int r = concave_segment(s, vp, &sg);
+      if (r == 0) return 0;
+      if (r == 1) continue;
+      sg.depth |= SEG_LG;   /* not decided: Figure 9, here and below */
     }
     lg_bounds lb;
     eval_bounds(vp, s->rl, s->o, s->d, sg.a, sg.b, &lb);

@@ -105,11 +105,18 @@ enum {
   LG_SEG_ROOT,       /* at most one root, sign change: regula falsi */
   LG_SEG_SPLIT,      /* eq. (6) true: subdivide */
   LG_SEG_TINY,       /* shorter than tol: decided by the tolerance rule */
-  LG_SEG_PLANE       /* one leaf live: the density is monotone along the
+  LG_SEG_PLANE,      /* one leaf live: the density is monotone along the
                         ray and its 0.5 level is the leaf's plane, so the
                         crossing, if the ends' signs differ, is that
                         plane's, by one division (no splitting, no
                         polishing) */
+  LG_SEG_CONCAVE     /* the view is a product of smoothed halfspaces,
+                        log-concave along the ray, so the solid meets the
+                        segment in one interval or none: ends of unlike
+                        sign hold one crossing (polished), ends inside
+                        none, ends outside none when tangents of log rho
+                        keep it below log 0.5, else two around a point
+                        found inside (nroots says which) */
 };
 
 typedef struct lg_trace_event {

@@ -288,11 +288,13 @@ static void test_sharp(void) {
   dt_tape_free(tp);
 }
 
-typedef struct { int events, splits; } tr_ctx;
+typedef struct { int events, splits, concave, plane; } tr_ctx;
 static void tracer(void *ctx, const lg_trace_event *ev) {
   tr_ctx *c = ctx;
   c->events++;
   if (ev->decision == LG_SEG_SPLIT) c->splits++;
+  if (ev->decision == LG_SEG_CONCAVE) c->concave++;
+  if (ev->decision == LG_SEG_PLANE) c->plane++;
 }
 
 /* One ray against dense sampling.  Returns failures. */
@@ -428,20 +430,212 @@ static void test_api(void) {
   int n = lg_roots(tp, o, d, 0, 3, 1e-9, r, 4, NULL);
   int n1 = lg_roots(tp, o, d, 0, 3, 1e-9, r1, 1, NULL);
   CHECK("maxout = 1 returns the first root", n == 2 && n1 == 1 && r1[0].t == r[0].t);
-  tr_ctx c = {0, 0};
+  tr_ctx c = {0, 0, 0, 0};
   lg_hook h = {tracer, &c};
   csg_span all = {0, 3, -1, -1, 0, 0};
   lg_stats st = {0};
   n = lg_roots_spans(tp, o, d, 0, 3, &all, 1, 1e-9, r, 4, &st, &h);
-  CHECK("trace hook sees every segment", n == 2 && c.events == st.segments &&
-                                              c.splits > 0);
+  /* the cube is a product: one concave row finds both crossings */
+  CHECK("trace hook sees every segment (a product: one concave row)",
+        n == 2 && c.events == st.segments && c.concave == 1 && c.splits == 0);
+  /* a cube minus a box through it is not: Figure 9 splits */
+  rtree t2;
+  int root2 = unit_cube(&t2, 0, 0.07);
+  double lo[3] = {0.3, 0.3, -0.5}, hi[3] = {0.7, 0.7, 1.5};
+  double rr[6] = {0.05, 0.05, 0.05, 0.05, 0.05, 0.05};
+  root2 = rt_op(&t2, R_DIFF, root2, rt_box(&t2, lo, hi, rr));
+  dt_tape *tp2 = rt_tape(&t2, root2);
+  tr_ctx c2 = {0, 0, 0, 0};
+  lg_hook h2 = {tracer, &c2};
+  lg_stats st2 = {0};
+  n = lg_roots_spans(tp2, o, d, 0, 3, &all, 1, 1e-9, r, 4, &st2, &h2);
+  CHECK("trace hook sees every segment (a difference: splits)",
+        n == 4 && c2.events == st2.segments && c2.splits > 0);
+  dt_tape_free(tp2);
   n = lg_roots_spans(tp, o, d, 0, 3, NULL, 0, 1e-9, r, 4, NULL, NULL);
   CHECK("no spans, no roots", n == 0);
   dt_tape_free(tp);
 }
 
+/* The concave path (lg.c): a product of smoothed halfspaces is
+ * log-concave, so along a ray its density is unimodal and the solid
+ * convex. Random rounded polytopes (8 to 14 planes with random normals, 1
+ * to 1.5 from the centre, radii 0.01 to 0.3, centred at 0, 1e3 or 1e6),
+ * and rays near their surfaces: through a surface point p (long double
+ * bisection of the reference from the centre, deep inside), along a
+ * random tangent direction (the normal by long double central
+ * differences), moved out or in along the normal by delta = 1e-2 to
+ * 1e-9 of the size (not below 1e-14 of the coordinates, the doubles'
+ * grid there). Each ray is classed by the reference alone: the
+ * largest density along it by golden-section search in long double
+ * (unimodal: exact up to rounding), a miss below 0.5 - m, two crossings
+ * above 0.5 + m (m: the rounding of doubles at the coordinates, 1e-11 +
+ * 1e-13 |centre|; rays between are skipped). A miss must give no root;
+ * a hit an entry and an exit, each within tol (1e-9) plus the rounding
+ * of the density over its slope (8 eps |coords| / |rho'|) of the
+ * reference's crossing on its side of the peak. The trace hook says the
+ * concave path decided most rays. */
+static int random_polytope(rtree *t, rng_t *g, double shift) {
+  t->n = 0;
+  int np = 8 + (int)(rng_u64(g) % 7), k = -1;
+  for (int i = 0; i < np; i++) {
+    double n[3];
+    rand_dir(g, 1, n);
+    double d = rng_range(g, 1, 1.5) + n[0] * shift + n[1] * shift + n[2] * shift;
+    int l = rt_leaf(t, n[0], n[1], n[2], d, rng_range(g, 0.01, 0.3));
+    k = k < 0 ? l : rt_op(t, R_PROD, k, l);
+  }
+  /* a cube of side 6 keeps it bounded whatever the normals */
+  double lo[3], hi[3], rr[6] = {0.1, 0.1, 0.1, 0.1, 0.1, 0.1};
+  for (int i = 0; i < 3; i++) lo[i] = shift - 3, hi[i] = shift + 3;
+  return rt_op(t, R_PROD, k, rt_box(t, lo, hi, rr));
+}
+
+/* The largest reference density along o + s d, s in [a, b], by golden
+ * section (the density is unimodal there), and where. The density must
+ * be positive at mid, which the search starts from: it is first cut to
+ * the interval where it is positive (by bisection: that set is an
+ * interval), so that golden section never compares two zeros. */
+static long double ref_peak(const rtree *t, int root, const double o[3],
+                            const double d[3], long double a, long double b,
+                            long double mid, long double *at) {
+  const long double ph = 0.6180339887498948482L;
+  for (int side = 0; side < 2; side++) {
+    long double x = side ? b : a, y = mid;   /* rho(y) > 0 */
+    if (ref_ld_ray(t, root, o, d, x) > 0) continue;
+    for (int i = 0; i < 200; i++) {
+      long double m = 0.5L * (x + y);
+      if (ref_ld_ray(t, root, o, d, m) > 0) y = m; else x = m;
+    }
+    if (side) b = y; else a = y;
+  }
+  long double x1 = b - ph * (b - a), x2 = a + ph * (b - a);
+  long double f1 = ref_ld_ray(t, root, o, d, x1), f2 = ref_ld_ray(t, root, o, d, x2);
+  for (int i = 0; i < 160; i++) {
+    if (f1 < f2) { a = x1; x1 = x2; f1 = f2; x2 = a + ph * (b - a); f2 = ref_ld_ray(t, root, o, d, x2); }
+    else { b = x2; x2 = x1; f2 = f1; x1 = b - ph * (b - a); f1 = ref_ld_ray(t, root, o, d, x1); }
+  }
+  *at = f1 > f2 ? x1 : x2;
+  return f1 > f2 ? f1 : f2;
+}
+
+static void test_concave(void) {
+  rng_t g = {424242};
+  double deltas[] = {1e-2, 1e-4, 1e-6, 1e-7, 1e-9};
+  double shifts[] = {0, 0, 1e3, 1e6};
+  int bad_miss = 0, bad_hit = 0, bad_pos = 0, rays = 0, concave_rays = 0;
+  int searched = 0;
+  int misses = 0, hits = 0, skipped = 0;
+  double worst = 0;
+  for (int sc = 0; sc < 80; sc++) {
+    double sh = shifts[sc % 4];
+    rtree t;
+    int root = random_polytope(&t, &g, sh);
+    dt_tape *tp = rt_tape(&t, root);
+    for (int k = 0; k < 6; k++) {
+      double u[3], c[3] = {sh, sh, sh};
+      rand_dir(&g, 1, u);
+      long double s = ref_cross(&t, root, c, u, 0, 5);
+      long double p[3], nrm[3], h = 1e-6L, len = 0;
+      for (int i = 0; i < 3; i++) p[i] = c[i] + s * u[i];
+      for (int i = 0; i < 3; i++) {   /* -grad rho: outward */
+        long double q1[3] = {p[0], p[1], p[2]}, q2[3] = {p[0], p[1], p[2]};
+        q1[i] += h;
+        q2[i] -= h;
+        nrm[i] = -(ref_ld(&t, root, q1) - ref_ld(&t, root, q2)) / (q1[i] - q2[i]);
+        len += nrm[i] * nrm[i];
+      }
+      len = sqrtl(len);
+      for (int i = 0; i < 3; i++) nrm[i] /= len;
+      double dir[3], dl = 0;   /* a random tangent direction */
+      rand_dir(&g, 1, dir);
+      long double dn = dir[0] * nrm[0] + dir[1] * nrm[1] + dir[2] * nrm[2];
+      for (int i = 0; i < 3; i++) dir[i] = (double)(dir[i] - dn * nrm[i]);
+      for (int i = 0; i < 3; i++) dl += dir[i] * dir[i];
+      for (int i = 0; i < 3; i++) dir[i] /= sqrt(dl);
+      for (int j = 0; j < 5; j++) {
+        if (deltas[j] < 1e-14 * (1 + sh)) continue;   /* below the grid */
+        for (int side = -1; side <= 1; side += 2) {
+          double o[3];
+          for (int i = 0; i < 3; i++)
+            o[i] = (double)(p[i] + side * deltas[j] * nrm[i] - 8 * dir[i]);
+          long double at, top = ref_peak(&t, root, o, dir, 0, 16, 8, &at);
+          long double m = 1e-11L + 1e-13L * sh;
+          int hit = top > 0.5L + m;
+          if (!hit && !(top < 0.5L - m)) { skipped++; continue; }
+          tr_ctx tc = {0, 0, 0, 0};
+          lg_hook hk = {tracer, &tc};
+          csg_span all = {0, 16, -1, -1, 0, 0};
+          lg_root r[8];
+          double tol = 1e-9;
+          int n = lg_roots_spans(tp, o, dir, 0, 16, &all, 1, tol, r, 8, NULL,
+                                 &hk);
+          rays++;
+          /* rays with a segment of two or more leaves */
+          searched += tc.events > tc.plane;
+          concave_rays += tc.concave > 0;
+          if (!hit) {
+            misses++;
+            if (n != 0) bad_miss++;
+            continue;
+          }
+          hits++;
+          if (n != 2 || r[0].kind != LG_ENTER || r[1].kind != LG_EXIT) {
+            bad_hit++;
+            continue;
+          }
+          long double e[2] = {ref_cross(&t, root, o, dir, 0, at),
+                              ref_cross(&t, root, o, dir, at, 16)};
+          for (int i = 0; i < 2; i++) {
+            /* the crossing's condition: each plane's distance is rounded
+               (n.p - d and the sums: 8 eps (|n||p| + |d|), generously),
+               which moves rho by its sensitivity to that plane's offset
+               (a central difference in d, long double) times that, and
+               the crossing by the sum over |rho'| along the ray */
+            long double q[3], noise = 0;
+            for (int kk = 0; kk < 3; kk++) q[kk] = o[kk] + e[i] * dir[kk];
+            for (int li = 0; li < t.n; li++) {
+              rnode *x = &t.nodes[li];
+              if (x->op != R_LEAF) continue;
+              double d0 = x->d, hh = 1e-7 * (1 + fabs(d0));
+              double dp = d0 + hh, dm = d0 - hh;
+              x->d = dp;
+              long double fp = ref_ld(&t, root, q);
+              x->d = dm;
+              long double fm = ref_ld(&t, root, q);
+              x->d = d0;
+              long double ds = 8 * DBL_EPSILON *
+                  (fabsl(x->n[0] * q[0]) + fabsl(x->n[1] * q[1]) +
+                   fabsl(x->n[2] * q[2]) + fabs(d0));
+              noise += fabsl(fp - fm) / (dp - dm) * ds;
+            }
+            long double sl = fabsl(ref_slope(&t, root, o, dir, e[i], 1e-7L));
+            long double allow = tol + noise / sl;
+            long double err = fabsl(r[i].t - e[i]);
+            if (err / allow > worst) worst = (double)(err / allow);
+            if (err > allow) bad_pos++;
+          }
+        }
+      }
+    }
+    dt_tape_free(tp);
+  }
+  printf("# concave: %d rays (%d misses, %d hits, %d too close to call "
+         "skipped), %d with segments of two or more leaves, %d of them "
+         "decided by the concave path; worst crossing error %.3g of "
+         "allowed\n", rays, misses, hits, skipped, searched, concave_rays,
+         worst);
+  CHECK("concave: rays the reference says miss give no root", bad_miss == 0);
+  CHECK("concave: rays the reference says hit cross twice, within tol",
+        bad_hit == 0 && bad_pos == 0 && hits > 800);
+  CHECK("concave: the concave path decided the rays that needed a search "
+        "(but a few grazes too close to call)",
+        concave_rays >= searched - searched / 100 && searched > rays / 2);
+}
+
 int main(void) {
   check_prefix = "roots";
+  test_concave();
   test_multiroot();
   test_lg_bounds();
   test_cube_axis();

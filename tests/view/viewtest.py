@@ -243,7 +243,7 @@ def browser_tests(host, port, token, scene, defs):
             tr = qcs_eval(defs, "Trace (Shift (0, 0, 0) obj4) %s %s" % (o, d)).strip().splitlines()
             roots_prompt = nums(tr[-1]) if tr else []
             # the Trace table's rows: depth, t0, t1, ..., decision
-            seg_lines = [l for l in tr if re.match(r"^\s*\d+\s+\S+\s+\S+\s.*\b(split|root|none|miss|flat|tiny|plane)\s*$", l)]
+            seg_lines = [l for l in tr if re.match(r"^\s*\d+\s+\S+\s+\S+\s.*\b(split|root|none|miss|flat|tiny|plane|concave)\s*$", l)]
             ok = (close([hit["density"]], dens) and close(hit["gradient"], grad)
                   and len(seg_lines) == len(hit["segments"]) and hit["where"] and ":23:" in hit["where"])
             troots = [s for s in roots_prompt]
