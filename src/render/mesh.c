@@ -30,8 +30,11 @@
 #define MAX_DEPTH 19       /* grid coordinates fit 20 bits */
 /* weld joins edges shorter than this (of the octree's side) */
 #define WELD 0x1p-46
-/* the second try's weld of vertices on no common edge: 2^-44 of the size */
-#define NEAR_WELD 4
+/* the second try's weld of vertices on no common edge: 2^-40 of the size
+   (prisms of 60 to 80 sides corner to corner, turned: their corners'
+   faces all but in one plane, the exact points spread along the line of
+   contact by up to 4e-13) */
+#define NEAR_WELD 64
 /* Cells where two surfaces, each one sheet, are not proven one sheet
    together split this many levels below the finest at most (walk). */
 #define TWO_LEVELS 2
@@ -4420,7 +4423,8 @@ static int weld(Mesher *m) {
     }
   if (m->near_weld) {
     /* wider than an edge's: where the turned planes of a line of contact
-       meet, the exact points cluster within 1e-13 (NEAR_WELD) */
+       meet, the exact points cluster within 1e-13, and within 4e-13
+       where those planes are all but one plane (NEAR_WELD) */
     double gn = g * NEAR_WELD;
     SnapEnt *o = malloc(m->nv * sizeof *o);
     if (!o) {

@@ -2081,7 +2081,8 @@ static Value *eval_text(const char *text) {
    of the object on the segment p -+ tol along the triangle's normal or an
    axis (a root at distance <= tol along any direction proves the
    distance). With rounded (a density tree and its radius), also by the
-   Density probe: the density crosses 0.5 on one of those segments. The
+   Density probe: the density crosses 0.5 on one of those segments (at 9
+   points along it). The
    number of points failing both (or either, for rounded). */
 static long probe_points(const char *obj, const char *tree, double radius,
                          const Mesh *m, double tol, int n) {
@@ -2104,14 +2105,19 @@ static long probe_points(const char *obj, const char *tree, double radius,
         }
       }
       if (!dens) {
-        double q[2];
-        for (int sgn = 0; sgn < 2; sgn++) {
+        /* a change of side of 0.5 along the segment, sampled at 9
+           points: the ends alone miss it where the solid is thinner
+           than the segment (a wedge where two boxes' faces meet at a
+           small angle: both ends outside) */
+        double q[9];
+        for (int k2 = 0; k2 < 9 && !dens; k2++) {
+          double f = k2 / 8.0;
           snprintf(buf, sizeof buf, "Density %.17g (%.17g, %.17g, %.17g) (%s)", radius,
-                   o[0] + sgn * e[0], o[1] + sgn * e[1], o[2] + sgn * e[2], tree);
+                   o[0] + f * e[0], o[1] + f * e[1], o[2] + f * e[2], tree);
           Value *r = eval_text(buf);
-          q[sgn] = r && r->kind == V_NUM ? r->u.num : NAN;
+          q[k2] = r && r->kind == V_NUM ? r->u.num : NAN;
+          if (k2 > 0 && (q[k2 - 1] - 0.5) * (q[k2] - 0.5) <= 0) dens = 1;
         }
-        if ((q[0] - 0.5) * (q[1] - 0.5) <= 0) dens = 1;
       }
     }
     if (!found || !dens) bad++;
@@ -2914,6 +2920,24 @@ static void touching_prisms(void) {
      "(CylinderWith [Sides 22] 0.5 1) (Shift (1,0,0) (Rotate \"y\" "
      "7.826086956521737 (CylinderWith [Sides 23] 0.5 1))))))",
      {22, 23, 0}, 0.02},
+    /* many sides: the corners' faces all but in one plane, 3 degrees
+       from it or less, so the exact points where they meet spread along
+       the line by up to 4e-13, beyond 2^-44 of the size: caps with an
+       edge of 4e-13 left a crack (refused as thinner than the finest
+       cell once the sharp cells about it were given up; 786 triangles
+       for 70 and 72 sides), until the near weld reached 2^-40 */
+    {"a 60-sided prism beside a turned 61-sided one, corner to corner, rotated",
+     "Rotate \"x\" 31.5 (Union (CylinderWith [Sides 60] 0.5 1) (Shift (1,0,0) "
+     "(Rotate \"y\" 2.9508196721311477 (CylinderWith [Sides 61] 0.5 1))))",
+     {60, 61, 0}, 0.02},
+    {"an 80-sided prism beside a turned 81-sided one, corner to corner, rotated",
+     "Rotate \"x\" 7 (Union (CylinderWith [Sides 80] 0.5 1) (Shift (1,0,0) "
+     "(Rotate \"y\" 2.2222222222222223 (CylinderWith [Sides 81] 0.5 1))))",
+     {80, 81, 0}, 0.02},
+    {"a 70-sided prism beside a 72-sided one, corner to corner, rotated",
+     "Rotate \"x\" 40 (Union (CylinderWith [Sides 70] 0.5 1) (Shift (1,0,0) "
+     "(CylinderWith [Sides 72] 0.5 1)))",
+     {70, 72, 0}, 0.02},
   };
   for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
     const double tol = objs[k].tol, r = 0.5;
