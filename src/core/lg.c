@@ -3,6 +3,7 @@
 #include "core/lg.h"
 
 #include <float.h>
+#include <stdint.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -209,14 +210,14 @@ double lg_multiroot_length(double f0, double df0, double f1, double df1,
    split's) */
 typedef struct {
   double a, b, fa, dfa, fb, dfb;
-  long depth;   /* the subdivision depth, and SEG_LG when the concave
+  int64_t depth;   /* the subdivision depth, and SEG_LG when the concave
                    path left the segment to the LG search */
 } segment;
 
 /* A segment (and its descendants) the concave path could not decide:
    searched by Figure 9 alone. */
-#define SEG_LG (1L << 32)
-#define SEG_DEPTH(sg) ((int)((sg).depth & 0xffffffffL))
+#define SEG_LG ((int64_t)1 << 32)
+#define SEG_DEPTH(sg) ((int)((sg).depth & 0xffffffff))
 
 /* Everything one search needs, so helpers stay short. */
 typedef struct {
@@ -291,6 +292,9 @@ polish(search *s, const dt_tape *t, double a, double b, double fa, double fb,
   int pa = pos(fa);
   if (!pa && fa == 0) return a;    /* entering right after a zero at a */
   if (pa && fb == 0) return b;     /* leaving at a zero at b */
+  /* 4 ulp of the bracket as it is now: the concave path polishes over a
+     whole interval, whose far end may be 1e13 times the root's distance
+     (a filter hull made long by planes all but parallel to the ray) */
   double rtol = max2(s->tol, 4 * DBL_EPSILON * max2(fabs(a), fabs(b)));
   double x, f, df;
   if (fabs(fa) < fabs(fb)) x = a, f = fa, df = dfa;
@@ -312,6 +316,7 @@ polish(search *s, const dt_tape *t, double a, double b, double fa, double fb,
     f = feval(s, t, x, &df);
     if (pos(f) == pa) a = x, fa = f;
     else b = x, fb = f;
+    rtol = max2(s->tol, 4 * DBL_EPSILON * max2(fabs(a), fabs(b)));
     if (f == 0) {
       /* On the surface: a simple root is exact here, unless f stays 0
        * on a stretch (then the change is at its far end): look one tol
@@ -538,7 +543,7 @@ static int lc_leaves(const search *s, const dt_tape *t, lc_leaf *lv, int *n,
 
 /* At o + x d: an upper bound gup of g = log rho, an interval [slo, shi]
  * holding g' (per unit of the ray parameter) and a lower bound flo of rho.
- * Per leaf, with alpha known within ea and q = 1 - alpha > 4 ea: the
+ * Per leaf, with alpha known within ea and q = 1 - alpha >= 4 ea: the
  * kernel f falls as alpha rises and c = -(log f)' in alpha,
  * 3 (1 + a) / ((1 - a)(2 + a)), rises with c' = 3 (a^2 + 2a + 3) / D^2
  * <= 18 / (1 - a)^2 <= 32 / q^2 over alpha's interval; so log f there is
@@ -566,7 +571,8 @@ static int lc_at(const lc_leaf *lv, int n, double c, double x, double *gup,
     E += dc * fabs(l->b) + (cc + dc) * l->eb;
     mag += fabs(term);
   }
-  if (!(p > 0 && isfinite(S) && isfinite(E))) return 0;
+  /* a subnormal product has lost its relative precision */
+  if (!(p >= DBL_MIN && isfinite(S) && isfinite(E))) return 0;
   double er = 8 * (n + 2) * u;   /* the kernels' and the product's rounding */
   double g = log(p * (1 + er)) + gx * (1 + 4 * u);
   *gup = g + 4 * u * fabs(g) + DBL_MIN;
@@ -577,16 +583,21 @@ static int lc_at(const lc_leaf *lv, int n, double c, double x, double *gup,
   return isfinite(*gup);
 }
 
-/* Cut [*l, *r] to where every factor's alpha is below 1/2: a leaf whose
- * alpha is at least 1/4 (after its rounding) at a point, and rising away
- * from it, keeps its kernel below 0.32 beyond, and so rho below 0.5, so
- * the cut parts hold no crossing. Returns 0 when nothing is left. */
-static int lc_clip(const lc_leaf *lv, int n, double *l, double *r) {
+/* Cut [*l, *r] at the points where a leaf's alpha is about 1/2, keeping
+ * the side where it is lower: where the alpha computed there is at least
+ * 1/4 after its rounding, and rises away from the cut (the sign of its
+ * rate nd k proven), the kernel is below f(1/4) = 0.3164 beyond it, and
+ * rho, the constants' product c times kernels of at most 1, below 0.5
+ * when c f(1/4) < 0.5 (c is 1 in a rounded polyhedron; a pruned Sum of
+ * halfspaces that are 1 there can leave 2 or more), so the cut parts hold
+ * no crossing. Returns 0 when nothing is left. */
+static int lc_clip(const lc_leaf *lv, int n, double c, double *l, double *r) {
   const double u = DBL_EPSILON;
   double lo = *l, hi = *r;
+  if (!(c * 0.3165 < 0.5)) return 1;
   for (int i = 0; i < n; i++) {
     const lc_leaf *f = &lv[i];
-    if (f->nd == 0) continue;
+    if (!(fabs(f->b) > f->eb)) continue;   /* alpha's direction not proven */
     double x = (0.5 / f->k - f->base) / f->nd;   /* alpha = 1/2 about here */
     if (!(x > lo && x < hi)) continue;
     double a = (f->base + x * f->nd) * f->k;
@@ -651,7 +662,7 @@ static int concave_segment(search *s, const dt_tape *t, const segment *sg) {
   if (!lc_leaves(s, t, lv, &n, &c)) return 2;
   double Gl, Sl0, Sl1, Fl, Gr, Sr0, Sr1, Fr;
   double l = sg->a, r = sg->b;
-  if (!pa && !lc_clip(lv, n, &l, &r)) {   /* rho < 0.5 all along */
+  if (!pa && !lc_clip(lv, n, c, &l, &r)) {   /* rho < 0.5 all along */
     concave_trace(s, t, sg, 0);
     return 1;
   }

@@ -633,9 +633,69 @@ static void test_concave(void) {
         concave_rays >= searched - searched / 100 && searched > rays / 2);
 }
 
+/* Two cases a review of the concave path found (each failed before its
+ * fix): a product whose constant is above 1 (a pruned Sum of halfspaces
+ * that are 1 along the ray: 4 times a slab 0.05 thick) was cut off as
+ * "rho below 0.5" beside a factor of 0.32; and a crossing polished over a
+ * whole interval 1e13 long stopped within 4 ulp of its far end (0.009
+ * here), not of the root. Both against long double bisection. */
+static void test_concave_review(void) {
+  rtree t;
+  t.n = 0;
+  int a = rt_leaf(&t, 0, 1, 0, 10, 1), b = rt_leaf(&t, 0, 1, 0, 10, 1),
+      e = rt_leaf(&t, 0, 1, 0, 10, 1), f = rt_leaf(&t, 0, 1, 0, 10, 1);
+  int sum = rt_op(&t, R_SUM, rt_op(&t, R_SUM, a, b), rt_op(&t, R_SUM, e, f));
+  int c = rt_leaf(&t, 1, 0, 0, 0, 1), d = rt_leaf(&t, -1, 0, 0, -0.5, 0.01);
+  int root = rt_op(&t, R_PROD, sum, rt_op(&t, R_PROD, c, d));
+  dt_tape *tp = rt_tape(&t, root);
+  double o[3] = {-3, 0, 0}, dir[3] = {1, 0, 0};
+  lg_root r[8];
+  int n = lg_roots(tp, o, dir, 0, 6, 1e-9, r, 8, NULL);
+  long double e0 = ref_cross(&t, root, o, dir, 3, 3.53),
+              e1 = ref_cross(&t, root, o, dir, 3.53, 4);
+  CHECK("concave review: a product with a constant of 4 (a pruned Sum): "
+        "both crossings, within tol",
+        n == 2 && fabsl(r[0].t - e0) <= 1e-9L && fabsl(r[1].t - e1) <= 1e-9L);
+  dt_tape_free(tp);
+  /* the review's fuzz case: five planes of radius about 5e-7, all but
+     parallel to the ray, so the filters' hull runs to 2^45; the ray
+     starts inside and leaves at 0.178 */
+  static const double L[5][5] = {
+      {0x1.d13074dd6f20dp-1, -0x1.0b7abff71bceap-3, 0x1.964e9996af89ap-2,
+       0x1.40332c97983e6p+0, 0x1.f80da17e34d2dp-22},
+      {0x1.43b2266657822p-1, 0x1.28c4d21eaf79bp-1, -0x1.073c6ec9e4654p-1,
+       0x1.1edae8d05ab13p+0, 0x1.006f5bbac42a4p-21},
+      {0x1.feab0f438551bp-1, -0x1.999c4a70dec98p-5, -0x1.a94f36bff7ac4p-5,
+       0x1.34dc52ac7510bp+0, 0x1.ff52c3db8511bp-22},
+      {-0x1.91f12acddf9b6p-5, -0x1.a2ee1dcd9ebecp-3, -0x1.f48b31047b8f1p-1,
+       0x1.24046b97a54d7p+0, 0x1.e75321fa26061p-23},
+      {0x1.fcc414b156accp-1, 0x1.1ddb3795d6be2p-4, -0x1.67f33b05fedd4p-4,
+       0x1.47cf3839b7b99p+0, 0x1.0a52df68fd4ffp-21}};
+  rtree u;
+  u.n = 0;
+  int ru = -1;
+  for (int i = 0; i < 5; i++) {
+    int l = rt_leaf(&u, L[i][0], L[i][1], L[i][2], L[i][3], L[i][4]);
+    ru = ru < 0 ? l : rt_op(&u, R_PROD, ru, l);
+  }
+  dt_tape *tu = rt_tape(&u, ru);
+  double o2[3] = {-0x1.b76753ef80373p+2, -0x1.2ba08543439cep+1, -0x1.26dfb0b6f49d5p-2},
+         d2[3] = {0x1.fbb79be4488c3p+4, 0x1.8313aaccbff7ep+4, -0x1.a9e3be780b6ecp+2};
+  double t1 = 0x1.642779f9e1c09p+45, tol = 0x1.b2dfb2813cdb5p-36;
+  n = lg_roots(tu, o2, d2, 0, t1, tol, r, 8, NULL);
+  long double x = ref_cross(&u, ru, o2, d2, 0, 0.5);
+  char name[200];
+  snprintf(name, sizeof name, "concave review: a filter hull 2^45 long: the "
+           "exit within tol (%.3g) of the reference's (error %.3Lg)", tol,
+           n >= 1 ? fabsl(r[n - 1].t - x) : -1.0L);
+  CHECK(name, n == 1 && r[0].kind == LG_EXIT && fabsl(r[0].t - x) <= tol);
+  dt_tape_free(tu);
+}
+
 int main(void) {
   check_prefix = "roots";
   test_concave();
+  test_concave_review();
   test_multiroot();
   test_lg_bounds();
   test_cube_axis();
