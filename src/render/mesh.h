@@ -206,6 +206,14 @@ typedef struct MeshReport {
   int cover_kept;          /* the last round was not kept (it proved no
                               more, or changed the topology, or failed):
                               the mesh is the round's before */
+  long float_joined;       /* the file's floats' mesh made a mesh again
+                              (mesh_float.h, by the writer's caller):
+                              vertices joined, */
+  long float_closed;       /* triangles that closed up, */
+  long float_pairs;        /* pairs facing apart dropped, */
+  long float_parted;       /* fans given their own vertex, */
+  double float_moved;      /* the largest move (added to certified); */
+  int float_apart;         /* or, the other way, the vertices kept apart */
   double seconds;
 } MeshReport;
 
