@@ -64,7 +64,7 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
             "certified bound grown by the largest move)\n", r->welded);
   if (r->sliver_pairs || r->sliver_caps || r->sliver_holes)
     fprintf(f, "  slivers: where planes all but meet in a line, once their "
-            "vertices within 2^-40 of the object's size were joined, %ld "
+            "vertices within 2^-39 of the object's size were joined, %ld "
             "pair%s of triangles on the same vertices facing apart dropped, "
             "%ld triangle%s with three vertices all but on one line taken "
             "out and the edges left along the line zipped (a triangle "
