@@ -74,22 +74,25 @@ def run(qcs, idx, n1, n2, obj, tol, timeout):
         if p.returncode != 0 or not os.path.exists(stl):
             m = re.search(r"qcs: (.*)", rep)
             return "refused: " + (m.group(1)[:160] if m else "rc %d" % p.returncode)
+        why = []
         if "given up" in rep:
-            return "sharp cells given up"
+            why.append("sharp cells given up")
         if "the mesh as made was kept" in rep:
-            return "flat regions not triangulated again (their mesh failed a check)"
-        if "warning:" in rep:
-            m = re.search(r"warning: (.*)", rep)
-            return "warning: " + m.group(1)[:120]
+            why.append("flat regions not triangulated again (their mesh failed a check)")
+        m = re.search(r"warning: \S+ (.*)", rep)
+        if m:
+            why.append("warning: " + m.group(1)[:100])
         m = re.search(r"mesh \S+: (\d+) triangles", rep)
         nt = int(m.group(1)) if m else -1
         want = 4 * n1 - 4 + 4 * n2 - 4
         g = re.search(r"\(genus (\d+) in all\)", rep)
         genus = int(g.group(1)) if g else -1
         if genus != 0:
-            return "genus %d, %d triangles" % (genus, nt)
-        if nt > want + 16:
-            return "%d triangles (the prisms alone %d)" % (nt, want)
+            why.append("genus %d, %d triangles" % (genus, nt))
+        elif nt > want + 16:
+            why.append("%d triangles (the prisms alone %d)" % (nt, want))
+        if why:
+            return "; ".join(why)
     return None
 
 

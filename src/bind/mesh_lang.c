@@ -33,7 +33,14 @@ static void report(FILE *f, const MeshReport *r, const char *path, double e) {
     fprintf(f, "  sharp cells: %ld of them without the planes crossing them "
             "whose faces do not reach them (a many-sided prism's sides near "
             "its rim)\n", r->sharp_pruned);
-  if (r->flat_regions)
+  if (r->flat_regions && r->flat_frozen)
+    fprintf(f, "  flat parts: %ld regions in one plane triangulated again "
+            "without their inner vertices, %zu -> %zu triangles (done %d "
+            "time%s more: where the new triangles met others, within "
+            "rounding, those regions were kept as made)\n",
+            r->flat_regions, r->flat_before, r->triangles, r->flat_frozen,
+            r->flat_frozen == 1 ? "" : "s");
+  else if (r->flat_regions)
     fprintf(f, "  flat parts: %ld regions in one plane triangulated again "
             "without their inner vertices, %zu -> %zu triangles\n",
             r->flat_regions, r->flat_before, r->triangles);

@@ -36,6 +36,9 @@
    contact by up to 4e-13; 2^-40 left 63 and 62 sides turned thrice,
    fuzz-prisms seed 44 s233, refused) */
 #define NEAR_WELD 128
+/* Times the flat merge is done again with the regions where it met
+   itself kept as made, before it is undone */
+#define FLAT_TRIES 8
 /* Cells where two surfaces, each one sheet, are not proven one sheet
    together split this many levels below the finest at most (walk). */
 #define TWO_LEVELS 2
@@ -3950,6 +3953,26 @@ static int widen(const Mesher *m, Mesh *me) {
   return 0;
 }
 
+/* widen undone: the parted vertices of me moved back to where
+   part_contacts first put them (PINCH), as the flat merge saw them. */
+static int unwiden(const Mesher *m, Mesh *me) {
+  if (!m->npin || !me) return 0;
+  hmap at = {0};
+  for (size_t i = 0; i < m->npin; i++)
+    if (hput(&at, place_key(m->pin + 6 * i + 3), (int)i) < 0) {
+      hfree(&at);
+      return -1;
+    }
+  for (size_t v = 0; v < me->nv; v++) {
+    double *p = me->v + 3 * v;
+    int i = hget(&at, place_key(p));
+    if (i >= 0 && !memcmp(p, m->pin + 6 * (size_t)i + 3, 3 * sizeof *p))
+      memcpy(p, m->pin + 6 * (size_t)i, 3 * sizeof *p);
+  }
+  hfree(&at);
+  return 0;
+}
+
 /* part_contacts where the sharp cells met (elsewhere nothing touches:
    each marching triangle lies in its own tetrahedron), its moves in the
    certified bound. 0, or -1 out of memory. */
@@ -5533,13 +5556,14 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
      instead (kept aside until then) */
   Mesh *made = NULL;
   MeshMerge mm = {0};
+  int *from = NULL; /* the merge's origins (mesh_merge_flat_frozen) */
   double mscale = 0;
   for (size_t i = 0; i < 3 * me->nv; i++) mscale = fmax(mscale, fabs(me->v[i]));
   double mdelta = ldexp(fmax(mscale, size), -44);
   if (!ms->uniform && !ms->keep_flat && !test_fault && me->nt &&
       4 * mdelta <= 1e-3 * e &&
       (made = mesh_copy(me)) != NULL) {
-    if (mesh_merge_flat(me, mdelta, &mm) < 0) { /* out of memory: as made */
+    if (mesh_merge_flat_frozen(me, mdelta, NULL, &from, &mm) < 0) { /* out of memory: as made */
       mesh_free(me);
       me = made;
       made = NULL;
@@ -5553,6 +5577,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     mesh_free(me);
     mesh_free(made);
     rc = MESH_ENOMEM;
+    free(from);
     goto done;
   }
   MeshCheck ck;
@@ -5574,6 +5599,7 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
       rc = MESH_RESHARP;
       rep->resharp = 1;
     }
+    free(from);
     goto done;
   }
   rep->components = ck.components;
@@ -5590,13 +5616,60 @@ static int mesh_run(const Scene *s, int node, const MeshSettings *ms,
     snprintf(err, errlen, "the slivers taken out left a mesh of genus %ld",
              (2 * ck.components - ck.euler) / 2);
     rc = MESH_EINTERNAL;
+    free(from);
     goto done;
   }
   if (me->nv && (test_fault == 2 || (test_fault == 1 && sharp)))
     push_through(me);
   MeshSelfCheck sck;
   int sr = self_check(me, rep, err, errlen, &rc, &sck);
+  /* the merged regions where the mesh meets itself kept as made (their
+     triangles frozen) and the rest merged again, a few times, before the
+     whole merge is undone below */
+  unsigned char *frozen = NULL;
+  for (int tries = 0; sr != 0 && made && from && rc == MESH_ESELF && tries < FLAT_TRIES;
+       tries++) {
+    if (!frozen && !(frozen = calloc(made->nt ? made->nt : 1, 1))) break;
+    long more = 0;
+    for (int k = 0; k < 2; k++) {
+      int f = sck.tri[k] < me->nt ? from[sck.tri[k]] : 0;
+      if (f >= 0) continue; /* a triangle as made */
+      for (size_t i = 0; i < made->nt; i++)
+        if (from[me->nt + i] == -1 - f && !frozen[i]) {
+          frozen[i] = 1;
+          more++;
+        }
+    }
+    if (!more) break;
+    Mesh *me2 = mesh_copy(made);
+    int *from2 = NULL;
+    MeshMerge mm2;
+    MeshCheck ck2;
+    if (!me2 || unwiden(&m, me2) < 0 ||
+        mesh_merge_flat_frozen(me2, mdelta, frozen, &from2, &mm2) < 0 ||
+        !mm2.regions || !from2 || widen(&m, me2) < 0 || mesh_check(me2, &ck2) != 0) {
+      mesh_free(me2);
+      free(from2);
+      break;
+    }
+    mesh_free(me);
+    me = me2;
+    free(from);
+    from = from2;
+    mm = mm2;
+    ck = ck2;
+    rep->components = ck.components;
+    rep->euler = ck.euler;
+    rep->flat_frozen = tries + 1;
+    rc = MESH_OK;
+    err[0] = 0;
+    sr = self_check(me, rep, err, errlen, &rc, &sck);
+  }
+  free(frozen);
+  free(from);
+  from = NULL;
   if (sr != 0 && made && rc == MESH_ESELF) {
+    rep->flat_frozen = 0;
     /* the mesh as made, checked for closure and self-intersection in
        its turn */
     mesh_free(me);

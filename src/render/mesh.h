@@ -168,6 +168,8 @@ typedef struct MeshReport {
                               (added to certified) */
   int flat_undone;         /* the checks failed with them: 1 closure, 2
                               self-intersection (the mesh as made kept) */
+  int flat_frozen;         /* else: the merges it took, the regions where
+                              the mesh met itself kept as made */
   long components;         /* the mesh's connected components and Euler */
   long euler;              /* characteristic (mesh_check) */
   long pairs;              /* the self-intersection check (mesh_check.h):

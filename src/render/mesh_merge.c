@@ -295,6 +295,8 @@ typedef struct {
   double (*rplane)[4];
   unsigned char *rbad;
   int *seed;    /* the triangles, largest first: regions' seeds */
+  const unsigned char *frozen; /* per triangle: a region of its own, not
+                                  merged (NULL: none) */
   Bound B;
   BEdge *edges;
   size_t nedges;
@@ -714,13 +716,14 @@ static void grow_regions(Ctx *C, const Adj *A, int *stack, const int *within,
         const double *q = m->v + 3 * m->t[3 * i + (size_t)k];
         off |= !(fabs(n[0] * q[0] + n[1] * q[1] + n[2] * q[2] - d) <= C->delta);
       }
-      if (off && pass < 2) continue;
+      int fz = C->frozen && C->frozen[i];
+      if (off && pass < 2 && !fz) continue;
       int r = C->nreg++;
       C->reg[i] = r;
       C->rcount[r] = 1;
       memcpy(C->rplane[r], n, sizeof n);
       C->rplane[r][3] = d;
-      if (off) continue;
+      if (off || fz) continue;
       size_t sp = 0;
       stack[sp++] = (int)i;
       /* breadth first (the stack read from its bottom): compact patches */
@@ -730,6 +733,7 @@ static void grow_regions(Ctx *C, const Adj *A, int *stack, const int *within,
         for (int e = 0; e < 3; e++) {
           int j = across(A, x, e);
           if (j >= 0 && C->reg[j] < 0 && C->rcount[r] < cap &&
+              !(C->frozen && C->frozen[j]) &&
               (!within || within[j] == within[i]) && region_normal_ok(C, j, n, d)) {
             C->reg[j] = r;
             C->rcount[r]++;
@@ -786,13 +790,15 @@ static int bound_build(Ctx *C, const Adj *A) {
   return 0;
 }
 
-static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
+static int mesh_merge_run(Mesh *m, double delta, const unsigned char *frozen,
+                          int **from, MeshMerge *st) {
   size_t nv = m->nv, nt = m->nt;
   int rc = -2;
   Adj A = {m, malloc((nv + 1) * sizeof *A.vs), malloc(3 * nt * sizeof *A.vt), NULL};
   Ctx C = {0};
   C.m = m;
   C.delta = delta;
+  C.frozen = frozen;
   C.reg = malloc(nt * sizeof *C.reg);
   C.rcount = malloc(nt * sizeof *C.rcount);
   C.rplane = malloc(nt * sizeof *C.rplane);
@@ -1064,6 +1070,28 @@ static int mesh_merge_run(Mesh *m, double delta, MeshMerge *st) {
     }
   }
   for (size_t i = 0; i < 3 * tot; i++) t2[i] = remap[t2[i]];
+  if (from) { /* each triangle's origin: kept, or new of region r */
+    int *f = malloc((tot ? tot : 1) * sizeof *f);
+    if (!f) {
+      free(t2);
+      goto out;
+    }
+    size_t q = 0;
+    for (size_t i = 0; i < nt; i++)
+      if (!merged[C.reg[i]]) f[q++] = (int)i;
+    for (size_t j = 0; j < nnew; j++) f[q++] = -1 - newr[j];
+    *from = f;
+    /* and the region of each triangle merged, after them */
+    int *g = realloc(f, (tot + nt) * sizeof *f);
+    if (!g) {
+      free(f);
+      *from = NULL;
+      free(t2);
+      goto out;
+    }
+    for (size_t i = 0; i < nt; i++) g[tot + i] = merged[C.reg[i]] ? C.reg[i] : -1;
+    *from = g;
+  }
   free(m->t);
   m->t = t2;
   m->nt = tot;
@@ -1105,11 +1133,17 @@ out:
   return rc;
 }
 
-int mesh_merge_flat(Mesh *m, double delta, MeshMerge *st) {
+int mesh_merge_flat_frozen(Mesh *m, double delta, const unsigned char *frozen,
+                           int **from, MeshMerge *st) {
   memset(st, 0, sizeof *st);
   st->before = st->after = m->nt;
+  if (from) *from = NULL;
   if (!(delta > 0) || m->nt < 2 || m->nt > (size_t)INT32_MAX / 3) return 0;
-  int rc = mesh_merge_run(m, delta, st);
+  int rc = mesh_merge_run(m, delta, frozen, from, st);
   mesh_check_release();
   return rc;
+}
+
+int mesh_merge_flat(Mesh *m, double delta, MeshMerge *st) {
+  return mesh_merge_flat_frozen(m, delta, NULL, NULL, st);
 }

@@ -59,4 +59,16 @@ typedef struct MeshMerge {
    success (m may be unchanged), -2 out of memory (m unchanged). */
 int mesh_merge_flat(struct Mesh *m, double delta, MeshMerge *st);
 
+/* The same with the triangles i of m where frozen[i] (NULL: none) each a
+   region of its own, left as they are. from, if not NULL: *from is set
+   to a malloc'd array (NULL when nothing was merged) of m->nt (after) +
+   nt (before) ints: for each triangle of the result, the triangle of m
+   it was (>= 0) or -1 - r for a new one of region r; then for each
+   triangle of m as given, its region r when that was merged, else -1.
+   (A caller whose result intersects itself freezes the regions there
+   and merges again: mesh.c.) */
+int mesh_merge_flat_frozen(struct Mesh *m, double delta,
+                           const unsigned char *frozen, int **from,
+                           MeshMerge *st);
+
 #endif

@@ -3466,6 +3466,56 @@ static void float_files(void) {
   }
 }
 
+/* The flat merge done again where it met itself (mesh.c, FLAT_TRIES):
+   a corner all but on a face, or two prisms corner to corner, leave
+   flat regions whose new triangles meet the other part's within 1e-16
+   (tools/fuzz-prisms.py seed 43 s91, a 24-sided prism's corner on a
+   triangular one's face, turned thrice; seed 44 s283, 29 and 44 sides
+   corner to corner, turned about z). Before, the whole merge was undone:
+   the octree's triangles, 506 and 6,168. Now the regions of the pair that
+   met are kept as made and the rest merged again: flat_undone 0, the
+   merge done again at least once, closed and oriented, no
+   self-intersections (exact, here too), at most half the octree's
+   triangles, the volume (long double) and 3000 triangle points within
+   the tolerance. */
+static void flat_retry(void) {
+  static const struct { const char *name, *src; int n[2]; double tol; } objs[] = {
+    {"fuzz-prisms 43 s91: a 24-sided prism's corner on a 3-sided one's face, turned thrice",
+     "Rotate \"x\" 60.0 (Rotate \"x\" 20.0 (Rotate \"z\" 20.0 (Union (CylinderWith "
+     "[Sides 24] 0.5 1) (Shift (0.75,0,0) (CylinderWith [Sides 3] 0.5 1)))))", {24, 3}, 0.078},
+    {"fuzz-prisms 44 s283: a 29-sided prism beside a 44-sided one, corner to corner, turned",
+     "Rotate \"z\" (-47.437) (Union (CylinderWith [Sides 29] 0.5 1) (Shift (1.0,0,0) "
+     "(CylinderWith [Sides 44] 0.5 1)))", {29, 44}, 0.052},
+  };
+  for (size_t k = 0; k < sizeof objs / sizeof *objs; k++) {
+    Mesh *m = NULL;
+    MeshReport rep;
+    char buf[600];
+    Scene *s = compile_mesh(objs[k].name, objs[k].src, objs[k].tol, &m, &rep);
+    if (!s) continue;
+    long eu = 0;
+    MeshCheck ck;
+    MeshSelfCheck sc;
+    int co = closed_oriented(m, &eu), mc = mesh_check(m, &ck), self = mesh_self_check(m, &sc);
+    snprintf(buf, sizeof buf, "flat merge again: %s: undone %d, done again %d "
+             "time(s), %ld regions, %zu -> %zu triangles, closed and oriented, "
+             "no self-intersections, %ld component(s), Euler %ld", objs[k].name,
+             rep.flat_undone, rep.flat_frozen, rep.flat_regions, rep.flat_before,
+             m->nt, ck.components, eu);
+    CHECK(buf, rep.flat_undone == 0 && rep.flat_frozen >= 1 && rep.flat_regions > 0 &&
+                   2 * m->nt <= rep.flat_before && co && mc == 0 && self == 0 &&
+                   eu == 2 * ck.components);
+    long double vol = 0;
+    for (int i = 0; i < 2; i++) {
+      long double n = objs[k].n[i];
+      vol += n * 0.25L * sinl(2 * acosl(-1) / n) / 2; /* radius 0.5, height 1 */
+    }
+    volume_and_surface("flat merge again", objs[k].name, s, m, &rep, vol, objs[k].tol);
+    mesh_free(m);
+    scene_free(s);
+  }
+}
+
 int main(void) {
   check_prefix = "mesh";
   I = bind_interp_new();
@@ -3533,6 +3583,7 @@ int main(void) {
       2, 1, 0, 0);
   one("figure12 obj5 at 0.01", src, 0.01, 2, 1, 0, 0);
   float_files();
+  flat_retry();
   /* tools/fuzz-prisms.py seed 44 (20-80 sides) s233, 63 and 62 sides
      corner to corner turned thrice: the corners' faces within 3 degrees
      of one plane; refused as thinner than the finest cell until the
