@@ -389,12 +389,10 @@ static void *run(void *arg) {
   return NULL;
 }
 
-static void *wait_run(void *unused) {
-  (void)unused;
+static void wait_run(void) {
   pthread_mutex_lock(&run_done.mu);
   while (!run_done.done) pthread_cond_wait(&run_done.cv, &run_done.mu);
   pthread_mutex_unlock(&run_done.mu);
-  return NULL;
 }
 
 /* ---- qcs tradeoff / qcs convolution (issue 6) ---- */
@@ -1018,7 +1016,7 @@ int main(int argc, char **argv) {
     run(&o);
   } else {
     GC_unregister_my_thread();
-    wait_run(NULL);
+    wait_run();
     pthread_join(th, NULL);
   }
   fflush(stdout);
